@@ -1,0 +1,54 @@
+#include "apps/cli.hpp"
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <iostream>
+#include <vector>
+
+#include "apps/commands.hpp"
+#include "core/error.hpp"
+
+namespace lambert {
+
+int run_cli(int argc, const char* const* argv) {
+  CLI::App app{"lambert: radiosity and form factors for Lambertian scenes"};
+  app.set_version_flag("--version", std::string("lambert ") + LAMBERT_VERSION);
+  app.require_subcommand(1, 1);
+
+  // Each entry: the subcommand and the function that runs it once parsed.
+  std::vector<std::pair<CLI::App*, std::function<int()>>> commands;
+  InfoOptions info;
+  commands.emplace_back(add_info_command(app, info), [&] { return run_info(info); });
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "lambert: " << e.what() << " (see lambert --help)\n";
+    return kExitUsage;
+  }
+  try {
+    for (auto& [cmd, run] : commands)
+      if (cmd->parsed()) return run();
+    return kExitUsage;
+  } catch (const UsageError& e) {
+    std::cerr << "lambert: " << e.what() << '\n';
+    return kExitUsage;
+  } catch (const Error& e) {
+    std::cerr << "lambert: " << e.what() << '\n';
+    return kExitFailure;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "lambert: out of memory\n";
+    return kExitFailure;
+  } catch (const std::exception& e) {
+    std::cerr << "lambert: " << e.what() << '\n';
+    return kExitFailure;
+  }
+}
+
+}  // namespace lambert

@@ -1,0 +1,42 @@
+#include "apps/common.hpp"
+
+#include "core/log.hpp"
+#include "io/obj_loader.hpp"
+
+namespace lambert {
+
+void add_scene_options(CLI::App* cmd, SceneArgs& args) {
+  cmd->add_option("scene", args.scene, "OBJ scene file (default: the built-in Cornell box)");
+  auto* edge = cmd->add_option("--max-edge", args.max_edge, "Longest patch edge, in scene units")
+                   ->check(CLI::PositiveNumber);
+  cmd->add_option("--patches", args.patches, "Approximate total number of patches")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{100000000}))
+      ->excludes(edge);
+}
+
+void add_run_options(CLI::App* cmd, RunArgs& args) {
+  cmd->add_option("-j,--threads", args.threads, "Worker threads (default: all cores)")
+      ->check(CLI::Range(1, 1024));
+  cmd->add_option("--seed", args.seed, "Random seed (results are bitwise reproducible)");
+  cmd->add_flag("-q,--quiet", args.quiet, "No progress or log output on stderr");
+  cmd->add_flag("-v,--verbose", args.verbose, "More log output on stderr");
+}
+
+void apply_run_options(const RunArgs& args) {
+  set_log_level(args.quiet     ? LogLevel::Quiet
+                : args.verbose ? LogLevel::Verbose
+                               : LogLevel::Normal);
+}
+
+LoadedScene load_scene(const SceneArgs& args) {
+  LoadedScene out;
+  out.scene = load_obj(args.scene.empty() ? builtin_cornell_box_path() : args.scene);
+  MeshOptions mo;
+  mo.max_edge = args.max_edge;
+  mo.target_patches = args.patches > 0 || args.max_edge > 0 ? args.patches : args.default_patches;
+  out.mesh = mesh_scene(out.scene, mo);
+  out.max_edge = out.mesh.max_edge;
+  return out;
+}
+
+}  // namespace lambert

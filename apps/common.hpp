@@ -1,0 +1,46 @@
+#pragma once
+// Options shared by subcommands and the load-and-mesh step they all start with.
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <string>
+
+#include "geometry/mesh.hpp"
+#include "geometry/scene.hpp"
+
+namespace lambert {
+
+/// Scene file and meshing target.
+struct SceneArgs {
+  std::string scene;                 ///< OBJ path; empty = built-in Cornell box
+  double max_edge = 0.0;             ///< --max-edge
+  std::int64_t patches = 0;          ///< --patches
+  std::int64_t default_patches = 0;  ///< used when neither is given
+};
+
+/// Threads, seed and verbosity.
+struct RunArgs {
+  int threads = 0;          ///< -j; 0 = all cores
+  std::uint64_t seed = 1;   ///< --seed
+  bool quiet = false;       ///< -q
+  bool verbose = false;     ///< -v
+};
+
+/// Adds the positional SCENE and --max-edge / --patches to a subcommand.
+void add_scene_options(CLI::App* cmd, SceneArgs& args);
+/// Adds -j/--threads, --seed, -q/--quiet and -v/--verbose to a subcommand.
+void add_run_options(CLI::App* cmd, RunArgs& args);
+/// Applies --quiet / --verbose to the logger.
+void apply_run_options(const RunArgs& args);
+
+/// A loaded and meshed scene.
+struct LoadedScene {
+  Scene scene;
+  PatchMesh mesh;
+  double max_edge = 0.0;  ///< the --max-edge actually used (0 = one element per face)
+};
+
+/// Loads the scene (or the built-in Cornell box) and meshes it.
+LoadedScene load_scene(const SceneArgs& args);
+
+}  // namespace lambert

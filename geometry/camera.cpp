@@ -1,0 +1,41 @@
+#include "geometry/camera.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+namespace lambert {
+
+Eigen::Vector3d Camera::ray_direction(double px, double py) const {
+  const Eigen::Vector3d forward = (look_at - eye).normalized();
+  const Eigen::Vector3d right = forward.cross(up).normalized();
+  const Eigen::Vector3d true_up = right.cross(forward);
+  const double half_h = std::tan(0.5 * vfov_degrees * M_PI / 180.0);
+  const double half_w = half_h * static_cast<double>(width) / static_cast<double>(height);
+  const double sx = (2.0 * px / width - 1.0) * half_w;
+  const double sy = (1.0 - 2.0 * py / height) * half_h;
+  return forward + sx * right + sy * true_up;
+}
+
+Camera cornell_camera() {
+  Camera c;
+  c.eye = Eigen::Vector3d(278, 273, -800);
+  c.look_at = Eigen::Vector3d(278, 273, 0);
+  c.up = Eigen::Vector3d(0, 1, 0);
+  c.vfov_degrees = 2.0 * std::atan(12.5 / 35.0) * 180.0 / M_PI;
+  c.defined = true;
+  return c;
+}
+
+Camera framing_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  Camera c;
+  const Eigen::Vector3d center = 0.5 * (lo + hi);
+  const double radius = std::max(1e-12, 0.5 * (hi - lo).norm());
+  c.vfov_degrees = 40.0;
+  const double dist = radius / std::tan(0.5 * c.vfov_degrees * M_PI / 180.0) * 1.1;
+  c.eye = center - Eigen::Vector3d(0, 0, dist);
+  c.look_at = center;
+  c.defined = true;
+  return c;
+}
+
+}  // namespace lambert

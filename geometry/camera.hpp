@@ -1,0 +1,30 @@
+#pragma once
+// Pinhole camera.
+
+#include <Eigen/Core>
+
+namespace lambert {
+
+/// A pinhole camera: position, target, up vector, vertical field of view and image size.
+struct Camera {
+  Eigen::Vector3d eye = Eigen::Vector3d(0, 0, -1);
+  Eigen::Vector3d look_at = Eigen::Vector3d(0, 0, 0);
+  Eigen::Vector3d up = Eigen::Vector3d(0, 1, 0);
+  double vfov_degrees = 40.0;  ///< full vertical field of view
+  int width = 512;
+  int height = 512;
+  bool defined = false;  ///< false until a scene or the user sets it
+
+  /// World-space direction (not normalised) through pixel position (px, py), with
+  /// (0,0) the top-left corner of the image and (width, height) the bottom-right.
+  Eigen::Vector3d ray_direction(double px, double py) const;
+};
+
+/// The published Cornell box camera: eye (278, 273, -800) looking along +z, up +y,
+/// 35 mm focal length on a 25 mm film: vfov = 2 atan(12.5/35) = 39.3077 degrees.
+Camera cornell_camera();
+
+/// A camera that frames the bounding box [lo, hi] from the -z side.
+Camera framing_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+
+}  // namespace lambert

@@ -1,0 +1,295 @@
+#include "geometry/mesh.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <unordered_map>
+
+#include "core/error.hpp"
+#include "core/sampling.hpp"
+#include "geometry/polygon.hpp"
+
+namespace lambert {
+namespace {
+
+// A triangle or quad of one surface, by surface-local vertex ids.
+struct Element {
+  std::array<std::int32_t, 4> v{};
+  int n = 3;
+};
+
+// The elements of one surface before subdivision, with welded vertices.
+struct SurfaceElements {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Element> elements;
+};
+
+SurfaceElements collect(const Scene& scene, std::int32_t surface) {
+  SurfaceElements out;
+  std::map<std::array<double, 3>, std::int32_t> weld;  // exact-position welding
+  auto local = [&](const Eigen::Vector3d& p) {
+    const std::array<double, 3> key{p.x(), p.y(), p.z()};
+    auto it = weld.find(key);
+    if (it != weld.end()) return it->second;
+    const auto id = static_cast<std::int32_t>(out.points.size());
+    out.points.push_back(p);
+    weld.emplace(key, id);
+    return id;
+  };
+  std::vector<Eigen::Vector3d> poly;
+  for (const auto& f : scene.faces) {
+    if (f.surface != surface) continue;
+    poly.clear();
+    for (auto v : f.vertices) poly.push_back(scene.vertices[v]);
+    if (polygon_area(poly) <= 0.0) continue;
+    if (poly.size() == 3 || (poly.size() == 4 && is_convex(poly))) {
+      Element e;
+      e.n = static_cast<int>(poly.size());
+      for (int k = 0; k < e.n; ++k) e.v[k] = local(poly[k]);
+      out.elements.push_back(e);
+      continue;
+    }
+    for (const auto& t : triangulate(poly)) {
+      Element e;
+      for (int k = 0; k < 3; ++k) e.v[k] = local(poly[t[k]]);
+      out.elements.push_back(e);
+    }
+  }
+  return out;
+}
+
+std::uint64_t edge_key(std::int32_t a, std::int32_t b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
+         static_cast<std::uint32_t>(b);
+}
+
+// Segment counts per edge satisfying the conformity constraints (see mesh_scene).
+std::unordered_map<std::uint64_t, std::int64_t> edge_counts(const SurfaceElements& s,
+                                                            double max_edge) {
+  std::unordered_map<std::uint64_t, std::int64_t> count;
+  for (const auto& e : s.elements) {
+    for (int k = 0; k < e.n; ++k) {
+      const auto a = e.v[k], b = e.v[(k + 1) % e.n];
+      const double len = (s.points[a] - s.points[b]).norm();
+      std::int64_t n = 1;
+      if (max_edge > 0) n = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(len / max_edge)));
+      count[edge_key(a, b)] = n;
+    }
+  }
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (const auto& e : s.elements) {
+      auto key = [&](int k) { return edge_key(e.v[k % e.n], e.v[(k + 1) % e.n]); };
+      auto unify = [&](std::initializer_list<int> edges) {
+        std::int64_t m = 0;
+        for (int k : edges) m = std::max(m, count[key(k)]);
+        for (int k : edges) {
+          if (count[key(k)] != m) {
+            count[key(k)] = m;
+            changed = true;
+          }
+        }
+      };
+      if (e.n == 3) {
+        unify({0, 1, 2});
+      } else {
+        unify({0, 2});
+        unify({1, 3});
+      }
+    }
+  }
+  return count;
+}
+
+std::int64_t count_patches(const SurfaceElements& s, double max_edge) {
+  const auto count = edge_counts(s, max_edge);
+  std::int64_t total = 0;
+  for (const auto& e : s.elements) {
+    const auto n0 = count.at(edge_key(e.v[0], e.v[1]));
+    const auto n1 = count.at(edge_key(e.v[1], e.v[2]));
+    total += e.n == 3 ? n0 * n0 : n0 * n1;
+  }
+  return total;
+}
+
+Patch make_patch(const PatchMesh& mesh, std::array<std::int32_t, 4> v, int n) {
+  Patch p;
+  p.vertices = v;
+  p.vertex_count = n;
+  const auto& a = mesh.vertices[v[0]];
+  const auto& b = mesh.vertices[v[1]];
+  const auto& c = mesh.vertices[v[2]];
+  Eigen::Vector3d cross1 = (b - a).cross(c - a);
+  const double a1 = 0.5 * cross1.norm();
+  Eigen::Vector3d centroid = a1 * (a + b + c) / 3.0;
+  Eigen::Vector3d nrm = cross1;
+  double area = a1;
+  if (n == 4) {
+    const auto& d = mesh.vertices[v[3]];
+    const Eigen::Vector3d cross2 = (c - a).cross(d - a);
+    const double a2 = 0.5 * cross2.norm();
+    centroid += a2 * (a + c + d) / 3.0;
+    nrm += cross2;
+    area += a2;
+  }
+  p.area = area;
+  p.centroid = centroid / area;
+  p.normal = nrm.normalized();
+  return p;
+}
+
+// Emits the patches of one surface into `mesh`.
+void subdivide(const SurfaceElements& s, double max_edge, std::int32_t surface,
+               const Material& mat, PatchMesh& mesh) {
+  const auto count = edge_counts(s, max_edge);
+  auto new_vertex = [&](const Eigen::Vector3d& p) {
+    mesh.vertices.push_back(p);
+    mesh.vertex_surface.push_back(surface);
+    return static_cast<std::int32_t>(mesh.vertices.size() - 1);
+  };
+  std::vector<std::int32_t> corner(s.points.size());
+  for (size_t k = 0; k < s.points.size(); ++k) corner[k] = new_vertex(s.points[k]);
+  // Shared points along each edge, stored from the lower to the higher local id.
+  std::unordered_map<std::uint64_t, std::vector<std::int32_t>> edge_points;
+  auto edge_point = [&](std::int32_t a, std::int32_t b, std::int64_t t) -> std::int32_t {
+    const auto n = count.at(edge_key(a, b));
+    auto& pts = edge_points[edge_key(a, b)];
+    if (pts.empty()) {
+      const std::int32_t lo = std::min(a, b), hi = std::max(a, b);
+      pts.push_back(corner[lo]);
+      for (std::int64_t k = 1; k < n; ++k) {
+        const double u = static_cast<double>(k) / static_cast<double>(n);
+        pts.push_back(new_vertex((1.0 - u) * s.points[lo] + u * s.points[hi]));
+      }
+      pts.push_back(corner[hi]);
+    }
+    return a < b ? pts[t] : pts[n - t];
+  };
+  auto emit = [&](std::array<std::int32_t, 4> v, int n) {
+    Patch p = make_patch(mesh, v, n);
+    p.rho = mat.rho;
+    p.emission = mat.emission;
+    p.surface = surface;
+    mesh.patches.push_back(p);
+  };
+  for (const auto& e : s.elements) {
+    const auto& P = s.points;
+    if (e.n == 3) {
+      const std::int64_t n = count.at(edge_key(e.v[0], e.v[1]));
+      // Grid point (a, b), a + b <= n: v0 + a/n (v1 - v0) + b/n (v2 - v0).
+      std::vector<std::int32_t> id((n + 1) * (n + 1), -1);
+      auto at = [&](std::int64_t a, std::int64_t b) -> std::int32_t& { return id[a * (n + 1) + b]; };
+      for (std::int64_t a = 0; a <= n; ++a) {
+        for (std::int64_t b = 0; a + b <= n; ++b) {
+          if (b == 0) at(a, b) = edge_point(e.v[0], e.v[1], a);
+          else if (a == 0) at(a, b) = edge_point(e.v[0], e.v[2], b);
+          else if (a + b == n) at(a, b) = edge_point(e.v[1], e.v[2], b);
+          else at(a, b) = new_vertex(P[e.v[0]] + (static_cast<double>(a) / n) * (P[e.v[1]] - P[e.v[0]]) +
+                                     (static_cast<double>(b) / n) * (P[e.v[2]] - P[e.v[0]]));
+        }
+      }
+      for (std::int64_t a = 0; a < n; ++a) {
+        for (std::int64_t b = 0; a + b < n; ++b) {
+          emit({at(a, b), at(a + 1, b), at(a, b + 1), 0}, 3);
+          if (a + b < n - 1) emit({at(a + 1, b), at(a + 1, b + 1), at(a, b + 1), 0}, 3);
+        }
+      }
+    } else {
+      const std::int64_t nu = count.at(edge_key(e.v[0], e.v[1]));
+      const std::int64_t nv = count.at(edge_key(e.v[1], e.v[2]));
+      // Grid point (a, b): bilinear in the quad; a along v0->v1, b along v0->v3.
+      std::vector<std::int32_t> id((nu + 1) * (nv + 1), -1);
+      auto at = [&](std::int64_t a, std::int64_t b) -> std::int32_t& { return id[a * (nv + 1) + b]; };
+      for (std::int64_t a = 0; a <= nu; ++a) {
+        for (std::int64_t b = 0; b <= nv; ++b) {
+          if (b == 0) at(a, b) = edge_point(e.v[0], e.v[1], a);
+          else if (b == nv) at(a, b) = edge_point(e.v[3], e.v[2], a);
+          else if (a == 0) at(a, b) = edge_point(e.v[0], e.v[3], b);
+          else if (a == nu) at(a, b) = edge_point(e.v[1], e.v[2], b);
+          else {
+            const double u = static_cast<double>(a) / nu, w = static_cast<double>(b) / nv;
+            at(a, b) = new_vertex((1 - u) * (1 - w) * P[e.v[0]] + u * (1 - w) * P[e.v[1]] +
+                                  u * w * P[e.v[2]] + (1 - u) * w * P[e.v[3]]);
+          }
+        }
+      }
+      for (std::int64_t a = 0; a < nu; ++a)
+        for (std::int64_t b = 0; b < nv; ++b)
+          emit({at(a, b), at(a + 1, b), at(a + 1, b + 1), at(a, b + 1)}, 4);
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> PatchMesh::corners(std::int32_t i) const {
+  const auto& p = patches[i];
+  std::vector<Eigen::Vector3d> c;
+  for (int k = 0; k < p.vertex_count; ++k) c.push_back(vertices[p.vertices[k]]);
+  return c;
+}
+
+PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options) {
+  LAMBERT_CHECK(options.max_edge >= 0 && options.target_patches >= 0, "negative mesh target");
+  std::vector<SurfaceElements> surfaces;
+  for (size_t s = 0; s < scene.surfaces.size(); ++s)
+    surfaces.push_back(collect(scene, static_cast<std::int32_t>(s)));
+
+  double max_edge = options.max_edge;
+  if (max_edge <= 0 && options.target_patches > 0) {
+    // Bisection on log(max_edge): the patch count is monotone (non-increasing) in max_edge.
+    auto total = [&](double h) {
+      std::int64_t t = 0;
+      for (const auto& s : surfaces) t += count_patches(s, h);
+      return t;
+    };
+    const auto [lo_corner, hi_corner] = scene.bounds();
+    double hi = (hi_corner - lo_corner).norm();  // one element per edge or fewer
+    double lo = hi * 1e-4;
+    const double target = static_cast<double>(options.target_patches);
+    if (total(lo) < target) {
+      max_edge = lo;
+    } else {
+      for (int it = 0; it < 60; ++it) {
+        const double mid = std::sqrt(lo * hi);
+        (static_cast<double>(total(mid)) > target ? lo : hi) = mid;
+      }
+      // Pick whichever bracket is closer to the target.
+      const double dlo = std::abs(static_cast<double>(total(lo)) - target);
+      const double dhi = std::abs(static_cast<double>(total(hi)) - target);
+      max_edge = dlo < dhi ? lo : hi;
+    }
+  }
+
+  PatchMesh mesh;
+  for (const auto& s : scene.surfaces) mesh.surface_names.push_back(s.name);
+  const auto [lo, hi] = scene.bounds();
+  mesh.max_edge = max_edge;
+  mesh.scale = scene.faces.empty() ? 1.0 : std::max((hi - lo).norm(), 1e-300);
+  for (size_t s = 0; s < surfaces.size(); ++s) {
+    subdivide(surfaces[s], max_edge, static_cast<std::int32_t>(s),
+              scene.material_of(static_cast<std::int32_t>(s)), mesh);
+  }
+  LAMBERT_CHECK(mesh.patches.size() < static_cast<size_t>(INT32_MAX), "too many patches");
+  return mesh;
+}
+
+std::uint64_t mesh_hash(const PatchMesh& mesh) {
+  std::uint64_t h = mix64(mesh.patches.size());
+  auto add = [&](double x) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    h = mix64(h ^ bits);
+  };
+  for (const auto& p : mesh.patches) {
+    for (int k = 0; k < p.vertex_count; ++k)
+      for (int d = 0; d < 3; ++d) add(mesh.vertices[p.vertices[k]][d]);
+    add(static_cast<double>(p.surface));
+  }
+  return h;
+}
+
+}  // namespace lambert

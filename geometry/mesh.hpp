@@ -1,0 +1,60 @@
+#pragma once
+// Meshing: subdivision of every surface into patches (triangles and quads), conforming
+// within a surface (shared vertices, no T-junctions created by the mesher), preserving
+// area exactly (sub-elements tile each planar element).
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "geometry/scene.hpp"
+
+namespace lambert {
+
+/// One radiosity element: a planar triangle (vertex_count 3) or quad (4).
+struct Patch {
+  std::array<std::int32_t, 4> vertices{};  ///< into PatchMesh::vertices; [3] unused for triangles
+  int vertex_count = 3;
+  double area = 0.0;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();    ///< unit front normal (winding)
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< area centroid
+  Eigen::Vector3d rho = Eigen::Vector3d::Zero();       ///< reflectance of its material
+  Eigen::Vector3d emission = Eigen::Vector3d::Zero();  ///< emitted radiosity E (W/m^2)
+  std::int32_t surface = 0;                            ///< index into Scene::surfaces
+};
+
+/// The patches of a scene. Vertices are shared within a surface, never across surfaces.
+struct PatchMesh {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::int32_t> vertex_surface;  ///< surface of each vertex
+  std::vector<Patch> patches;
+  std::vector<std::string> surface_names;  ///< copied from the scene, indexed by surface id
+  double scale = 1.0;                      ///< bounding-box diagonal (for relative epsilons)
+  double max_edge = 0.0;                   ///< edge bound used (0 = one element per face)
+
+  std::int32_t size() const { return static_cast<std::int32_t>(patches.size()); }
+  /// Corner positions of patch i.
+  std::vector<Eigen::Vector3d> corners(std::int32_t i) const;
+};
+
+/// Meshing target. Exactly one of max_edge > 0 or target_patches > 0 is used
+/// (max_edge wins when both are set); with neither, every face becomes one element.
+struct MeshOptions {
+  double max_edge = 0.0;            ///< longest allowed patch edge, scene units
+  std::int64_t target_patches = 0;  ///< approximate total patch count
+};
+
+/// Subdivides every surface of `scene`. Faces with more than 4 vertices and concave quads
+/// are triangulated first. Each element edge of length L shared within a surface gets
+/// n = ceil(L / max_edge) segments, raised until every triangle has equal counts on its
+/// three edges and every quad on opposite edges (a monotone fixpoint), so neighbours agree.
+/// Complexity O(faces + patches).
+PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options);
+
+/// A stable 64-bit hash of the meshed geometry (vertices, patches, surfaces), which is all
+/// F depends on; materials may change without invalidating a saved F.
+std::uint64_t mesh_hash(const PatchMesh& mesh);
+
+}  // namespace lambert

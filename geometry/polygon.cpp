@@ -1,0 +1,106 @@
+#include "geometry/polygon.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+
+namespace lambert {
+
+Eigen::Vector3d newell_normal(const std::vector<Eigen::Vector3d>& poly) {
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  const size_t m = poly.size();
+  if (m < 3) return n;
+  // Sum of (p_k - p_0) x (p_{k+1} - p_0): exact for planar polygons, relative to a vertex
+  // to avoid cancellation far from the origin.
+  for (size_t k = 1; k + 1 < m; ++k) n += (poly[k] - poly[0]).cross(poly[k + 1] - poly[0]);
+  return n;
+}
+
+double polygon_area(const std::vector<Eigen::Vector3d>& poly) {
+  return 0.5 * newell_normal(poly).norm();
+}
+
+double planarity_deviation(const std::vector<Eigen::Vector3d>& poly) {
+  if (poly.size() <= 3) return 0.0;
+  const Eigen::Vector3d n = newell_normal(poly);
+  if (n.norm() == 0.0) return 0.0;
+  const Eigen::Vector3d u = n.normalized();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : poly) mean += p;
+  mean /= static_cast<double>(poly.size());
+  double dev = 0.0;
+  for (const auto& p : poly) dev = std::max(dev, std::abs(u.dot(p - mean)));
+  return dev;
+}
+
+double polygon_diameter(const std::vector<Eigen::Vector3d>& poly) {
+  double d = 0.0;
+  for (size_t a = 0; a < poly.size(); ++a)
+    for (size_t b = a + 1; b < poly.size(); ++b) d = std::max(d, (poly[a] - poly[b]).norm());
+  return d;
+}
+
+namespace {
+// 2D projection of the polygon onto the plane orthogonal to its normal's dominant axis,
+// oriented so that the polygon is counter-clockwise in 2D.
+std::vector<Eigen::Vector2d> project(const std::vector<Eigen::Vector3d>& poly) {
+  const Eigen::Vector3d n = newell_normal(poly);
+  int axis = 0;
+  n.cwiseAbs().maxCoeff(&axis);
+  const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+  const bool flip = n[axis] < 0;
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(poly.size());
+  for (const auto& p : poly) out.emplace_back(flip ? p[b] : p[a], flip ? p[a] : p[b]);
+  return out;
+}
+
+double cross2(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
+}
+}  // namespace
+
+bool is_convex(const std::vector<Eigen::Vector3d>& poly) {
+  const auto p = project(poly);
+  const size_t m = p.size();
+  for (size_t k = 0; k < m; ++k) {
+    if (cross2(p[k], p[(k + 1) % m], p[(k + 2) % m]) <= 0.0) return false;
+  }
+  return true;
+}
+
+std::vector<std::array<int, 3>> triangulate(const std::vector<Eigen::Vector3d>& poly) {
+  std::vector<std::array<int, 3>> tris;
+  const auto p = project(poly);
+  std::vector<int> idx(poly.size());
+  for (size_t k = 0; k < idx.size(); ++k) idx[k] = static_cast<int>(k);
+  auto inside = [&](int a, int b, int c, int q) {
+    return cross2(p[a], p[b], p[q]) >= 0 && cross2(p[b], p[c], p[q]) >= 0 &&
+           cross2(p[c], p[a], p[q]) >= 0;
+  };
+  size_t guard = 0;
+  while (idx.size() > 3 && guard++ < 10 * poly.size() * poly.size()) {
+    bool clipped = false;
+    for (size_t k = 0; k < idx.size(); ++k) {
+      const int a = idx[(k + idx.size() - 1) % idx.size()], b = idx[k],
+                c = idx[(k + 1) % idx.size()];
+      if (cross2(p[a], p[b], p[c]) <= 0.0) continue;  // reflex or degenerate corner
+      bool ear = true;
+      for (int q : idx) {
+        if (q != a && q != b && q != c && inside(a, b, c, q)) {
+          ear = false;
+          break;
+        }
+      }
+      if (!ear) continue;
+      tris.push_back({a, b, c});
+      idx.erase(idx.begin() + static_cast<std::ptrdiff_t>(k));
+      clipped = true;
+      break;
+    }
+    if (!clipped) break;  // numerically degenerate: fall back to a fan below
+  }
+  for (size_t k = 1; k + 1 < idx.size(); ++k) tris.push_back({idx[0], idx[k], idx[k + 1]});
+  return tris;
+}
+
+}  // namespace lambert

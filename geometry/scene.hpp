@@ -1,0 +1,61 @@
+#pragma once
+// The scene model: materials, named surfaces and their planar polygonal faces.
+// Units are whatever the scene file uses (the Cornell box: millimetres); radiosity and
+// emission are in W/m^2 of that unit system ("same units as E").
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "geometry/camera.hpp"
+
+namespace lambert {
+
+/// A Lambertian material: diffuse reflectance rho (RGB, each in [0,1)) and emitted
+/// radiosity E (RGB, W/m^2, >= 0).
+struct Material {
+  std::string name;
+  Eigen::Vector3d rho = Eigen::Vector3d::Zero();
+  Eigen::Vector3d emission = Eigen::Vector3d::Zero();
+  /// True when any channel of E is positive.
+  bool emits() const { return emission.maxCoeff() > 0.0; }
+};
+
+/// A planar polygon, wound counter-clockwise about its front normal (right-hand rule).
+struct Face {
+  std::vector<std::int32_t> vertices;  ///< indices into Scene::vertices (>= 3)
+  std::int32_t surface = 0;            ///< index into Scene::surfaces
+  int line = 0;                        ///< source line of the face (0 if unknown)
+};
+
+/// A named surface: one OBJ group/object with one material. Output is reported per surface.
+struct Surface {
+  std::string name;
+  std::int32_t material = 0;  ///< index into Scene::materials
+};
+
+/// A whole scene as loaded from a file (or built by a test).
+struct Scene {
+  std::string source;  ///< file name it came from (for messages)
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<Face> faces;
+  std::vector<Surface> surfaces;
+  std::vector<Material> materials;
+  Camera camera;  ///< default view for rendering
+
+  /// Sum of all face areas.
+  double total_area() const;
+  /// Axis-aligned bounding box (min, max) of the vertices used by faces.
+  std::pair<Eigen::Vector3d, Eigen::Vector3d> bounds() const;
+  /// Material of a surface.
+  const Material& material_of(std::int32_t surface) const {
+    return materials[surfaces[surface].material];
+  }
+};
+
+/// Adds a planar polygon face on a (new or existing) surface; for tests and built-in scenes.
+void add_polygon(Scene& scene, const std::string& surface, const Material& material,
+                 const std::vector<Eigen::Vector3d>& corners);
+
+}  // namespace lambert

@@ -1,0 +1,44 @@
+#include "apps/cli.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+namespace lambert {
+namespace {
+int run(std::vector<std::string> args) {
+  args.insert(args.begin(), "lambert");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  return run_cli(static_cast<int>(argv.size()), argv.data());
+}
+}  // namespace
+
+TEST(Cli, HelpAndVersionSucceed) {
+  EXPECT_EQ(run({"--help"}), kExitOk);
+  EXPECT_EQ(run({"--version"}), kExitOk);
+}
+
+TEST(Cli, UsageErrorsExitWithTwo) {
+  EXPECT_EQ(run({}), kExitUsage);
+  EXPECT_EQ(run({"frobnicate"}), kExitUsage);
+  EXPECT_EQ(run({"info", "--no-such-option"}), kExitUsage);
+  EXPECT_EQ(run({"info", "--patches", "-5"}), kExitUsage);
+  EXPECT_EQ(run({"info", "--patches", "10", "--max-edge", "3"}), kExitUsage);
+}
+
+TEST(Cli, InfoDescribesTheBuiltInCornellBox) {
+  ::testing::internal::CaptureStdout();
+  const int code = run({"info", "-q", "--patches", "500"});
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  EXPECT_EQ(code, kExitOk);
+  EXPECT_NE(out.find("tall_block"), std::string::npos);
+  EXPECT_NE(out.find("emitters: light"), std::string::npos);
+}
+
+TEST(Cli, MissingSceneExitsWithOne) {
+  EXPECT_EQ(run({"info", "-q", "/nonexistent.obj"}), kExitFailure);
+}
+
+}  // namespace lambert

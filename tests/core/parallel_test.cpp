@@ -1,0 +1,45 @@
+#include "core/parallel.hpp"
+
+#include <gtest/gtest.h>
+
+#include <numeric>
+#include <stdexcept>
+#include <vector>
+
+#include "core/sampling.hpp"
+
+namespace lambert {
+
+TEST(ParallelFor, VisitsEveryIndexExactlyOnce) {
+  for (int threads : {1, 2, 7}) {
+    std::vector<int> hits(1003, 0);
+    parallel_for(static_cast<std::int64_t>(hits.size()), 17, threads,
+                 [&](std::int64_t b, std::int64_t e) {
+                   for (auto i = b; i < e; ++i) ++hits[i];
+                 });
+    for (int h : hits) ASSERT_EQ(h, 1) << "threads=" << threads;
+  }
+}
+
+TEST(ParallelFor, RethrowsTheWorkersExceptionOnTheCaller) {
+  EXPECT_THROW(parallel_for(100, 1, 4,
+                            [](std::int64_t b, std::int64_t) {
+                              if (b == 42) throw std::runtime_error("boom");
+                            }),
+               std::runtime_error);
+}
+
+TEST(Sampling, KroneckerPointsAreEquidistributed) {
+  // A shifted Kronecker lattice has star discrepancy O(log n / n); the count of n = 4096
+  // points in any axis-aligned box of volume 1/16 must be within a few percent of n/16,
+  // far tighter than the sqrt(n/16) = 16 points of random sampling. Allow 8 points (2 %).
+  Kronecker4 seq(hash_keys(7, 1, 2));
+  const int n = 4096;
+  for (int d = 0; d < 4; ++d) {
+    int inside = 0;
+    for (int s = 0; s < n; ++s) inside += seq.get(s, d) < 1.0 / 16;
+    EXPECT_NEAR(inside, n / 16, 8) << "dimension " << d;
+  }
+}
+
+}  // namespace lambert
