@@ -1,0 +1,92 @@
+#include "geometry/analytic.hpp"
+
+#include <cmath>
+
+namespace lambert {
+namespace {
+Material grey() { return {"grey", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()}; }
+Material lamp() { return {"lamp", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Ones()}; }
+}  // namespace
+
+Scene parallel_squares(double d) {
+  Scene s;
+  add_polygon(s, "a", lamp(), {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});  // faces +z
+  add_polygon(s, "b", grey(), {{0, 0, d}, {0, 1, d}, {1, 1, d}, {1, 0, d}});  // faces -z
+  s.camera = framing_camera({0, 0, 0}, {1, 1, d});
+  return s;
+}
+
+double parallel_rectangles_factor(double a, double b, double c) {
+  const double X = a / c, Y = b / c;
+  const double X2 = 1 + X * X, Y2 = 1 + Y * Y;
+  return 2.0 / (M_PI * X * Y) *
+         (std::log(std::sqrt(X2 * Y2 / (X2 + Y2 - 1))) + X * std::sqrt(Y2) * std::atan(X / std::sqrt(Y2)) +
+          Y * std::sqrt(X2) * std::atan(Y / std::sqrt(X2)) - X * std::atan(X) - Y * std::atan(Y));
+}
+
+Scene perpendicular_squares() {
+  Scene s;
+  add_polygon(s, "a", lamp(), {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});  // z=0, faces +z
+  add_polygon(s, "b", grey(), {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}});  // x=0, faces +x
+  s.camera = framing_camera({0, 0, 0}, {1, 1, 1});
+  return s;
+}
+
+double perpendicular_rectangles_factor(double l, double w, double h) {
+  const double H = h / l, W = w / l;
+  const double H2 = H * H, W2 = W * W, HW = H2 + W2;
+  const double t1 = W * std::atan(1 / W) + H * std::atan(1 / H) - std::sqrt(HW) * std::atan(1 / std::sqrt(HW));
+  const double a = (1 + W2) * (1 + H2) / (1 + HW);
+  const double b = W2 * (1 + HW) / ((1 + W2) * HW);
+  const double c = H2 * (1 + HW) / ((1 + H2) * HW);
+  const double t2 = 0.25 * std::log(a * std::pow(b, W2) * std::pow(c, H2));
+  return (t1 + t2) / (M_PI * W);
+}
+
+Scene unit_cube() {
+  Scene s;
+  // Each face wound counter-clockwise about its inward normal.
+  add_polygon(s, "-x", grey(), {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}});  // normal +x
+  add_polygon(s, "+x", grey(), {{1, 0, 0}, {1, 0, 1}, {1, 1, 1}, {1, 1, 0}});  // normal -x
+  add_polygon(s, "-y", grey(), {{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}});  // normal +y
+  add_polygon(s, "+y", lamp(), {{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}});  // normal -y
+  add_polygon(s, "-z", grey(), {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});  // normal +z
+  add_polygon(s, "+z", grey(), {{0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1}});  // normal -z
+  s.camera = framing_camera({0, 0, 0}, {1, 1, 1});
+  return s;
+}
+
+Scene coaxial_disks(double r1, double r2, double h, int segments) {
+  Scene s;
+  // Regular polygons with the disk's area: circumradius R with (n/2) R² sin(2π/n) = π r².
+  auto ring = [&](double r, double z, bool up) {
+    const double R = r * std::sqrt(2 * M_PI / (segments * std::sin(2 * M_PI / segments)));
+    std::vector<Eigen::Vector3d> p;
+    for (int k = 0; k < segments; ++k) {
+      const double t = 2 * M_PI * (up ? k : segments - k) / segments;
+      p.emplace_back(R * std::cos(t), R * std::sin(t), z);
+    }
+    return p;
+  };
+  add_polygon(s, "a", lamp(), ring(r1, 0, true));   // faces +z
+  add_polygon(s, "b", grey(), ring(r2, h, false));  // faces -z
+  const double r = std::max(r1, r2);
+  s.camera = framing_camera({-r, -r, 0}, {r, r, h});
+  return s;
+}
+
+double coaxial_disks_factor(double r1, double r2, double h) {
+  const double R1 = r1 / h, R2 = r2 / h;
+  const double X = 1 + (1 + R2 * R2) / (R1 * R1);
+  return 0.5 * (X - std::sqrt(X * X - 4 * (R2 / R1) * (R2 / R1)));
+}
+
+std::vector<AnalyticCase> analytic_cases() {
+  return {
+      {"parallel_squares", parallel_squares(1.0), parallel_rectangles_factor(1, 1, 1)},
+      {"perpendicular_squares", perpendicular_squares(), perpendicular_rectangles_factor(1, 1, 1)},
+      {"coaxial_disks", coaxial_disks(0.5, 0.5, 1.0, 64), coaxial_disks_factor(0.5, 0.5, 1.0)},
+  };
+}
+
+}  // namespace lambert

@@ -1,0 +1,45 @@
+#pragma once
+// Built-in analytic test scenes with closed-form view factors (Howell's catalog), used by
+// the tests and by `lambert accuracy`. All lengths in metres (unitless), surfaces named
+// "a" and "b" where a pair is involved.
+
+#include <string>
+#include <vector>
+
+#include "geometry/scene.hpp"
+
+namespace lambert {
+
+/// Two directly opposed parallel unit squares at distance `d`, facing each other.
+Scene parallel_squares(double d = 1.0);
+/// Exact F between directly opposed parallel rectangles a x b at distance c (Howell C-11).
+double parallel_rectangles_factor(double a, double b, double c);
+
+/// Two unit squares at right angles sharing an edge, both facing into the wedge.
+Scene perpendicular_squares();
+/// Exact F between perpendicular rectangles with a common edge of length l, widths w (from
+/// the emitter, "a") and h (the receiver) (Howell C-14).
+double perpendicular_rectangles_factor(double l, double w, double h);
+
+/// The inside of the unit cube: six faces facing inwards, named +x, -x, +y, -y, +z, -z.
+Scene unit_cube();
+/// Exact F between opposite (or adjacent) faces of a cube: 0.199824896 (0.200043776).
+constexpr double kCubeOpposite = 0.19982489569838732;
+constexpr double kCubeAdjacent = 0.20004377607540316;
+
+/// Two coaxial parallel disks of radii r1 ("a", emitter) and r2 ("b") at distance h,
+/// approximated by regular polygons with `segments` sides (inscribed) of the same area.
+Scene coaxial_disks(double r1, double r2, double h, int segments = 64);
+/// Exact F from disk 1 to disk 2 (Howell C-41).
+double coaxial_disks_factor(double r1, double r2, double h);
+
+/// An analytic case: its scene and the exact factor from surface "a" to surface "b".
+struct AnalyticCase {
+  std::string name;
+  Scene scene;
+  double exact_ab = 0.0;
+};
+/// The built-in analytic cases (parallel squares, perpendicular squares, coaxial disks).
+std::vector<AnalyticCase> analytic_cases();
+
+}  // namespace lambert

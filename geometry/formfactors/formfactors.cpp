@@ -1,0 +1,179 @@
+#include "geometry/formfactors/formfactors.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "core/parallel.hpp"
+#include "core/progress.hpp"
+#include "core/timer.hpp"
+#include "geometry/formfactors/pairwise.hpp"
+
+namespace lambert {
+
+namespace ff {
+
+// Ray ends are lifted off their patches by this fraction of the scene's bounding-box
+// diagonal. Embree intersects in single precision (relative error ~6e-8 of the coordinate
+// magnitude); 1e-6 of the diagonal is > 10x that for any point inside the box, yet far
+// below any feature size a radiosity mesh resolves (the form-factor bias it introduces is
+// of the order of offset / patch size, < 1e-4 for 1e4 patches).
+constexpr double kRayOffset = 1e-6;
+// Corners closer than this fraction of the diagonal to a patch's plane count as in the
+// plane for culling (float-rounded coordinates of coplanar patches differ by ~1e-16 rel.).
+constexpr double kPlaneEps = 1e-12;
+
+namespace {
+struct UpperEntry {
+  std::int32_t j;
+  double G;
+};
+}  // namespace
+
+FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& options,
+                             PairEstimator estimator) {
+  Timer timer;
+  const std::int32_t n = mesh.size();
+  const std::vector<PatchGeom> geom = patch_geometry(mesh);
+  const Bvh bvh(mesh);
+  const PairContext ctx{geom, bvh, options.samples, options.seed, kRayOffset * mesh.scale};
+  const double plane_eps = kPlaneEps * mesh.scale;
+
+  // Row i holds the pairs (i, j > i); rows are filled in parallel, one row per task.
+  std::vector<std::vector<UpperEntry>> upper(n);
+  std::vector<std::vector<double>> upper_var(options.with_stderr ? n : 0);
+  std::vector<std::int64_t> tested(n, 0), rays(n, 0);
+  const std::int64_t total_pairs = static_cast<std::int64_t>(n) * (n - 1) / 2;
+  Progress progress("form factors", options.progress ? total_pairs : 0, "rays");
+  parallel_for(n, 1, options.threads, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t ii = begin; ii < end; ++ii) {
+      const auto i = static_cast<std::int32_t>(ii);
+      std::int64_t row_rays = 0;
+      for (std::int32_t j = i + 1; j < n; ++j) {
+        if (!can_exchange(geom[i], geom[j], plane_eps)) continue;
+        ++tested[i];
+        const PairEstimate e = estimator(ctx, i, j);
+        row_rays += e.rays;
+        if (e.G <= 0.0) continue;
+        upper[i].push_back({j, e.G});
+        if (options.with_stderr) upper_var[i].push_back(e.var);
+      }
+      rays[i] = row_rays;
+      progress.advance(n - 1 - i, row_rays);
+    }
+  });
+  progress.finish();
+
+  FormFactors out;
+  out.options = options;
+  for (std::int32_t i = 0; i < n; ++i) {
+    out.stats.pairs_tested += tested[i];
+    out.stats.rays += rays[i];
+  }
+  out.stats.pairs_culled = total_pairs - out.stats.pairs_tested;
+
+  // Assemble CSR directly: row i = lower entries (m < i, from upper[m]) then upper[i].
+  std::vector<std::int32_t> lower_count(n, 0);
+  for (std::int32_t m = 0; m < n; ++m)
+    for (const auto& e : upper[m]) ++lower_count[e.j];
+  std::vector<std::int64_t> row_start(n + 1, 0);
+  for (std::int32_t i = 0; i < n; ++i)
+    row_start[i + 1] = row_start[i] + lower_count[i] + static_cast<std::int64_t>(upper[i].size());
+  const std::int64_t nnz = row_start[n];
+  LAMBERT_CHECK(nnz < INT32_MAX, "too many form factors for 32-bit sparse indices");
+  SparseF F(n, n), S;
+  F.resizeNonZeros(nnz);
+  if (options.with_stderr) {
+    S.resize(n, n);
+    S.resizeNonZeros(nnz);
+  }
+  std::vector<std::int64_t> fill(row_start.begin(), row_start.end() - 1);
+  for (std::int32_t m = 0; m < n; ++m) {  // lower part, in increasing m: sorted
+    for (size_t k = 0; k < upper[m].size(); ++k) {
+      const auto& e = upper[m][k];
+      const std::int64_t at = fill[e.j]++;
+      F.innerIndexPtr()[at] = m;
+      F.valuePtr()[at] = e.G / geom[e.j].area;
+      if (options.with_stderr) {
+        S.innerIndexPtr()[at] = m;
+        S.valuePtr()[at] = std::sqrt(upper_var[m][k]) / geom[e.j].area;
+      }
+    }
+  }
+  for (std::int32_t i = 0; i < n; ++i) {
+    for (size_t k = 0; k < upper[i].size(); ++k) {
+      const std::int64_t at = fill[i]++;
+      F.innerIndexPtr()[at] = upper[i][k].j;
+      F.valuePtr()[at] = upper[i][k].G / geom[i].area;
+      if (options.with_stderr) {
+        S.innerIndexPtr()[at] = upper[i][k].j;
+        S.valuePtr()[at] = std::sqrt(upper_var[i][k]) / geom[i].area;
+      }
+    }
+    std::vector<UpperEntry>().swap(upper[i]);  // release memory as we go
+  }
+  for (std::int32_t i = 0; i <= n; ++i) {
+    F.outerIndexPtr()[i] = static_cast<std::int32_t>(row_start[i]);
+    if (options.with_stderr) S.outerIndexPtr()[i] = static_cast<std::int32_t>(row_start[i]);
+  }
+  out.F = std::move(F);
+  if (options.with_stderr) out.stderr_F = std::move(S);
+  out.stats.seconds = timer.seconds();
+  return out;
+}
+
+}  // namespace ff
+
+namespace {
+
+struct EstimatorEntry {
+  const char* name;
+  FormFactors (*compute)(const PatchMesh&, const FormFactorOptions&);
+};
+
+const std::vector<EstimatorEntry>& registry() {
+  static const std::vector<EstimatorEntry> table = {
+      {"hybrid",
+       [](const PatchMesh& m, const FormFactorOptions& o) {
+         return ff::compute_pairwise(m, o, ff::estimate_hybrid);
+       }},
+      {"mc",
+       [](const PatchMesh& m, const FormFactorOptions& o) {
+         return ff::compute_pairwise(m, o, ff::estimate_mc);
+       }},
+  };
+  return table;
+}
+
+// Drops entries below the threshold, and their standard errors (same sparsity pattern).
+void apply_threshold(FormFactors& ff, double threshold) {
+  if (threshold <= 0.0) return;
+  if (ff.stderr_F.nonZeros() > 0) {
+    for (std::int32_t k = 0; k < ff.F.nonZeros(); ++k)
+      if (ff.F.valuePtr()[k] < threshold) ff.stderr_F.valuePtr()[k] = std::nan("");
+    ff.stderr_F.prune([](std::int32_t, std::int32_t, double v) { return !std::isnan(v); });
+  }
+  ff.F.prune([threshold](std::int32_t, std::int32_t, double v) { return v >= threshold; });
+}
+
+}  // namespace
+
+std::vector<std::string> form_factor_estimators() {
+  std::vector<std::string> names;
+  for (const auto& e : registry()) names.emplace_back(e.name);
+  return names;
+}
+
+FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions& options) {
+  if (options.samples < 1) throw UsageError("--samples must be at least 1");
+  if (mesh.patches.empty()) throw UsageError("the scene has no patches");
+  for (const auto& e : registry()) {
+    if (options.estimator != e.name) continue;
+    FormFactors out = e.compute(mesh, options);
+    apply_threshold(out, options.threshold);
+    return out;
+  }
+  throw UsageError("unknown form-factor estimator '" + options.estimator + "'");
+}
+
+}  // namespace lambert

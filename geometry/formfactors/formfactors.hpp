@@ -1,0 +1,57 @@
+#pragma once
+// Form-factor estimation: the registry of estimators and the shared result type.
+//
+// F_ij = (1/A_i) ∫_{A_i} ∫_{A_j} V(x,y) cosθ_x cosθ_y / (π r²) dA_y dA_x  (dimensionless),
+// the fraction of the power leaving patch i (front side, diffusely) that arrives at patch j.
+
+#include <Eigen/SparseCore>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/sparse.hpp"
+#include "geometry/mesh.hpp"
+
+namespace lambert {
+
+/// Row-major sparse form-factor matrix: row i holds F_ij for every j patch i sees.
+using SparseF = SparseRowMatrix;
+
+/// Settings of one form-factor computation.
+struct FormFactorOptions {
+  std::string estimator = "hybrid";  ///< a name from form_factor_estimators()
+  int samples = 32;                  ///< sample pairs (rays) per patch pair
+  std::uint64_t seed = 1;
+  int threads = 0;                   ///< 0 = all cores
+  double threshold = 0.0;            ///< drop entries with F_ij < threshold (after estimation)
+  bool with_stderr = false;          ///< also estimate the standard error of each entry
+  int hemicube_resolution = 128;     ///< hemicube top-face resolution (estimator "hemicube")
+  bool symmetrize = false;           ///< average A_i F_ij and A_j F_ji (non-reciprocal estimators)
+  bool progress = true;              ///< draw a progress bar (when stderr is a terminal)
+};
+
+/// What a computation did (for diagnostics and reports).
+struct FormFactorStats {
+  std::int64_t pairs_tested = 0;  ///< unordered pairs that can exchange energy
+  std::int64_t pairs_culled = 0;  ///< unordered pairs facing away from each other
+  std::int64_t rays = 0;          ///< occlusion rays traced
+  double seconds = 0.0;           ///< wall time of the computation
+};
+
+/// The estimated matrix, optionally with per-entry standard errors (same sparsity).
+struct FormFactors {
+  SparseF F;
+  SparseF stderr_F;  ///< empty (0 x 0) unless with_stderr
+  FormFactorStats stats;
+  FormFactorOptions options;  ///< the settings that produced F
+};
+
+/// Names of the available estimators ("mc", "hybrid", ...).
+std::vector<std::string> form_factor_estimators();
+
+/// Computes F for every patch pair of `mesh` with the chosen estimator. Multi-threaded;
+/// for a given seed the result is bitwise identical for any thread count. Throws UsageError
+/// for an unknown estimator or invalid settings.
+FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions& options);
+
+}  // namespace lambert

@@ -1,0 +1,78 @@
+#pragma once
+// Geometric kernels shared by the form-factor estimators (internal to geometry/).
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cmath>
+
+#include "geometry/mesh.hpp"
+
+namespace lambert::ff {
+
+/// A patch's corners and frame, copied out of the mesh for cache-friendly pair loops.
+struct PatchGeom {
+  std::array<Eigen::Vector3d, 4> p;
+  int n = 3;
+  Eigen::Vector3d normal;
+  Eigen::Vector3d centroid;
+  double area = 0.0;
+  double diameter = 0.0;
+};
+
+/// Copies corners and frame of every patch.
+std::vector<PatchGeom> patch_geometry(const PatchMesh& mesh);
+
+/// True when the two patches can exchange energy: some corner of each lies strictly in
+/// front of the other's plane (by more than `eps`, scene units).
+bool can_exchange(const PatchGeom& a, const PatchGeom& b, double eps);
+
+/// Maps (u, v) in [0,1)^2 to a point on the patch and returns the area density's inverse,
+/// the weight J with ∫ f dA = E[f(x) J] for (u, v) uniform on the unit square.
+/// Triangles: the parallelogram folded onto the triangle (2-to-1, so J = A);
+/// quads: bilinear (J = |dx/du x dx/dv|, constant A for parallelograms).
+inline Eigen::Vector3d sample_patch(const PatchGeom& g, double u, double v, double& jacobian) {
+  if (g.n == 3) {
+    if (u + v > 1.0) {
+      u = 1.0 - u;
+      v = 1.0 - v;
+    }
+    jacobian = g.area;
+    return g.p[0] + u * (g.p[1] - g.p[0]) + v * (g.p[2] - g.p[0]);
+  }
+  const Eigen::Vector3d du = (1 - v) * (g.p[1] - g.p[0]) + v * (g.p[2] - g.p[3]);
+  const Eigen::Vector3d dv = (1 - u) * (g.p[3] - g.p[0]) + u * (g.p[2] - g.p[1]);
+  jacobian = du.cross(dv).norm();
+  return (1 - u) * (1 - v) * g.p[0] + u * (1 - v) * g.p[1] + u * v * g.p[2] + (1 - u) * v * g.p[3];
+}
+
+/// Like sample_patch but smooth in (u, v), for quadrature: triangles use the collapsed
+/// (Duffy) map x = p0 + u (p1 - p0) + u v (p2 - p1), J = 2 A u; quads are bilinear.
+inline Eigen::Vector3d quadrature_point(const PatchGeom& g, double u, double v,
+                                        double& jacobian) {
+  if (g.n == 3) {
+    jacobian = 2.0 * g.area * u;
+    return g.p[0] + u * (g.p[1] - g.p[0]) + u * v * (g.p[2] - g.p[1]);
+  }
+  return sample_patch(g, u, v, jacobian);
+}
+
+/// Point-to-polygon form factor (Lambert's contour formula, exact):
+///   F_{dx->P} = -(1/2π) Σ_k θ_k  n_x · (r_k × r_{k+1}) / |r_k × r_{k+1}|
+/// with r_k = p_k - x and θ_k the angle between r_k and r_{k+1}. The polygon is first
+/// clipped to the half-space in front of x (n_x · (y - x) > 0) so that the horizon is
+/// respected, and is 0 when x lies behind the polygon's plane (only its front receives).
+double point_to_patch(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& g);
+
+/// Highest Gauss-Legendre order available.
+constexpr int kMaxGaussOrder = 32;
+
+/// Gauss-Legendre nodes and weights on [0, 1] for orders 1..kMaxGaussOrder (thread-safe).
+struct GaussRule {
+  const double* x;
+  const double* w;
+  int n;
+};
+GaussRule gauss_legendre(int order);
+
+}  // namespace lambert::ff

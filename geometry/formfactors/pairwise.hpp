@@ -1,0 +1,60 @@
+#pragma once
+// The pairwise form-factor driver shared by the ray-traced estimators (internal).
+//
+// For every unordered pair (i, j) that can exchange energy, an estimator returns
+// G_ij = ∫_{A_i} ∫_{A_j} V cosθ_i cosθ_j / (π r²) dA_j dA_i (scene units²) and the variance
+// of that estimate. F_ij = G_ij / A_i and F_ji = G_ij / A_j, so A_i F_ij = A_j F_ji holds
+// by construction. Each pair's random stream is a hash of (seed, i, j): results do not
+// depend on the thread count or schedule.
+
+#include <cstdint>
+#include <vector>
+
+#include "geometry/bvh.hpp"
+#include "geometry/formfactors/formfactors.hpp"
+#include "geometry/formfactors/kernels.hpp"
+
+namespace lambert::ff {
+
+/// What an estimator sees.
+struct PairContext {
+  const std::vector<PatchGeom>& geom;
+  const Bvh& bvh;
+  int samples;
+  std::uint64_t seed;
+  double offset;  ///< ray ends are lifted this far off their patches (scene units)
+};
+
+/// One pair's estimate.
+struct PairEstimate {
+  double G = 0.0;    ///< estimate of G_ij
+  double var = 0.0;  ///< estimated variance of G (0 when unknown)
+  std::int64_t rays = 0;
+};
+
+/// Signature of a pair estimator.
+using PairEstimator = PairEstimate (*)(const PairContext&, std::int32_t i, std::int32_t j);
+
+/// Estimator "mc": 4-D randomly shifted Kronecker points (x on i, y on j), one occlusion
+/// ray per sample with positive kernel. Unbiased; variance from the sample variance / k.
+PairEstimate estimate_mc(const PairContext& ctx, std::int32_t i, std::int32_t j);
+
+/// Estimator "hybrid": exact point-to-patch factors at Gauss-Legendre nodes on one patch
+/// times the visible fraction from rays to sample points on the other, done from both
+/// sides and averaged. Exact (to quadrature) for unoccluded pairs.
+PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_t j);
+
+/// Runs `estimator` over all pairs in parallel and assembles F (and stderr if asked).
+FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& options,
+                             PairEstimator estimator);
+
+/// True when the segment between x (on a patch with normal nx) and y (normal ny) is free,
+/// with both ends lifted by `offset` along their normals so the end patches never occlude.
+inline bool visible(const Bvh& bvh, const Eigen::Vector3d& x, const Eigen::Vector3d& nx,
+                    const Eigen::Vector3d& y, const Eigen::Vector3d& ny, double offset) {
+  const Eigen::Vector3d a = x + offset * nx;
+  const Eigen::Vector3d b = y + offset * ny;
+  return !bvh.occluded(a.cast<float>(), (b - a).cast<float>(), 0.0f, 1.0f);
+}
+
+}  // namespace lambert::ff

@@ -1,0 +1,174 @@
+#include "geometry/formfactors/formfactors.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "geometry/analytic.hpp"
+
+namespace lambert {
+namespace {
+
+FormFactors compute(const Scene& scene, const std::string& estimator, int samples,
+                    std::uint64_t seed = 1, double max_edge = 0.0, int threads = 0) {
+  FormFactorOptions o;
+  o.estimator = estimator;
+  o.samples = samples;
+  o.seed = seed;
+  o.threads = threads;
+  o.with_stderr = true;
+  o.progress = false;
+  return compute_form_factors(mesh_scene(scene, {max_edge, 0}), o);
+}
+
+// Surface-to-surface factor from surface 0 to surface 1 and its standard error (entries
+// are independent, so variances add), from a mesh with several patches per surface.
+std::pair<double, double> surface_factor(const PatchMesh& mesh, const FormFactors& ff) {
+  double area0 = 0.0, sum = 0.0, var = 0.0;
+  for (const auto& p : mesh.patches) area0 += p.surface == 0 ? p.area : 0.0;
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    if (mesh.patches[i].surface != 0) continue;
+    for (SparseF::InnerIterator it(ff.F, i), st(ff.stderr_F, i); it; ++it, ++st) {
+      if (mesh.patches[it.col()].surface != 1) continue;
+      sum += mesh.patches[i].area * it.value();
+      var += std::pow(mesh.patches[i].area * st.value(), 2);
+    }
+  }
+  return {sum / area0, std::sqrt(var) / area0};
+}
+
+}  // namespace
+
+TEST(AnalyticFactors, ClosedFormsMatchHowellTables) {
+  // Howell's tabulated values to their 9 printed digits.
+  EXPECT_NEAR(parallel_rectangles_factor(1, 1, 1), 0.199824896, 1e-9);
+  EXPECT_NEAR(perpendicular_rectangles_factor(1, 1, 1), 0.200043776, 1e-9);
+  // Coaxial unit-radius disks one radius apart: (3 - sqrt 5) / 2 ... for R1 = R2 = 1, X = 3.
+  EXPECT_NEAR(coaxial_disks_factor(1, 1, 1), 0.5 * (3 - std::sqrt(5.0)), 1e-15);
+}
+
+TEST(FormFactorMc, ParallelUnitSquaresMatchHowell) {
+  const FormFactors ff = compute(parallel_squares(1.0), "mc", 4096);
+  const double f = ff.F.coeff(0, 1), se = ff.stderr_F.coeff(0, 1);
+  // The estimator's own standard error; 4 sigma has a two-sided false-alarm rate of 6e-5.
+  EXPECT_GT(se, 0.0);
+  EXPECT_NEAR(f, kCubeOpposite, 4 * se) << "stderr " << se;
+}
+
+TEST(FormFactorMc, PerpendicularSquaresSharingAnEdgeMatchHowell) {
+  const FormFactors ff = compute(perpendicular_squares(), "mc", 1 << 16);
+  const double f = ff.F.coeff(0, 1), se = ff.stderr_F.coeff(0, 1);
+  EXPECT_NEAR(f, kCubeAdjacent, 4 * se) << "stderr " << se;
+}
+
+TEST(FormFactorHybrid, IsExactForUnoccludedPairs) {
+  // No blocker: every ray is visible and the estimate is the Gauss-Legendre integral of the
+  // exact point-to-patch factor. Its quadrature error is bounded by the disagreement of
+  // the two sides' integrals (reported in stderr) and is < 1e-6 by the order choice.
+  for (int samples : {2, 16}) {
+    const FormFactors par = compute(parallel_squares(1.0), "hybrid", samples);
+    EXPECT_NEAR(par.F.coeff(0, 1), kCubeOpposite, 1e-6);
+    const FormFactors perp = compute(perpendicular_squares(), "hybrid", samples);
+    EXPECT_NEAR(perp.F.coeff(0, 1), kCubeAdjacent, 1e-5);
+  }
+  // The disks are 64-gons, triangulated into 62 triangles each by the mesher.
+  const PatchMesh disks = mesh_scene(coaxial_disks(0.5, 0.5, 1.0, 64), {});
+  FormFactorOptions o;
+  o.samples = 8;
+  o.with_stderr = true;
+  o.progress = false;
+  const auto [f, se] = surface_factor(disks, compute_form_factors(disks, o));
+  // The 64-gon of equal area differs from the disk by O(1/64²) in F (measured ~2e-5).
+  EXPECT_NEAR(f, coaxial_disks_factor(0.5, 0.5, 1.0), 1e-4 + 4 * se);
+}
+
+TEST(FormFactorHybrid, MeshedSquaresSumToTheSurfaceFactor) {
+  for (const auto& [scene, exact] :
+       {std::pair{parallel_squares(1.0), kCubeOpposite}, std::pair{perpendicular_squares(), kCubeAdjacent}}) {
+    const PatchMesh mesh = mesh_scene(scene, {0.25, 0});
+    FormFactorOptions o;
+    o.samples = 8;
+    o.with_stderr = true;
+    o.progress = false;
+    const FormFactors ff = compute_form_factors(mesh, o);
+    const auto [f, se] = surface_factor(mesh, ff);
+    // Unoccluded: quadrature error only, < 1e-5 per entry relative, plus stderr.
+    EXPECT_NEAR(f, exact, 1e-5 + 4 * se);
+  }
+}
+
+TEST(FormFactors, UnitCubeRowsSumToOneAndReciprocityIsExact) {
+  for (const std::string est : {"hybrid", "mc"}) {
+    const PatchMesh mesh = mesh_scene(unit_cube(), {0.34, 0});  // 3x3 patches per face
+    FormFactorOptions o;
+    o.estimator = est;
+    o.samples = est == "mc" ? 256 : 8;
+    o.with_stderr = true;
+    o.progress = false;
+    const FormFactors ff = compute_form_factors(mesh, o);
+    for (std::int32_t i = 0; i < mesh.size(); ++i) {
+      double sum = 0.0, var = 0.0;
+      for (SparseF::InnerIterator it(ff.F, i), st(ff.stderr_F, i); it; ++it, ++st) {
+        sum += it.value();
+        var += st.value() * st.value();
+        const double aij = mesh.patches[i].area * it.value();
+        const double aji = mesh.patches[it.col()].area * ff.F.coeff(it.col(), i);
+        // Both come from the same G_ij divided by the areas: equal to rounding (2 ulps).
+        EXPECT_NEAR(aij, aji, 4e-16 * aij);
+      }
+      // A closed enclosure: every ray leaving a patch lands on another. hybrid: quadrature
+      // error (< 1e-5 per entry x 45 entries); mc: 5 sigma of the row's own error.
+      EXPECT_NEAR(sum, 1.0, est == "hybrid" ? 2e-4 : 5 * std::sqrt(var)) << est << " row " << i;
+    }
+  }
+}
+
+TEST(FormFactors, FullyBlockedPairIsZero) {
+  Scene s = parallel_squares(1.0);
+  Material m{"plate", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
+  add_polygon(s, "plate", m, {{-1, -1, 0.5}, {2, -1, 0.5}, {2, 2, 0.5}, {-1, 2, 0.5}});
+  for (const std::string est : {"mc", "hybrid"}) {
+    const FormFactors ff = compute(s, est, 64);
+    // a and b see each other only through the plate: no ray gets through, exactly 0.
+    EXPECT_EQ(ff.F.coeff(0, 1), 0.0) << est;
+    EXPECT_EQ(ff.F.coeff(1, 0), 0.0) << est;
+    // The plate faces +z: b (above it, facing down) sees its front; a is behind it.
+    EXPECT_GT(ff.F.coeff(1, 2), 0.0) << est;
+    EXPECT_EQ(ff.F.coeff(0, 2), 0.0) << est;
+  }
+}
+
+TEST(FormFactorMc, ErrorFallsAtLeastLikeOneOverSqrtSamples) {
+  // RMS error over 24 seeds at k and 16k samples: a plain MC estimator improves by
+  // sqrt(16) = 4; the shifted lattice does at least as well. Allow the ratio down to 4/1.5
+  // (the RMS over 24 seeds is itself uncertain by ~1/sqrt(2*24) = 15 %, doubled for safety).
+  auto rms = [](int k) {
+    double s2 = 0.0;
+    for (std::uint64_t seed = 1; seed <= 24; ++seed) {
+      const double e = compute(perpendicular_squares(), "mc", k, seed).F.coeff(0, 1) - kCubeAdjacent;
+      s2 += e * e;
+    }
+    return std::sqrt(s2 / 24);
+  };
+  const double e1 = rms(64), e2 = rms(1024);
+  EXPECT_GT(e1 / e2, 4.0 / 1.5) << "rms(64) " << e1 << " rms(1024) " << e2;
+}
+
+TEST(FormFactors, BitwiseIdenticalForAnyThreadCount) {
+  Scene s = unit_cube();
+  Material m{"plate", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
+  add_polygon(s, "plate", m, {{0.3, 0.3, 0.5}, {0.7, 0.3, 0.5}, {0.7, 0.7, 0.5}, {0.3, 0.7, 0.5}});
+  for (const std::string est : {"mc", "hybrid"}) {
+    const FormFactors one = compute(s, est, 8, 7, 0.2, 1);
+    for (int threads : {2, 3, 8}) {
+      const FormFactors many = compute(s, est, 8, 7, 0.2, threads);
+      ASSERT_EQ(one.F.nonZeros(), many.F.nonZeros());
+      for (std::int32_t k = 0; k < one.F.nonZeros(); ++k) {
+        ASSERT_EQ(one.F.valuePtr()[k], many.F.valuePtr()[k]) << est << " threads " << threads;
+        ASSERT_EQ(one.F.innerIndexPtr()[k], many.F.innerIndexPtr()[k]);
+      }
+    }
+  }
+}
+
+}  // namespace lambert
