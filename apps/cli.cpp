@@ -19,6 +19,9 @@ int run_cli(int argc, const char* const* argv) {
   std::vector<std::pair<CLI::App*, std::function<int()>>> commands;
   InfoOptions info;
   commands.emplace_back(add_info_command(app, info), [&] { return run_info(info); });
+  FormFactorsOptions formfactors;
+  commands.emplace_back(add_formfactors_command(app, formfactors),
+                        [&] { return run_formfactors(formfactors); });
 
   try {
     app.parse(argc, argv);

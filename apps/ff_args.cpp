@@ -1,0 +1,59 @@
+#include "apps/ff_args.hpp"
+
+#include "core/log.hpp"
+#include "core/progress.hpp"
+#include "io/ff_file.hpp"
+
+namespace lambert {
+
+void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load) {
+  cmd->add_option("--estimator", args.estimator, "Form-factor estimator")
+      ->check(CLI::IsMember(form_factor_estimators()))
+      ->capture_default_str();
+  cmd->add_option("--samples", args.samples, "Sample pairs (rays) per patch pair")
+      ->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
+  cmd->add_option("--threshold", args.threshold, "Drop form factors below this value")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--hemicube-res", args.hemicube_resolution,
+                  "Hemicube top-face resolution (estimator hemicube)")
+      ->check(CLI::Range(4, 8192))
+      ->capture_default_str();
+  cmd->add_flag("--symmetrize", args.symmetrize,
+                "Average A_i F_ij and A_j F_ji (for non-reciprocal estimators)");
+  if (with_load)
+    cmd->add_option("--ff", args.ff_file, "Use a saved form-factor file (from `formfactors -o`)");
+}
+
+FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run) {
+  FormFactorOptions o;
+  o.estimator = args.estimator;
+  o.samples = args.samples;
+  o.seed = run.seed;
+  o.threads = run.threads;
+  o.threshold = args.threshold;
+  o.hemicube_resolution = args.hemicube_resolution;
+  o.symmetrize = args.symmetrize;
+  o.progress = !run.quiet;
+  return o;
+}
+
+FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& args,
+                                const RunArgs& run, bool with_stderr) {
+  if (!args.ff_file.empty()) {
+    FormFactors ff = read_form_factors(args.ff_file, mesh_hash(scene.mesh), scene.mesh.size());
+    log_info("form factors: loaded " + args.ff_file + " (" + std::to_string(ff.F.nonZeros()) +
+             " entries)");
+    return ff;
+  }
+  FormFactorOptions o = make_ff_options(args, run);
+  o.with_stderr = with_stderr;
+  FormFactors ff = compute_form_factors(scene.mesh, o);
+  log_info("form factors: " + std::to_string(scene.mesh.size()) + " patches, " +
+           format_si(static_cast<double>(ff.F.nonZeros())) + " entries, " +
+           format_si(static_cast<double>(ff.stats.rays)) + " rays in " +
+           format_duration(ff.stats.seconds));
+  return ff;
+}
+
+}  // namespace lambert

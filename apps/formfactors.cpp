@@ -1,0 +1,190 @@
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "apps/commands.hpp"
+#include "apps/ff_args.hpp"
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/progress.hpp"
+#include "geometry/formfactors/analysis.hpp"
+#include "io/ff_file.hpp"
+#include "io/json.hpp"
+
+namespace lambert {
+namespace {
+
+std::string settings_string(const FormFactorOptions& o, const LoadedScene& s) {
+  std::ostringstream ss;
+  ss << "estimator=" << o.estimator << " samples=" << o.samples << " seed=" << o.seed
+     << " threshold=" << o.threshold << " patches=" << s.mesh.size() << " max_edge=" << s.max_edge;
+  if (o.estimator == "hemicube") ss << " hemicube_res=" << o.hemicube_resolution << " symmetrize=" << o.symmetrize;
+  return ss.str();
+}
+
+void write_diagnostics_json(std::ostream& out, const LoadedScene& s, const FormFactors& ff,
+                            const FormFactorDiagnostics& d, const std::string& settings) {
+  JsonWriter j(out);
+  j.begin_object();
+  j.field("scene", s.scene.source);
+  j.field("settings", settings);
+  j.field("patches", d.n);
+  j.field("nnz", d.nnz);
+  j.field("pairs_tested", ff.stats.pairs_tested);
+  j.field("pairs_culled", ff.stats.pairs_culled);
+  j.field("rays", ff.stats.rays);
+  j.field("seconds", ff.stats.seconds);
+  j.field("rays_per_second", ff.stats.seconds > 0 ? ff.stats.rays / ff.stats.seconds : 0.0);
+  j.key("row_sums");
+  j.begin_object();
+  j.field("min", d.row_sum_min);
+  j.field("max", d.row_sum_max);
+  j.field("mean", d.row_sum_mean);
+  j.field("histogram_max", FormFactorDiagnostics::kHistogramMax);
+  j.key("histogram");
+  j.begin_array();
+  for (auto c : d.row_sum_histogram) j.value(c);
+  j.end_array();
+  j.key("worst_rows");
+  j.begin_array();
+  for (auto i : d.worst_rows) {
+    j.begin_object();
+    j.field("patch", i);
+    j.field("surface", s.mesh.surface_names[s.mesh.patches[i].surface]);
+    double sum = 0.0;
+    for (SparseF::InnerIterator it(ff.F, i); it; ++it) sum += it.value();
+    j.field("row_sum", sum);
+    j.end_object();
+  }
+  j.end_array();
+  j.end_object();
+  j.field("reciprocity_max", d.reciprocity_max);
+  j.field("reciprocity_max_relative", d.reciprocity_max_relative);
+  j.field("entries_negative", d.negative);
+  j.field("entries_above_one", d.above_one);
+  j.end_object();
+}
+
+void print_diagnostics(const LoadedScene& s, const FormFactors& ff, const FormFactorDiagnostics& d) {
+  std::printf("patches %d, nnz %lld (%.1f%% dense), pairs tested %lld, culled %lld\n", d.n,
+              static_cast<long long>(d.nnz), 100.0 * d.nnz / std::max(1.0, double(d.n) * d.n),
+              static_cast<long long>(ff.stats.pairs_tested), static_cast<long long>(ff.stats.pairs_culled));
+  std::printf("rays %s in %s (%s rays/s)\n", format_si(double(ff.stats.rays)).c_str(),
+              format_duration(ff.stats.seconds).c_str(),
+              format_si(ff.stats.seconds > 0 ? ff.stats.rays / ff.stats.seconds : 0).c_str());
+  std::printf("row sums: min %.6f  mean %.6f  max %.6f\n", d.row_sum_min, d.row_sum_mean, d.row_sum_max);
+  std::printf("row-sum histogram (bins of %.2f from 0):", FormFactorDiagnostics::kHistogramMax / FormFactorDiagnostics::kHistogramBins);
+  for (auto c : d.row_sum_histogram) std::printf(" %lld", static_cast<long long>(c));
+  std::printf("\nlargest row sums:");
+  for (auto i : d.worst_rows) {
+    double sum = 0.0;
+    for (SparseF::InnerIterator it(ff.F, i); it; ++it) sum += it.value();
+    std::printf(" %d (%s) %.6f;", i, s.mesh.surface_names[s.mesh.patches[i].surface].c_str(), sum);
+  }
+  std::printf("\nreciprocity residual max |A_i F_ij - A_j F_ji| = %.3g (relative %.3g)\n",
+              d.reciprocity_max, d.reciprocity_max_relative);
+  std::printf("entries < 0: %lld, entries > 1: %lld\n", static_cast<long long>(d.negative),
+              static_cast<long long>(d.above_one));
+}
+
+void write_surface_json(const std::string& path, const SurfaceFactors& sf) {
+  write_stream_atomically(path, [&](std::ostream& out) {
+    JsonWriter j(out);
+    j.begin_object();
+    j.key("surfaces");
+    j.begin_array();
+    for (const auto& n : sf.surfaces) j.value(n);
+    j.end_array();
+    j.field("areas", sf.areas);
+    for (const char* key : {"F", "stderr"}) {
+      const Eigen::MatrixXd& m = std::string(key) == "F" ? sf.F : sf.stderr_F;
+      j.key(key);
+      j.begin_array();
+      for (Eigen::Index g = 0; g < m.rows(); ++g) {
+        std::vector<double> row(m.cols());
+        for (Eigen::Index h = 0; h < m.cols(); ++h) row[h] = m(g, h);
+        j.value(row);
+      }
+      j.end_array();
+    }
+    j.end_object();
+  });
+}
+
+void write_point_json(std::ostream& out, const PointFactors& pf) {
+  JsonWriter j(out);
+  j.begin_object();
+  j.key("surfaces");
+  j.begin_array();
+  for (const auto& n : pf.surfaces) j.value(n);
+  j.end_array();
+  j.field("F", pf.F);
+  j.field("stderr", pf.stderr_F);
+  j.end_object();
+}
+
+Eigen::Vector3d parse_vec(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
+
+}  // namespace
+
+CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts) {
+  auto* cmd = app.add_subcommand(
+      "formfactors", "Compute form factors F and save them (Matrix Market or binary), or surface/point view factors");
+  opts.scene.default_patches = 2000;
+  add_scene_options(cmd, opts.scene);
+  add_run_options(cmd, opts.run);
+  add_ff_options(cmd, opts.ff, false);
+  cmd->add_option("-o,--output", opts.output,
+                  "Output: F.mtx (Matrix Market), F.bin (binary), or JSON with --by-surface/--point");
+  cmd->add_option("--report", opts.report, "Diagnostics JSON (default: OUTPUT with .report.json)");
+  cmd->add_flag("--stderr", opts.with_stderr, "Also estimate and save per-entry standard errors (binary format)");
+  auto* by = cmd->add_flag("--by-surface", opts.by_surface, "Write the surface-to-surface view-factor table as JSON");
+  auto* pt = cmd->add_option("--point", opts.point, "Sensor point X,Y,Z (differential area)")
+                 ->delimiter(',')
+                 ->expected(3);
+  auto* nm = cmd->add_option("--normal", opts.normal, "Sensor normal NX,NY,NZ")->delimiter(',')->expected(3);
+  pt->needs(nm);
+  nm->needs(pt);
+  pt->excludes(by);
+  return cmd;
+}
+
+int run_formfactors(const FormFactorsOptions& opts) {
+  apply_run_options(opts.run);
+  const LoadedScene scene = load_scene(opts.scene);
+  if (!opts.point.empty()) {
+    const FormFactorOptions o = make_ff_options(opts.ff, opts.run);
+    const PointFactors pf = point_form_factors(scene.mesh, parse_vec(opts.point), parse_vec(opts.normal), o);
+    if (opts.output.empty()) {
+      write_point_json(std::cout, pf);
+    } else {
+      write_stream_atomically(opts.output, [&](std::ostream& out) { write_point_json(out, pf); });
+      log_info("wrote " + opts.output);
+    }
+    return 0;
+  }
+  if (opts.output.empty()) throw UsageError("formfactors: -o/--output is required");
+  const FormFactors ff = obtain_form_factors(scene, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
+  const FormFactorDiagnostics d = diagnose(scene.mesh, ff.F);
+  print_diagnostics(scene, ff, d);
+  const std::string settings = settings_string(ff.options, scene);
+  namespace fs = std::filesystem;
+  const std::string ext = fs::path(opts.output).extension().string();
+  if (opts.by_surface) {
+    write_surface_json(opts.output, surface_factors(scene.mesh, ff));
+  } else if (ext == ".mtx") {
+    write_matrix_market(opts.output, ff.F, {mesh_hash(scene.mesh), settings});
+  } else {
+    write_ff_binary(opts.output, ff, {mesh_hash(scene.mesh), settings});
+  }
+  log_info("wrote " + opts.output);
+  const std::string report =
+      !opts.report.empty() ? opts.report : fs::path(opts.output).replace_extension(".report.json").string();
+  write_stream_atomically(report, [&](std::ostream& out) { write_diagnostics_json(out, scene, ff, d, settings); });
+  log_info("wrote " + report);
+  return 0;
+}
+
+}  // namespace lambert
