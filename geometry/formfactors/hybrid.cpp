@@ -39,26 +39,69 @@ struct SideEstimate {
   std::int64_t rays = 0;
 };
 
+// The part of patch a in front of patch b's plane, as one or more integration pieces.
+// F(x -> b) is exactly 0 behind b's plane and jumps there (a floor patch running under a
+// block whose face stands on it), which Gauss-Legendre rules integrate badly; clipping
+// the domain to the front part keeps the integrand continuous.
+void integration_domain(const PatchGeom& a, const PatchGeom& b, std::vector<PatchGeom>& pieces) {
+  pieces.clear();
+  double d[4];
+  bool straddles = false;
+  for (int k = 0; k < a.n; ++k) {
+    d[k] = b.normal.dot(a.p[k] - b.p[0]);
+    straddles = straddles || d[k] <= 0.0;
+  }
+  if (!straddles) {
+    pieces.push_back(a);
+    return;
+  }
+  Eigen::Vector3d poly[5];
+  int m = 0;
+  for (int k = 0; k < a.n; ++k) {
+    const int l = (k + 1) % a.n;
+    if (d[k] > 0.0) poly[m++] = a.p[k];
+    if ((d[k] > 0.0) != (d[l] > 0.0)) poly[m++] = a.p[k] + d[k] / (d[k] - d[l]) * (a.p[l] - a.p[k]);
+  }
+  for (int k = 1; k + 1 < m; ++k) {
+    PatchGeom t;
+    t.n = 3;
+    t.p = {poly[0], poly[k], poly[k + 1], poly[k + 1]};
+    t.normal = a.normal;
+    t.area = 0.5 * (poly[k] - poly[0]).cross(poly[k + 1] - poly[0]).norm();
+    if (t.area > 0.0) pieces.push_back(t);
+  }
+}
+
 SideEstimate one_side(const PairContext& ctx, const PatchGeom& a, const PatchGeom& b, int rays,
                       std::uint64_t stream) {
   SideEstimate out;
   const int m = quadrature_order(a, b);
   const GaussRule rule = gauss_legendre(m);
-  const int nodes = m * m;
+  thread_local std::vector<PatchGeom> pieces, targets;
+  thread_local std::vector<Eigen::Vector3d> xs;
+  thread_local std::vector<double> wf, target_cdf;
+  integration_domain(a, b, pieces);
+  // Visibility rays go to points of b in front of a's plane only (every node x lies in that
+  // plane, so the horizon is the same for all): points beyond it are not "blocked", they
+  // are outside the integral, and counting them as blocked would bias the estimate.
+  integration_domain(b, a, targets);
+  target_cdf.clear();
+  for (const PatchGeom& t : targets) target_cdf.push_back((target_cdf.empty() ? 0.0 : target_cdf.back()) + t.area);
+  xs.clear();
+  wf.clear();
   // Node points and their unoccluded contributions w_n F(x_n -> b).
-  constexpr int kMaxNodes = 12 * 12;  // the highest order quadrature_order() returns
-  Eigen::Vector3d xs[kMaxNodes];
-  double wf[kMaxNodes];
-  for (int u = 0; u < m; ++u) {
-    for (int v = 0; v < m; ++v) {
-      double jac;
-      const int n = u * m + v;
-      xs[n] = quadrature_point(a, rule.x[u], rule.x[v], jac);
-      wf[n] = rule.w[u] * rule.w[v] * jac * point_to_patch(xs[n], a.normal, b);
-      out.unoccluded += wf[n];
+  for (const PatchGeom& piece : pieces) {
+    for (int u = 0; u < m; ++u) {
+      for (int v = 0; v < m; ++v) {
+        double jac;
+        xs.push_back(quadrature_point(piece, rule.x[u], rule.x[v], jac));
+        wf.push_back(rule.w[u] * rule.w[v] * jac * point_to_patch(xs.back(), a.normal, b));
+        out.unoccluded += wf.back();
+      }
     }
   }
-  if (out.unoccluded <= 0.0 || rays <= 0) return out;
+  const int nodes = static_cast<int>(xs.size());
+  if (out.unoccluded <= 0.0 || rays <= 0 || targets.empty()) return out;
   const Kronecker4 seq(stream);
   double num = 0.0, den = 0.0;
   // Node of ray r: spread evenly over the nodes (randomly rotated) when rays < nodes,
@@ -72,9 +115,12 @@ SideEstimate one_side(const PairContext& ctx, const PatchGeom& a, const PatchGeo
                       : (r + static_cast<int>(rotate * nodes)) % nodes;
     if (wf[n] <= 0.0) continue;
     double jb;
-    const Eigen::Vector3d y = sample_patch(b, seq.get(r, 2), seq.get(r, 3), jb);
-    const bool vis = (y - xs[n]).dot(a.normal) > 0.0 && (xs[n] - y).dot(b.normal) > 0.0 &&
-                     visible(ctx.bvh, xs[n], a.normal, y, b.normal, ctx.offset);
+    const double pick = seq.get(r, 1) * target_cdf.back();
+    const size_t t = std::min<size_t>(
+        std::lower_bound(target_cdf.begin(), target_cdf.end(), pick) - target_cdf.begin(),
+        targets.size() - 1);
+    const Eigen::Vector3d y = sample_patch(targets[t], seq.get(r, 2), seq.get(r, 3), jb);
+    const bool vis = visible(ctx.bvh, xs[n], a.normal, y, b.normal, ctx.offset);
     ++out.rays;
     num += vis ? wf[n] : 0.0;
     den += wf[n];

@@ -14,8 +14,8 @@ namespace lambert::ff {
 struct PatchGeom {
   std::array<Eigen::Vector3d, 4> p;
   int n = 3;
-  Eigen::Vector3d normal;
-  Eigen::Vector3d centroid;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   double area = 0.0;
   double diameter = 0.0;
 };
