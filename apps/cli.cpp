@@ -19,9 +19,21 @@ int run_cli(int argc, const char* const* argv) {
   std::vector<std::pair<CLI::App*, std::function<int()>>> commands;
   InfoOptions info;
   commands.emplace_back(add_info_command(app, info), [&] { return run_info(info); });
+  RenderOptions render;
+  commands.emplace_back(add_render_command(app, render), [&] { return run_render(render); });
+  RunOptions run_opts;
+  commands.emplace_back(add_run_command(app, run_opts), [&] { return run_run(run_opts); });
+  SolveCommandOptions solve;
+  commands.emplace_back(add_solve_command(app, solve), [&] { return run_solve(solve); });
+  CompareOptions compare;
+  commands.emplace_back(add_compare_command(app, compare), [&] { return run_compare(compare); });
+  SolversOptions solvers;
+  commands.emplace_back(add_solvers_command(app, solvers), [&] { return run_solvers(solvers); });
   FormFactorsOptions formfactors;
   commands.emplace_back(add_formfactors_command(app, formfactors),
                         [&] { return run_formfactors(formfactors); });
+  AccuracyOptions accuracy;
+  commands.emplace_back(add_accuracy_command(app, accuracy), [&] { return run_accuracy(accuracy); });
 
   try {
     app.parse(argc, argv);

@@ -5,6 +5,8 @@
 
 #include "apps/common.hpp"
 #include "apps/ff_args.hpp"
+#include "apps/render_stages.hpp"
+#include "solvers/radiosity.hpp"
 
 namespace lambert {
 
@@ -33,5 +35,94 @@ struct FormFactorsOptions {
 CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts);
 /// Computes F and writes it (or surface / sensor-point view factors) plus diagnostics.
 int run_formfactors(const FormFactorsOptions& opts);
+
+/// Options of `lambert solve`.
+struct SolveCommandOptions {
+  SceneArgs scene;
+  RunArgs run;
+  FormFactorArgs ff;
+  SolveOptions solve;
+  std::string output = "radiosity.csv";  ///< per-patch CSV; summary JSON beside it
+};
+/// Registers `solve` on the app.
+CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts);
+/// Solves K B = E with one solver; writes the CSV and JSON summary; 3 if not converged.
+int run_solve(const SolveCommandOptions& opts);
+
+/// Options of `lambert compare`.
+struct CompareOptions {
+  SceneArgs scene;
+  RunArgs run;
+  FormFactorArgs ff;
+  SolveOptions solve;                ///< tolerance etc. shared by every solver
+  std::vector<std::string> solvers;  ///< empty = all
+  std::string output = "compare";    ///< directory or file prefix
+};
+/// Registers `compare` on the app.
+CLI::App* add_compare_command(CLI::App& app, CompareOptions& opts);
+/// Runs every solver on one system; prints and writes the table, histories and plots.
+int run_compare(const CompareOptions& opts);
+
+/// Options of `lambert solvers`.
+struct SolversOptions {
+  RunArgs run;
+};
+/// Registers `solvers` on the app.
+CLI::App* add_solvers_command(CLI::App& app, SolversOptions& opts);
+/// Lists the solver names and descriptions.
+int run_solvers(const SolversOptions& opts);
+
+/// Options of `lambert render`.
+struct RenderOptions {
+  SceneArgs scene;
+  RunArgs run;
+  FormFactorArgs ff;
+  SolveOptions solver;
+  CameraArgs camera;
+  ShadeArgs shade;
+  std::string radiosity;                ///< per-patch CSV from `solve`; empty = F + solve here
+  std::string output = "render.exr";    ///< linear HDR image
+  std::string png;                      ///< sRGB preview; empty = output with .png
+  std::string vertex_exr;               ///< per-vertex radiosity EXR (optional)
+  std::string ply;                      ///< coloured patch mesh (optional)
+};
+/// Registers `render` on the app.
+CLI::App* add_render_command(CLI::App& app, RenderOptions& opts);
+/// Renders B (from --radiosity or computed) to EXR + PNG, optionally vertex EXR and PLY.
+int run_render(const RenderOptions& opts);
+
+/// Options of `lambert run`.
+struct RunOptions {
+  SceneArgs scene;
+  RunArgs run;
+  FormFactorArgs ff;
+  SolveOptions solver;
+  CameraArgs camera;
+  ShadeArgs shade;
+  std::string output_dir = "out";  ///< -o: output directory, created if needed
+  std::string name;                ///< file prefix; empty = scene stem ("cornell" built-in)
+};
+/// Registers `run` on the app.
+CLI::App* add_run_command(CLI::App& app, RunOptions& opts);
+/// The whole pipeline with per-stage progress, a summary on stdout and every output file.
+int run_run(const RunOptions& opts);
+
+/// Options of `lambert accuracy`.
+struct AccuracyOptions {
+  SceneArgs scene;
+  RunArgs run;
+  std::string analytic_case;  ///< --case: a built-in analytic case instead of SCENE
+  std::vector<std::string> estimators;  ///< families to run; empty = mc, hybrid, hemicube
+  std::vector<int> mc_samples{4, 16, 64};
+  std::vector<int> hybrid_samples{4, 16, 64};
+  std::vector<int> hemicube_res{32, 64, 128, 256};
+  bool symmetrize = false;       ///< also run each hemicube resolution symmetrized
+  int reference_samples = 1024;  ///< hybrid reference for scenes without a closed form
+  std::string output = "accuracy";  ///< directory or file prefix
+};
+/// Registers `accuracy` on the app.
+CLI::App* add_accuracy_command(CLI::App& app, AccuracyOptions& opts);
+/// Runs the estimators, compares F and B with the reference; table, CSVs and plot.
+int run_accuracy(const AccuracyOptions& opts);
 
 }  // namespace lambert

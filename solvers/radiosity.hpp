@@ -31,26 +31,26 @@ struct SolveOptions {
   std::string solver = "gauss-seidel";  ///< a name from solver_names()
   double tol = 1e-8;
   int max_iterations = 10000;
-  double omega = 1.5;                    ///< SOR relaxation factor
+  double omega = 1.5;                       ///< SOR relaxation factor
   std::string preconditioner = "diagonal";  ///< bicgstab: "none", "diagonal" or "ilut"
-  int restart = 30;                      ///< gmres restart length
-  bool ambient = false;                  ///< southwell: add the ambient term for display
-  int threads = 1;                       ///< threads for F x products (Gauss-Seidel/SOR/
-                                         ///< Southwell sweeps are sequential); 0 = all cores
-  bool record_history = true;            ///< Krylov solvers: replay runs for the history
+  int restart = 30;                         ///< gmres restart length
+  bool ambient = false;                     ///< southwell: add the ambient term for display
+  int threads = 1;                          ///< threads for F x products (Gauss-Seidel/SOR/
+                                            ///< Southwell sweeps are sequential); 0 = all cores
+  bool record_history = true;               ///< Krylov solvers: replay runs for the history
 };
 
 /// Per-channel solver report.
 struct ChannelReport {
   SolveStatus status = SolveStatus::Converged;
   int iterations = 0;
-  std::int64_t matvecs = 0;            ///< matrix-vector products (or equivalent row sweeps)
-  double residual = 0.0;               ///< final relative residual ||E - K B|| / ||E||
+  std::int64_t matvecs = 0;              ///< matrix-vector products (or equivalent row sweeps)
+  double residual = 0.0;                 ///< final relative residual ||E - K B|| / ||E||
   std::vector<double> residual_history;  ///< relative residual at history point k
   std::vector<double> time_history;      ///< seconds since the start at history point k
   std::vector<int> history_iteration;    ///< iteration count at history point k (0 = guess)
   double seconds = 0.0;
-  std::string note;                      ///< solver remark (refinements, ambient, fallback)
+  std::string note;  ///< solver remark (refinements, ambient, fallback)
 };
 
 /// Power bookkeeping of a solution, per channel (W in scene units).

@@ -7,6 +7,7 @@
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "core/timer.hpp"
+#include "geometry/formfactors/hemicube.hpp"
 #include "geometry/formfactors/pairwise.hpp"
 
 namespace lambert {
@@ -141,6 +142,8 @@ const std::vector<EstimatorEntry>& registry() {
        [](const PatchMesh& m, const FormFactorOptions& o) {
          return ff::compute_pairwise(m, o, ff::estimate_mc);
        }},
+      {"hemicube",
+       [](const PatchMesh& m, const FormFactorOptions& o) { return ff::compute_hemicube(m, o); }},
   };
   return table;
 }

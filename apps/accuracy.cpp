@@ -1,0 +1,518 @@
+// `lambert accuracy`: several form-factor estimators and settings on one meshed scene,
+// each compared with a reference F and with the radiosity B that reference leads to.
+//
+// Reference: for a built-in analytic case (--case) the per-patch factors
+//   F_ij = (1/A_i) ∫_{A_i} F(x -> j) dA_x
+// with the exact point-to-patch factor F(x -> j) (Lambert's contour formula) integrated by
+// composite Gauss-Legendre quadrature (all analytic cases are unoccluded), plus the closed
+// form of the surface factor; for any other scene a high-sample `hybrid` run whose own
+// standard error is reported.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "apps/cli.hpp"
+#include "apps/commands.hpp"
+#include "apps/problem.hpp"
+#include "apps/solve_args.hpp"
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/parallel.hpp"
+#include "core/timer.hpp"
+#include "geometry/analytic.hpp"
+#include "geometry/formfactors/analysis.hpp"
+#include "geometry/formfactors/kernels.hpp"
+#include "io/plot.hpp"
+
+namespace lambert {
+namespace {
+
+// Pairs closer than this many patch diameters (centroid distance / larger diameter) count as
+// "near" in the error split: the hemicube's proximity error (F taken from the centre point
+// instead of averaged over patch i) is large there, while past ~2 diameters the point-to-area
+// factor varies little across patch i (relative error ~ (diameter / 2d)² < 6%).
+constexpr double kNearDiameters = 2.0;
+// Solver tolerance for comparing B: ||E - K B|| / ||E|| <= 1e-10 gives ||B - B*||∞ <=
+// 1e-10 ||E|| / (1 - ρmax) ~ 1e-9 relative for ρ ≤ 0.9, far below the F-induced differences
+// (>= 1e-6 for any estimator setting the harness runs).
+constexpr double kSolveTol = 1e-10;
+
+// One estimator run (or the reference) and its comparison with the reference.
+struct AccuracyRow {
+  std::string estimator;
+  std::string setting;
+  double seconds = 0.0;
+  std::int64_t nnz = 0;
+  double f_ab = std::nan("");        ///< surface factor of the first exact pair
+  double f_exact_err = std::nan("");  ///< max |F_GH - exact| over the exact surface pairs
+  double max_err = 0.0, rms_err = 0.0;  ///< per-patch |F_ij - Fref_ij|
+  double max_err_near = 0.0, max_err_far = 0.0;
+  std::int32_t worst_i = -1, worst_j = -1;
+  double worst_ratio = 0.0;     ///< centroid distance / diameter of the worst pair
+  double max_row_err = 0.0;     ///< max_i |Σ_j F_ij - Σ_j Fref_ij|
+  double reciprocity = 0.0;     ///< max |A_i F_ij - A_j F_ji| / ((A_i + A_j) / 2)
+  double b_max_rel = 0.0, b_rms_rel = 0.0;  ///< per surface and channel, vs B of the reference
+  std::vector<SurfaceRadiosity> surfaces;    ///< this run's per-surface B
+};
+
+// An exactly known surface-to-surface factor.
+struct ExactPair {
+  std::int32_t g, h;
+  double value;
+};
+
+// The scene to study: an analytic case or a file (or the built-in Cornell box).
+struct Study {
+  std::string name;
+  Scene scene;
+  PatchMesh mesh;
+  std::vector<ExactPair> exact;  ///< empty for non-analytic scenes
+};
+
+std::int32_t surface_index(const PatchMesh& mesh, const std::string& name) {
+  const auto it = std::find(mesh.surface_names.begin(), mesh.surface_names.end(), name);
+  LAMBERT_CHECK(it != mesh.surface_names.end(), "analytic case without surface " + name);
+  return static_cast<std::int32_t>(it - mesh.surface_names.begin());
+}
+
+std::vector<double> surface_areas(const PatchMesh& mesh) {
+  std::vector<double> a(mesh.surface_names.size(), 0.0);
+  for (const auto& p : mesh.patches) a[p.surface] += p.area;
+  return a;
+}
+
+MeshOptions mesh_options(const SceneArgs& args) {
+  MeshOptions mo;
+  mo.max_edge = args.max_edge;
+  mo.target_patches = args.patches > 0 || args.max_edge > 0 ? args.patches : args.default_patches;
+  return mo;
+}
+
+Study make_study(const AccuracyOptions& opts) {
+  Study s;
+  if (opts.analytic_case.empty()) {
+    LoadedScene loaded = load_scene(opts.scene);
+    s.name = loaded.scene.source;
+    s.scene = std::move(loaded.scene);
+    s.mesh = std::move(loaded.mesh);
+    return s;
+  }
+  if (!opts.scene.scene.empty()) throw UsageError("accuracy: give either SCENE or --case");
+  s.name = opts.analytic_case;
+  if (opts.analytic_case == "unit_cube") {
+    s.scene = unit_cube();
+    s.mesh = mesh_scene(s.scene, mesh_options(opts.scene));
+    // Every face sees the opposite face with kCubeOpposite and each of four neighbours with
+    // kCubeAdjacent (equal areas, so both directions have the same value).
+    for (std::int32_t g = 0; g < 6; ++g)
+      for (std::int32_t h = 0; h < 6; ++h) {
+        if (g == h) continue;
+        const bool opposite = s.mesh.surface_names[g].substr(1) == s.mesh.surface_names[h].substr(1);
+        s.exact.push_back({g, h, opposite ? kCubeOpposite : kCubeAdjacent});
+      }
+    return s;
+  }
+  for (auto& c : analytic_cases()) {
+    if (c.name != opts.analytic_case) continue;
+    s.scene = std::move(c.scene);
+    s.mesh = mesh_scene(s.scene, mesh_options(opts.scene));
+    const std::int32_t a = surface_index(s.mesh, "a"), b = surface_index(s.mesh, "b");
+    const std::vector<double> area = surface_areas(s.mesh);
+    s.exact.push_back({a, b, c.exact_ab});
+    s.exact.push_back({b, a, c.exact_ab * area[a] / area[b]});  // reciprocity
+    return s;
+  }
+  throw UsageError("accuracy: unknown --case '" + opts.analytic_case + "'");
+}
+
+// (1/A_a) ∫_{A_a} F(x -> b) dA_x by composite Gauss-Legendre: s x s cells of order m in
+// patch a's parameter square. The integrand is smooth for distant pairs (order 8 gives
+// ~1e-10 for d > 3 diameters, see hybrid.cpp's (size/2d)^(2m) argument) and has a
+// log-singular derivative along an edge shared with b, which 6 x 6 cells of order 16
+// (9216 nodes) resolve to ~1e-8 (checked against Howell C-14 for the shared-edge case).
+double quadrature_factor(const ff::PatchGeom& a, const ff::PatchGeom& b) {
+  const double q = (a.centroid - b.centroid).norm() / std::max(a.diameter, b.diameter);
+  const int cells = q > 3.0 ? 1 : q > 1.2 ? 2 : 6;
+  const int order = q > 3.0 ? 8 : 16;
+  const ff::GaussRule rule = ff::gauss_legendre(order);
+  double sum = 0.0;
+  for (int cu = 0; cu < cells; ++cu)
+    for (int cv = 0; cv < cells; ++cv)
+      for (int u = 0; u < order; ++u)
+        for (int v = 0; v < order; ++v) {
+          double jac;
+          const Eigen::Vector3d x = ff::quadrature_point(a, (cu + rule.x[u]) / cells,
+                                                         (cv + rule.x[v]) / cells, jac);
+          sum += rule.w[u] * rule.w[v] * jac * ff::point_to_patch(x, a.normal, b);
+        }
+  return sum / (cells * cells * a.area);
+}
+
+// The per-patch quadrature reference for unoccluded (analytic) cases, rows in parallel.
+FormFactors quadrature_reference(const PatchMesh& mesh, int threads) {
+  Timer timer;
+  const std::vector<ff::PatchGeom> geom = ff::patch_geometry(mesh);
+  const std::int32_t n = mesh.size();
+  const double eps = 1e-12 * mesh.scale;  // as kPlaneEps in formfactors.cpp
+  std::vector<std::vector<std::pair<std::int32_t, double>>> rows(n);
+  parallel_for(n, 1, threads, [&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t i = b; i < e; ++i)
+      for (std::int32_t j = 0; j < n; ++j) {
+        if (j == i || !ff::can_exchange(geom[i], geom[j], eps)) continue;
+        const double f = quadrature_factor(geom[i], geom[j]);
+        if (f > 0.0) rows[i].emplace_back(j, f);
+      }
+  });
+  std::vector<Eigen::Triplet<double, std::int32_t>> t;
+  for (std::int32_t i = 0; i < n; ++i)
+    for (const auto& [j, f] : rows[i]) t.emplace_back(i, j, f);
+  FormFactors out;
+  out.F.resize(n, n);
+  out.F.setFromTriplets(t.begin(), t.end());
+  out.options.estimator = "quadrature";
+  out.stats.seconds = timer.seconds();
+  return out;
+}
+
+// Per-patch comparison of F with the reference (union of both sparsity patterns).
+void compare_factors(const PatchMesh& mesh, const SparseF& F, const SparseF& ref, AccuracyRow& row) {
+  const std::vector<ff::PatchGeom> geom = ff::patch_geometry(mesh);
+  const SparseF diff = F - ref;
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(mesh.size());
+  row.max_row_err = (diff * ones).cwiseAbs().maxCoeff();
+  double sum2 = 0.0;
+  std::int64_t count = 0;
+  for (std::int32_t i = 0; i < diff.outerSize(); ++i) {
+    for (SparseF::InnerIterator it(diff, i); it; ++it) {
+      const ff::PatchGeom& gi = geom[i];
+      const ff::PatchGeom& gj = geom[it.col()];
+      const double e = std::abs(it.value());
+      sum2 += e * e;
+      ++count;
+      const double ratio =
+          (gi.centroid - gj.centroid).norm() / std::max(gi.diameter, gj.diameter);
+      double& bucket = ratio < kNearDiameters ? row.max_err_near : row.max_err_far;
+      bucket = std::max(bucket, e);
+      if (e > row.max_err) {
+        row.max_err = e;
+        row.worst_i = i;
+        row.worst_j = static_cast<std::int32_t>(it.col());
+        row.worst_ratio = ratio;
+      }
+    }
+  }
+  row.rms_err = count > 0 ? std::sqrt(sum2 / count) : 0.0;
+  // Reciprocity: G = diag(A) F, residual G - G^T per pair, in units of F.
+  Eigen::VectorXd area(mesh.size());
+  for (std::int32_t i = 0; i < mesh.size(); ++i) area[i] = mesh.patches[i].area;
+  const SparseF G = area.asDiagonal() * F;
+  const SparseF R = G - SparseF(G.transpose());
+  for (std::int32_t i = 0; i < R.outerSize(); ++i)
+    for (SparseF::InnerIterator it(R, i); it; ++it)
+      row.reciprocity = std::max(row.reciprocity,
+                                 std::abs(it.value()) / (0.5 * (area[i] + area[it.col()])));
+}
+
+std::vector<SurfaceRadiosity> solve_surfaces(const PatchMesh& mesh, const SparseF& F, int threads) {
+  const RadiosityProblem problem = make_problem(mesh, F);
+  SolveOptions so;
+  so.tol = kSolveTol;
+  so.threads = threads;
+  so.record_history = false;
+  const RadiositySolution sol = solve_radiosity(problem, so);
+  if (sol.status != SolveStatus::Converged)
+    log_warn(std::string("accuracy: radiosity solve ended with status ") + to_string(sol.status));
+  return surface_averages(mesh, sol.B);
+}
+
+// Relative differences of per-surface B (each channel with B_ref > 0): max and RMS.
+void compare_radiosity(const std::vector<SurfaceRadiosity>& ref, AccuracyRow& row) {
+  double sum2 = 0.0;
+  int count = 0;
+  for (size_t s = 0; s < ref.size(); ++s)
+    for (int c = 0; c < 3; ++c) {
+      if (ref[s].area <= 0.0 || !(ref[s].average[c] > 0.0)) continue;
+      const double rel = std::abs(row.surfaces[s].average[c] - ref[s].average[c]) / ref[s].average[c];
+      row.b_max_rel = std::max(row.b_max_rel, rel);
+      sum2 += rel * rel;
+      ++count;
+    }
+  row.b_rms_rel = count > 0 ? std::sqrt(sum2 / count) : 0.0;
+}
+
+void compare_exact(const Study& study, const FormFactors& ff, AccuracyRow& row) {
+  if (study.exact.empty()) return;
+  const SurfaceFactors sf = surface_factors(study.mesh, ff);
+  row.f_ab = sf.F(study.exact[0].g, study.exact[0].h);
+  row.f_exact_err = 0.0;
+  for (const auto& e : study.exact)
+    row.f_exact_err = std::max(row.f_exact_err, std::abs(sf.F(e.g, e.h) - e.value));
+}
+
+// The runs to make, in table order: (estimator, samples or resolution, symmetrize).
+struct RunSpec {
+  std::string estimator;
+  int value;
+  bool symmetrize;
+};
+
+std::vector<RunSpec> run_specs(const AccuracyOptions& opts) {
+  const std::vector<std::string> families =
+      opts.estimators.empty() ? std::vector<std::string>{"mc", "hybrid", "hemicube"} : opts.estimators;
+  std::vector<RunSpec> out;
+  for (const auto& f : families) {
+    if (f == "mc")
+      for (int k : opts.mc_samples) out.push_back({f, k, false});
+    if (f == "hybrid")
+      for (int k : opts.hybrid_samples) out.push_back({f, k, false});
+    if (f == "hemicube")
+      for (int r : opts.hemicube_res) {
+        out.push_back({f, r, false});
+        if (opts.symmetrize) out.push_back({f, r, true});
+      }
+  }
+  return out;
+}
+
+std::string spec_name(const RunSpec& s) { return s.symmetrize ? s.estimator + "-sym" : s.estimator; }
+std::string spec_setting(const RunSpec& s) {
+  return (s.estimator == "hemicube" ? "N=" : "k=") + std::to_string(s.value);
+}
+
+std::string output_base(const std::string& out) {
+  namespace fs = std::filesystem;
+  if (!out.empty() && (out.back() == '/' || fs::is_directory(out))) {
+    std::error_code ec;
+    fs::create_directories(out, ec);
+    if (ec) throw IoError(out + ": cannot create directory: " + ec.message());
+    return (fs::path(out) / "accuracy").string();
+  }
+  return out;
+}
+
+void write_table_csv(const std::string& path, const Study& study, const std::vector<AccuracyRow>& rows) {
+  write_stream_atomically(path, [&](std::ostream& out) {
+    out << "scene,estimator,setting,seconds,nnz,F_ab,F_exact_abs_err,max_abs_err,rms_abs_err,"
+           "max_abs_err_near,max_abs_err_far,worst_i,worst_j,worst_distance_ratio,"
+           "max_row_sum_err,reciprocity,B_max_rel_diff,B_rms_rel_diff\n";
+    for (const auto& r : rows)
+      out << csv_field(study.name) << ',' << r.estimator << ',' << r.setting << ','
+          << csv_number(r.seconds) << ',' << r.nnz << ',' << csv_number(r.f_ab) << ','
+          << csv_number(r.f_exact_err) << ',' << csv_number(r.max_err) << ','
+          << csv_number(r.rms_err) << ',' << csv_number(r.max_err_near) << ','
+          << csv_number(r.max_err_far) << ',' << r.worst_i << ',' << r.worst_j << ','
+          << csv_number(r.worst_ratio) << ',' << csv_number(r.max_row_err) << ','
+          << csv_number(r.reciprocity) << ',' << csv_number(r.b_max_rel) << ','
+          << csv_number(r.b_rms_rel) << '\n';
+  });
+}
+
+void write_surfaces_csv(const std::string& path, const std::vector<AccuracyRow>& rows,
+                        const std::vector<SurfaceRadiosity>& ref) {
+  write_stream_atomically(path, [&](std::ostream& out) {
+    out << "estimator,setting,surface,channel,B,B_reference,rel_diff\n";
+    for (const auto& r : rows)
+      for (size_t s = 0; s < ref.size(); ++s)
+        for (int c = 0; c < 3; ++c) {
+          const double b = r.surfaces[s].average[c], br = ref[s].average[c];
+          out << r.estimator << ',' << r.setting << ',' << csv_field(ref[s].name) << ','
+              << channel_name(c) << ',' << csv_number(b) << ',' << csv_number(br) << ','
+              << csv_number(br > 0.0 ? std::abs(b - br) / br : std::nan("")) << '\n';
+        }
+  });
+}
+
+// Error-vs-time panels, one series per estimator family (points in table order).
+std::vector<Plot> error_plots(const std::vector<AccuracyRow>& rows, bool analytic) {
+  Plot f, b;
+  f.title = "RMS |F - F_ref| per patch pair vs time";
+  f.x_label = "form-factor time (s)";
+  f.y_label = "RMS abs error of F";
+  b.title = "max relative B difference per surface vs time";
+  b.x_label = f.x_label;
+  b.y_label = "max |B - B_ref| / B_ref";
+  Plot e;
+  e.title = "surface factor error vs time (closed form)";
+  e.x_label = f.x_label;
+  e.y_label = "max |F_GH - exact|";
+  std::map<std::string, size_t> index;
+  for (const auto& r : rows) {
+    if (r.setting == "reference") continue;
+    auto [it, added] = index.emplace(r.estimator, f.series.size());
+    if (added) {
+      f.series.push_back({r.estimator, {}, {}});
+      b.series.push_back({r.estimator, {}, {}});
+      e.series.push_back({r.estimator, {}, {}});
+    }
+    const size_t k = it->second;
+    f.series[k].x.push_back(r.seconds);
+    f.series[k].y.push_back(r.rms_err);
+    b.series[k].x.push_back(r.seconds);
+    b.series[k].y.push_back(r.b_max_rel);
+    e.series[k].x.push_back(r.seconds);
+    e.series[k].y.push_back(r.f_exact_err);
+  }
+  if (analytic) return {f, e, b};
+  return {f, b};
+}
+
+void print_table(const Study& study, const std::vector<AccuracyRow>& rows) {
+  std::printf("%-12s %-10s %9s %10s %10s %10s %10s %10s %10s %10s %10s %10s %10s\n", "estimator",
+              "setting", "time (s)", "F_ab", "|F_GH-ex|", "max|dF|", "rms|dF|", "near max",
+              "far max", "max|dRow|", "recip", "B max rel", "B rms rel");
+  for (const auto& r : rows) {
+    std::printf("%-12s %-10s %9.3f %10.6f %10.3e %10.3e %10.3e %10.3e %10.3e %10.3e %10.3e "
+                "%10.3e %10.3e\n",
+                r.estimator.c_str(), r.setting.c_str(), r.seconds, r.f_ab, r.f_exact_err,
+                r.max_err, r.rms_err, r.max_err_near, r.max_err_far, r.max_row_err,
+                r.reciprocity, r.b_max_rel, r.b_rms_rel);
+  }
+  (void)study;
+}
+
+// Spells out the two hemicube failure modes from the table: the far-pair error (aliasing)
+// falls with the resolution, the near-pair error (proximity) does not.
+void print_failure_modes(const std::vector<AccuracyRow>& rows) {
+  const AccuracyRow* lo = nullptr;
+  const AccuracyRow* hi = nullptr;
+  for (const auto& r : rows) {
+    if (r.estimator != "hemicube") continue;
+    if (!lo) lo = &r;
+    hi = &r;
+  }
+  if (!lo || lo == hi) return;
+  std::printf("hemicube aliasing (pairs >= %.0f diameters apart): max |dF| %.3e at %s -> %.3e at %s\n",
+              kNearDiameters, lo->max_err_far, lo->setting.c_str(), hi->max_err_far, hi->setting.c_str());
+  if (lo->max_err_near <= 0.0 && hi->max_err_near <= 0.0) return;  // no neighbours in the scene
+  std::printf("hemicube proximity (pairs < %.0f diameters apart): max |dF| %.3e at %s -> %.3e at %s"
+              " (F is taken at the patch centre: resolution cannot remove this)\n",
+              kNearDiameters, lo->max_err_near, lo->setting.c_str(), hi->max_err_near,
+              hi->setting.c_str());
+}
+
+}  // namespace
+
+CLI::App* add_accuracy_command(CLI::App& app, AccuracyOptions& opts) {
+  auto* cmd = app.add_subcommand(
+      "accuracy", "Compare form-factor estimators and settings with a reference: table, CSV, plot");
+  opts.scene.default_patches = 200;
+  add_scene_options(cmd, opts.scene);
+  cmd->add_option("--case", opts.analytic_case, "Built-in analytic case instead of SCENE")
+      ->check(CLI::IsMember({"parallel_squares", "perpendicular_squares", "unit_cube", "coaxial_disks"}));
+  cmd->add_option("--estimators", opts.estimators, "Estimator families to run (default: all)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"mc", "hybrid", "hemicube"}));
+  cmd->add_option("--mc-samples", opts.mc_samples, "Sample counts for mc")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
+  cmd->add_option("--hybrid-samples", opts.hybrid_samples, "Sample counts for hybrid")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
+  cmd->add_option("--hemicube-res", opts.hemicube_res, "Resolutions for hemicube")
+      ->delimiter(',')
+      ->check(CLI::Range(4, 8192))
+      ->capture_default_str();
+  cmd->add_flag("--symmetrize", opts.symmetrize, "Also run each hemicube resolution symmetrized");
+  cmd->add_option("--reference-samples", opts.reference_samples,
+                  "Samples of the hybrid reference (scenes without a closed form)")
+      ->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
+  cmd->add_option("-o,--output", opts.output,
+                  "Output directory (existing or ending in /) or file prefix")
+      ->capture_default_str();
+  add_run_options(cmd, opts.run);
+  return cmd;
+}
+
+int run_accuracy(const AccuracyOptions& opts) {
+  apply_run_options(opts.run);
+  const Study study = make_study(opts);
+  const PatchMesh& mesh = study.mesh;
+  const bool analytic = !study.exact.empty();
+  std::printf("%s: %zu surfaces, %d patches\n", study.name.c_str(), mesh.surface_names.size(),
+              mesh.size());
+
+  // The reference.
+  FormFactorOptions base;
+  base.seed = opts.run.seed;
+  base.threads = opts.run.threads;
+  base.progress = !opts.run.quiet;
+  FormFactors ref;
+  if (analytic) {
+    log_info("accuracy: reference by quadrature of the exact point-to-patch factor");
+    ref = quadrature_reference(mesh, opts.run.threads);
+  } else {
+    FormFactorOptions o = base;
+    o.estimator = "hybrid";
+    o.samples = opts.reference_samples;
+    o.with_stderr = true;
+    log_info("accuracy: reference hybrid k=" + std::to_string(o.samples));
+    ref = compute_form_factors(mesh, o);
+  }
+  AccuracyRow ref_row;
+  ref_row.estimator = analytic ? "quadrature" : "hybrid";
+  ref_row.setting = "reference";
+  ref_row.seconds = ref.stats.seconds;
+  ref_row.nnz = ref.F.nonZeros();
+  compare_exact(study, ref, ref_row);
+  ref_row.surfaces = solve_surfaces(mesh, ref.F, opts.run.threads);
+  compare_factors(mesh, ref.F, ref.F, ref_row);
+  if (analytic) {
+    std::printf("reference: per-patch quadrature of the exact point-to-patch factor; exact "
+                "surface factors (closed form): F(%s->%s) = %.9f\n",
+                mesh.surface_names[study.exact[0].g].c_str(),
+                mesh.surface_names[study.exact[0].h].c_str(), study.exact[0].value);
+  } else {
+    double max_se = 0.0, sum2 = 0.0;
+    for (std::int32_t k = 0; k < ref.stderr_F.nonZeros(); ++k) {
+      max_se = std::max(max_se, ref.stderr_F.valuePtr()[k]);
+      sum2 += std::pow(ref.stderr_F.valuePtr()[k], 2);
+    }
+    std::printf("reference: hybrid k=%d, its own standard error per entry: max %.3e, RMS %.3e\n",
+                opts.reference_samples, max_se,
+                std::sqrt(sum2 / std::max<std::int64_t>(1, ref.stderr_F.nonZeros())));
+  }
+
+  std::vector<AccuracyRow> rows{ref_row};
+  for (const RunSpec& spec : run_specs(opts)) {
+    FormFactorOptions o = base;
+    o.estimator = spec.estimator;
+    if (spec.estimator == "hemicube") o.hemicube_resolution = spec.value;
+    else o.samples = spec.value;
+    o.symmetrize = spec.symmetrize;
+    AccuracyRow row;
+    row.estimator = spec_name(spec);
+    row.setting = spec_setting(spec);
+    log_info("accuracy: " + row.estimator + " " + row.setting);
+    const FormFactors ff = compute_form_factors(mesh, o);
+    row.seconds = ff.stats.seconds;
+    row.nnz = ff.F.nonZeros();
+    compare_exact(study, ff, row);
+    compare_factors(mesh, ff.F, ref.F, row);
+    row.surfaces = solve_surfaces(mesh, ff.F, opts.run.threads);
+    compare_radiosity(ref_row.surfaces, row);
+    rows.push_back(std::move(row));
+  }
+
+  print_table(study, rows);
+  print_failure_modes(rows);
+  const std::string base_path = output_base(opts.output);
+  const std::string csv = base_path + "_table.csv", surf = base_path + "_surfaces.csv";
+  const std::string svg = base_path + "_error_vs_time.svg", png = base_path + "_error_vs_time.png";
+  write_table_csv(csv, study, rows);
+  write_surfaces_csv(surf, rows, ref_row.surfaces);
+  const std::vector<Plot> plots = error_plots(rows, analytic);
+  write_loglog_svg(svg, plots);
+  write_loglog_png(png, plots);
+  std::printf("wrote %s, %s, %s, %s\n", csv.c_str(), surf.c_str(), svg.c_str(), png.c_str());
+  return kExitOk;
+}
+
+}  // namespace lambert

@@ -1,0 +1,179 @@
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "apps/cli.hpp"
+#include "apps/commands.hpp"
+#include "apps/problem.hpp"
+#include "apps/solve_args.hpp"
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "io/plot.hpp"
+
+namespace lambert {
+namespace {
+
+// One solver's row of the comparison (channels aggregated).
+struct CompareRow {
+  std::string solver;
+  RadiositySolution solution;
+  int iterations = 0;        ///< summed over channels
+  std::int64_t matvecs = 0;  ///< summed over channels
+  double residual = 0.0;     ///< worst channel
+  double max_diff = 0.0;     ///< max_i,c |B - B_direct|
+};
+
+// -o DIR (existing directory or ending in '/'): DIR/compare; otherwise a file prefix.
+std::string output_base(const std::string& out) {
+  namespace fs = std::filesystem;
+  if (!out.empty() && (out.back() == '/' || fs::is_directory(out))) {
+    std::error_code ec;
+    fs::create_directories(out, ec);
+    if (ec) throw IoError(out + ": cannot create directory: " + ec.message());
+    return (fs::path(out) / "compare").string();
+  }
+  return out;
+}
+
+// The channel the plot shows: the one with the most emitted power.
+int plot_channel(const RadiosityProblem& p) {
+  int best = 0;
+  for (int c = 1; c < 3; ++c)
+    if (p.area.dot(p.emission.col(c)) > p.area.dot(p.emission.col(best))) best = c;
+  return best;
+}
+
+void write_table_csv(const std::string& path, const std::vector<CompareRow>& rows) {
+  write_stream_atomically(path, [&](std::ostream& out) {
+    out << "solver,status,iterations,matvecs,seconds,residual,max_diff_direct\n";
+    for (const auto& r : rows)
+      out << r.solver << ',' << to_string(r.solution.status) << ',' << r.iterations << ','
+          << r.matvecs << ',' << csv_number(r.solution.seconds) << ',' << csv_number(r.residual)
+          << ',' << csv_number(r.max_diff) << '\n';
+  });
+}
+
+void write_history_csv(const std::string& path, const std::vector<CompareRow>& rows) {
+  write_stream_atomically(path, [&](std::ostream& out) {
+    out << "solver,channel,iteration,seconds,residual\n";
+    for (const auto& r : rows)
+      for (int c = 0; c < 3; ++c) {
+        const ChannelReport& ch = r.solution.channels[c];
+        for (size_t k = 0; k < ch.residual_history.size(); ++k)
+          out << r.solver << ',' << channel_name(c) << ',' << ch.history_iteration[k] << ','
+              << csv_number(ch.time_history[k]) << ',' << csv_number(ch.residual_history[k])
+              << '\n';
+      }
+  });
+}
+
+std::vector<Plot> convergence_plots(const std::vector<CompareRow>& rows, int c, double tol) {
+  Plot by_iteration, by_time;
+  const std::string ch = std::string(" (channel ") + channel_name(c) + ", tol " + [&] {
+    std::ostringstream s;
+    s << tol;
+    return s.str();
+  }() + ")";
+  by_iteration.title = "residual vs iteration" + ch;
+  by_iteration.x_label = "iteration";
+  by_time.title = "residual vs time" + ch;
+  by_time.x_label = "seconds";
+  by_iteration.y_label = by_time.y_label = "||E - K B|| / ||E||";
+  for (const auto& r : rows) {
+    const ChannelReport& rep = r.solution.channels[c];
+    PlotSeries it{r.solver, {}, rep.residual_history};
+    it.x.assign(rep.history_iteration.begin(), rep.history_iteration.end());
+    by_iteration.series.push_back(it);
+    by_time.series.push_back({r.solver, rep.time_history, rep.residual_history});
+  }
+  return {by_iteration, by_time};
+}
+
+}  // namespace
+
+CLI::App* add_compare_command(CLI::App& app, CompareOptions& opts) {
+  auto* cmd = app.add_subcommand(
+      "compare", "Run several solvers on one system: table, histories and convergence plots");
+  opts.scene.default_patches = 2000;
+  add_scene_options(cmd, opts.scene);
+  add_ff_options(cmd, opts.ff);
+  add_solve_options(cmd, opts.solve, false);
+  cmd->add_option("--solvers", opts.solvers, "Comma-separated solvers (default: all)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(solver_names()));
+  cmd->add_option("-o,--output", opts.output,
+                  "Output directory (existing or ending in /) or file prefix")
+      ->capture_default_str();
+  add_run_options(cmd, opts.run);
+  return cmd;
+}
+
+int run_compare(const CompareOptions& opts) {
+  apply_run_options(opts.run);
+  const LoadedScene loaded = load_scene(opts.scene);
+  const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);
+  const RadiosityProblem problem = make_problem(loaded.mesh, ff.F);
+  std::vector<std::string> names = opts.solvers.empty() ? solver_names() : opts.solvers;
+  names.erase(std::unique(names.begin(), names.end()), names.end());
+  const std::string base = output_base(opts.output);
+
+  std::vector<CompareRow> rows;
+  for (const auto& name : names) {
+    SolveOptions so = opts.solve;
+    so.solver = name;
+    so.threads = opts.run.threads;
+    log_info("compare: running " + name);
+    CompareRow row;
+    row.solver = name;
+    row.solution = solve_radiosity(problem, so);
+    for (const auto& ch : row.solution.channels) {
+      row.iterations += ch.iterations;
+      row.matvecs += ch.matvecs;
+      row.residual = std::max(row.residual, ch.residual);
+    }
+    rows.push_back(std::move(row));
+  }
+  // The reference: `direct` from the list, or an extra direct solve.
+  Eigen::MatrixX3d reference;
+  const auto direct = std::find_if(rows.begin(), rows.end(),
+                                   [](const CompareRow& r) { return r.solver == "direct"; });
+  if (direct != rows.end()) {
+    reference = direct->solution.B;
+  } else {
+    SolveOptions so = opts.solve;
+    so.solver = "direct";
+    so.threads = opts.run.threads;
+    log_info("compare: running direct for the reference solution");
+    reference = solve_radiosity(problem, so).B;
+  }
+  for (auto& r : rows) r.max_diff = (r.solution.B - reference).cwiseAbs().maxCoeff();
+
+  std::printf("%d patches, %lld form factors, tol %g, max-iter %d\n", loaded.mesh.size(),
+              static_cast<long long>(ff.F.nonZeros()), opts.solve.tol, opts.solve.max_iterations);
+  std::printf("%-13s %-15s %10s %10s %10s %12s %15s\n", "solver", "status", "iterations",
+              "mat-vecs", "time (s)", "residual", "max |B-direct|");
+  bool all_converged = true;
+  for (const auto& r : rows) {
+    std::printf("%-13s %-15s %10d %10lld %10.4f %12.3e %15.3e\n", r.solver.c_str(),
+                to_string(r.solution.status), r.iterations, static_cast<long long>(r.matvecs),
+                r.solution.seconds, r.residual, r.max_diff);
+    all_converged = all_converged && r.solution.status == SolveStatus::Converged;
+  }
+  const std::string table = base + "_table.csv", history = base + "_history.csv";
+  const std::string svg = base + "_convergence.svg", png = base + "_convergence.png";
+  write_table_csv(table, rows);
+  write_history_csv(history, rows);
+  const auto plots = convergence_plots(rows, plot_channel(problem), opts.solve.tol);
+  write_plots_svg(svg, plots);
+  write_plots_png(png, plots);
+  std::printf("wrote %s, %s, %s, %s\n", table.c_str(), history.c_str(), svg.c_str(), png.c_str());
+  if (!all_converged) {
+    log_warn("some solvers did not converge within --max-iter; results were written anyway");
+    return kExitNotConverged;
+  }
+  return kExitOk;
+}
+
+}  // namespace lambert

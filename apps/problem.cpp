@@ -1,0 +1,42 @@
+#include "apps/problem.hpp"
+
+#include "core/error.hpp"
+
+namespace lambert {
+
+RadiosityProblem make_problem(const PatchMesh& mesh, const SparseRowMatrix& F) {
+  const std::int32_t n = mesh.size();
+  if (F.rows() != n || F.cols() != n)
+    throw SceneError("form factors are " + std::to_string(F.rows()) + "x" +
+                     std::to_string(F.cols()) + " but the mesh has " + std::to_string(n) +
+                     " patches");
+  RadiosityProblem p;
+  p.F = &F;
+  p.rho.resize(n, 3);
+  p.emission.resize(n, 3);
+  p.area.resize(n);
+  for (std::int32_t i = 0; i < n; ++i) {
+    const Patch& patch = mesh.patches[i];
+    p.rho.row(i) = patch.rho.transpose();
+    p.emission.row(i) = patch.emission.transpose();
+    p.area[i] = patch.area;
+  }
+  return p;
+}
+
+std::vector<SurfaceRadiosity> surface_averages(const PatchMesh& mesh, const Eigen::MatrixX3d& B) {
+  std::vector<SurfaceRadiosity> out(mesh.surface_names.size());
+  for (size_t s = 0; s < out.size(); ++s) out[s].name = mesh.surface_names[s];
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    const Patch& p = mesh.patches[i];
+    SurfaceRadiosity& s = out.at(p.surface);
+    s.area += p.area;
+    ++s.patches;
+    s.average += p.area * B.row(i).transpose();
+  }
+  for (auto& s : out)
+    if (s.area > 0.0) s.average /= s.area;
+  return out;
+}
+
+}  // namespace lambert

@@ -1,0 +1,186 @@
+#include "apps/render_stages.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+
+#include "apps/problem.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/progress.hpp"
+#include "core/timer.hpp"
+#include "geometry/bvh.hpp"
+#include "io/exr.hpp"
+#include "io/ply.hpp"
+#include "io/tonemap.hpp"
+
+namespace lambert {
+namespace {
+
+Eigen::Vector3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
+
+}  // namespace
+
+void add_camera_options(CLI::App* cmd, CameraArgs& args) {
+  cmd->add_option("--eye", args.eye, "Camera position X Y Z (default: the scene's camera)")
+      ->expected(3);
+  cmd->add_option("--look-at", args.look_at, "Point the camera looks at, X Y Z")->expected(3);
+  cmd->add_option("--up", args.up, "Camera up vector X Y Z")->expected(3);
+  cmd->add_option("--fov", args.fov, "Vertical field of view, degrees")
+      ->check(CLI::Range(0.1, 179.0));
+  cmd->add_option("--size", args.size, "Image size WxH in pixels (default 512x512)");
+}
+
+Camera make_camera(const Scene& scene, const CameraArgs& args) {
+  Camera cam = scene.camera;
+  if (!cam.defined) {
+    const auto [lo, hi] = scene.bounds();
+    cam = framing_camera(lo, hi);
+  }
+  if (!args.eye.empty()) cam.eye = vec3(args.eye);
+  if (!args.look_at.empty()) cam.look_at = vec3(args.look_at);
+  if (!args.up.empty()) cam.up = vec3(args.up);
+  if (args.fov > 0) cam.vfov_degrees = args.fov;
+  if (!args.size.empty()) {
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(args.size.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 ||
+        (x != 'x' && x != 'X') || w < 1 || h < 1 || w > 16384 || h > 16384)
+      throw UsageError("--size must be WxH with 1 <= W, H <= 16384, got '" + args.size + "'");
+    cam.width = w;
+    cam.height = h;
+  }
+  const Eigen::Vector3d forward = cam.look_at - cam.eye;
+  if (!(forward.norm() > 0) || !(forward.normalized().cross(cam.up.normalized()).norm() > 1e-6))
+    throw UsageError("camera: --look-at must differ from --eye and --up must not be parallel "
+                     "to the view direction");
+  return cam;
+}
+
+void add_shade_options(CLI::App* cmd, ShadeArgs& args) {
+  cmd->add_flag("--flat", args.flat, "Per-patch (flat) shading instead of Gouraud");
+  cmd->add_option("--antialias", args.antialias, "K: K x K stratified samples per pixel")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+  cmd->add_option("--exposure", args.exposure,
+                  "PNG/PLY exposure in stops (pixel x 2^EV), or auto (key value 0.36)")
+      ->check([](const std::string& s) -> std::string {
+        if (s == "auto") return "";
+        char* end = nullptr;
+        const double v = std::strtod(s.c_str(), &end);
+        return !s.empty() && *end == '\0' && std::isfinite(v) && std::abs(v) <= 64
+                   ? ""
+                   : "must be 'auto' or a number of stops in [-64, 64]";
+      })
+      ->capture_default_str();
+  cmd->add_option("--vertex-interp", args.vertex_interp,
+                  "Per-vertex reconstruction: conservative (area-weighted, rescaled per surface "
+                  "to conserve power) or area (area-weighted only)")
+      ->check(CLI::IsMember({"conservative", "area"}))
+      ->capture_default_str();
+}
+
+void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOptions& solver,
+                 const RunArgs& run, RadiosityResult& r) {
+  r.ff_stats = F.stats;
+  r.ff_entries = F.F.nonZeros();
+  const Timer solve_timer;
+  const RadiosityProblem problem = make_problem(scene.mesh, F.F);
+  SolveOptions so = solver;
+  so.threads = run.threads;
+  r.solution = solve_radiosity(problem, so);
+  r.solve_seconds = solve_timer.seconds();
+  r.B = r.solution.B;
+  r.solved = true;
+  int iterations = 0;
+  for (const auto& c : r.solution.channels) iterations = std::max(iterations, c.iterations);
+  log_info("solve: " + solver.solver + " " + to_string(r.solution.status) + " after " +
+           std::to_string(iterations) + " iterations in " + format_duration(r.solve_seconds));
+  if (r.solution.status != SolveStatus::Converged)
+    log_warn("the solver did not converge (" + std::string(to_string(r.solution.status)) +
+             "); results are written anyway");
+}
+
+RadiosityResult compute_radiosity(const LoadedScene& scene, const FormFactorArgs& ff,
+                                  const SolveOptions& solver, const RunArgs& run) {
+  RadiosityResult r;
+  const Timer ff_timer;
+  const FormFactors F = obtain_form_factors(scene, ff, run);
+  r.ff_seconds = ff_timer.seconds();
+  solve_scene(scene, F, solver, run, r);
+  return r;
+}
+
+ShadedField shade_vertices(const PatchMesh& mesh, const Eigen::MatrixX3d& B, const ShadeArgs& args) {
+  const Timer timer;
+  ShadedField s;
+  s.field = interpolate_to_vertices(mesh, B, parse_vertex_interpolation(args.vertex_interp),
+                                    &s.power);
+  s.seconds = timer.seconds();
+  return s;
+}
+
+Image render_scene(const PatchMesh& mesh, const Eigen::MatrixX3d& B, const VertexField& field,
+                   const Camera& camera, const ShadeArgs& args, const RunArgs& run,
+                   RenderStats* stats) {
+  const Timer timer;
+  const Bvh bvh(mesh);
+  RenderSettings settings;
+  settings.flat = args.flat;
+  settings.antialias = args.antialias;
+  settings.seed = run.seed;
+  settings.threads = run.threads;
+  settings.progress = !run.quiet;
+  Image img = render(mesh, bvh, camera, B, field, settings, stats);
+  if (stats) stats->seconds = timer.seconds();  // including the BVH build
+  log_info("render: " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+           ", " + std::to_string(args.antialias * args.antialias) + " samples/pixel, " +
+           (args.flat ? "flat" : "Gouraud") + " shading in " + format_duration(timer.seconds()));
+  return img;
+}
+
+double choose_exposure(const ShadeArgs& args, const Image& image) {
+  return args.exposure == "auto" ? auto_exposure(image) : std::strtod(args.exposure.c_str(), nullptr);
+}
+
+std::vector<std::string> write_outputs(const OutputPaths& paths, const PatchMesh& mesh,
+                                       const ShadedField& shaded, const Image& image, double ev,
+                                       const std::string& settings) {
+  std::vector<std::string> written;
+  if (!paths.image_exr.empty()) {
+    write_image_exr(paths.image_exr, image,
+                    {"R,G,B: radiance L = B/pi (W m^-2 sr^-1, scene emission units per sr); "
+                     "A: fraction of pixel samples that hit a surface",
+                     settings,
+                     {}});
+    written.push_back(paths.image_exr);
+  }
+  if (!paths.png.empty()) {
+    write_png_preview(paths.png, image, ev);
+    written.push_back(paths.png);
+  }
+  if (!paths.vertex_exr.empty()) {
+    write_vertex_exr(paths.vertex_exr, shaded.field,
+                     {"R,G,B: radiosity B (W/m^2, the units of the scene's emission Ke); "
+                      "P: position (scene length units); N: unit normal; surface: index into "
+                      "surfaceNames",
+                      settings, mesh.surface_names});
+    written.push_back(paths.vertex_exr);
+  }
+  if (!paths.ply.empty()) {
+    write_ply(paths.ply, mesh, shaded.field, ev, settings);
+    written.push_back(paths.ply);
+  }
+  return written;
+}
+
+std::pair<double, double> worst_power_error(const std::vector<SurfacePower>& power) {
+  double after = 0.0, before = 0.0;
+  for (const auto& s : power) {
+    after = std::max(after, s.relative_error());
+    before = std::max(before, s.area_weighted_relative_error());
+  }
+  return {after, before};
+}
+
+}  // namespace lambert

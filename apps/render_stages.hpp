@@ -1,0 +1,92 @@
+#pragma once
+// The stages `lambert render` and `lambert run` share after load-and-mesh: radiosity (from a
+// CSV or from F + solve), per-vertex reconstruction, rendering and writing the result files,
+// with the CLI options that steer them (solver options: apps/solve_args.hpp).
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "apps/common.hpp"
+#include "apps/ff_args.hpp"
+#include "geometry/formfactors/formfactors.hpp"
+#include "geometry/render.hpp"
+#include "geometry/vertex_field.hpp"
+#include "solvers/radiosity.hpp"
+
+namespace lambert {
+
+/// --eye, --look-at, --up, --fov, --size: overrides of the scene's default camera.
+struct CameraArgs {
+  std::vector<double> eye, look_at, up;  ///< 3 values each, or empty
+  double fov = 0.0;                      ///< vertical field of view in degrees; 0 = the scene's
+  std::string size;                      ///< "WxH"; empty = the scene camera's
+};
+/// Adds the camera options to a subcommand.
+void add_camera_options(CLI::App* cmd, CameraArgs& args);
+/// The scene's camera (or one framing the scene) with the overrides applied.
+/// Throws UsageError for a malformed --size or a degenerate view.
+Camera make_camera(const Scene& scene, const CameraArgs& args);
+
+/// --flat, --antialias, --exposure, --vertex-interp.
+struct ShadeArgs {
+  bool flat = false;
+  int antialias = 2;
+  std::string exposure = "auto";  ///< "auto" or EV stops
+  std::string vertex_interp = "conservative";
+};
+/// Adds the shading options to a subcommand.
+void add_shade_options(CLI::App* cmd, ShadeArgs& args);
+
+/// The radiosity B of every patch and how it was obtained.
+struct RadiosityResult {
+  Eigen::MatrixX3d B;  ///< N x 3
+  bool solved = false;  ///< false when read from a CSV
+  RadiositySolution solution;  ///< valid when solved
+  FormFactorStats ff_stats;    ///< valid when solved (rays 0 when F was loaded)
+  std::int64_t ff_entries = 0;
+  double ff_seconds = 0.0;
+  double solve_seconds = 0.0;
+};
+
+/// Records F's statistics in `r` and solves for B over F (fills B, solution, solve_seconds);
+/// logs one line on stderr, and a warning when the solver did not converge.
+void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOptions& solver,
+                 const RunArgs& run, RadiosityResult& r);
+
+/// Computes F (or loads --ff) and solves for B; logs one line per stage on stderr.
+RadiosityResult compute_radiosity(const LoadedScene& scene, const FormFactorArgs& ff,
+                                  const SolveOptions& solver, const RunArgs& run);
+
+/// The per-vertex field of B and its per-surface power report.
+struct ShadedField {
+  VertexField field;
+  std::vector<SurfacePower> power;
+  double seconds = 0.0;
+};
+/// Interpolates B to the shading vertices with --vertex-interp.
+ShadedField shade_vertices(const PatchMesh& mesh, const Eigen::MatrixX3d& B, const ShadeArgs& args);
+
+/// Builds the BVH and renders the scene through `camera`.
+Image render_scene(const PatchMesh& mesh, const Eigen::MatrixX3d& B, const VertexField& field,
+                   const Camera& camera, const ShadeArgs& args, const RunArgs& run,
+                   RenderStats* stats);
+
+/// The exposure (EV) to use: --exposure, or automatic from the image.
+double choose_exposure(const ShadeArgs& args, const Image& image);
+
+/// Where to write what (empty = skip).
+struct OutputPaths {
+  std::string image_exr, png, vertex_exr, ply;
+};
+
+/// Writes the requested files atomically and returns the paths written, in order.
+std::vector<std::string> write_outputs(const OutputPaths& paths, const PatchMesh& mesh,
+                                       const ShadedField& shaded, const Image& image, double ev,
+                                       const std::string& settings);
+
+/// Largest relative power error over surfaces (after --vertex-interp) and before any rescale.
+std::pair<double, double> worst_power_error(const std::vector<SurfacePower>& power);
+
+}  // namespace lambert

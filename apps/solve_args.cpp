@@ -1,0 +1,51 @@
+#include "apps/solve_args.hpp"
+
+#include <cstdio>
+
+namespace lambert {
+
+void add_solve_options(CLI::App* cmd, SolveOptions& o, bool with_solver) {
+  if (with_solver)
+    cmd->add_option("--solver", o.solver, "Solver (see `lambert solvers`)")
+        ->check(CLI::IsMember(solver_names()))
+        ->capture_default_str();
+  cmd->add_option("--tol", o.tol, "Stop when ||E - K B||_2 / ||E||_2 <= tol")
+      ->check(CLI::Range(1e-16, 0.5))
+      ->capture_default_str();
+  cmd->add_option("--max-iter", o.max_iterations, "Iteration limit per channel")
+      ->check(CLI::Range(1, 100000000))
+      ->capture_default_str();
+  cmd->add_option("--omega", o.omega, "SOR relaxation factor, in (0, 2)")
+      ->check(CLI::Range(1e-3, 1.999))
+      ->capture_default_str();
+  cmd->add_option("--preconditioner", o.preconditioner, "bicgstab/gmres/cg preconditioner")
+      ->check(CLI::IsMember({"none", "diagonal", "ilut"}))
+      ->capture_default_str();
+  cmd->add_option("--restart", o.restart, "GMRES restart length")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  cmd->add_flag("--ambient", o.ambient, "southwell: add the ambient term (display estimate)");
+}
+
+const char* channel_name(int channel) {
+  static const char* kNames[] = {"R", "G", "B"};
+  return kNames[channel];
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string csv_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+}  // namespace lambert

@@ -1,0 +1,24 @@
+#pragma once
+// Solver options shared by `solve` and `compare`, and the report pieces both write.
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "solvers/radiosity.hpp"
+
+namespace lambert {
+
+/// Adds --tol, --max-iter, --omega, --preconditioner, --restart, --ambient (and --solver when
+/// `with_solver`) bound to `options`.
+void add_solve_options(CLI::App* cmd, SolveOptions& options, bool with_solver);
+
+/// "R", "G" or "B".
+const char* channel_name(int channel);
+
+/// Quotes a CSV field when it holds a comma, quote or newline (RFC 4180).
+std::string csv_field(const std::string& s);
+
+/// Formats a double for CSV/tables with full precision (%.17g).
+std::string csv_number(double v);
+
+}  // namespace lambert

@@ -1,0 +1,61 @@
+#pragma once
+// Rendering a radiosity solution: pinhole primary rays through the BVH, each hit shaded with
+// its radiance L = B / π (a Lambertian surface of radiosity B has radiance B/π in every
+// direction, W m^-2 sr^-1 in the scene's units). Gouraud shading interpolates B from the
+// shading vertices of a VertexField (barycentric on triangles, bilinear on quads, from the
+// hit point and the patch corners); flat shading uses the patch value. Only the front side
+// of a patch leaves radiosity: a hit on a back face is black, a miss is black with coverage 0.
+//
+// Antialiasing: K x K stratified samples per pixel, each jittered inside its stratum by a
+// hash of (seed, pixel, sample), so the image is a pure function of the inputs (deterministic
+// for any thread count). Pixel value = mean over samples; alpha = fraction of samples that hit.
+// Complexity O(width · height · K²) ray casts; rows are rendered in parallel.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "geometry/bvh.hpp"
+#include "geometry/camera.hpp"
+#include "geometry/mesh.hpp"
+#include "geometry/vertex_field.hpp"
+
+namespace lambert {
+
+/// A linear HDR image: RGB radiance and coverage, rows top to bottom.
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<float> rgb;    ///< width * height * 3, linear radiance
+  std::vector<float> alpha;  ///< width * height, fraction of samples that hit a surface
+
+  /// Radiance of pixel (x, y) (x right, y down).
+  Eigen::Vector3f pixel(int x, int y) const {
+    const size_t k = 3 * (static_cast<size_t>(y) * width + x);
+    return {rgb[k], rgb[k + 1], rgb[k + 2]};
+  }
+};
+
+/// Render settings.
+struct RenderSettings {
+  bool flat = false;       ///< per-patch shading instead of Gouraud
+  int antialias = 2;       ///< K: K x K stratified samples per pixel (1 = pixel centres)
+  std::uint64_t seed = 1;  ///< jitter seed (K > 1)
+  int threads = 0;         ///< 0 = all cores
+  bool progress = true;    ///< draw a progress bar (when stderr is a terminal)
+};
+
+/// What the render did.
+struct RenderStats {
+  std::int64_t rays = 0;
+  double seconds = 0.0;
+};
+
+/// Renders the mesh as seen by `camera` (its width x height). `patch_B` is N x 3; `vertices`
+/// (with values) is used for Gouraud shading and ignored when options.flat.
+/// Thread-safe with respect to its inputs (all const).
+Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
+             const Eigen::MatrixX3d& patch_B, const VertexField& vertices,
+             const RenderSettings& options, RenderStats* stats = nullptr);
+
+}  // namespace lambert

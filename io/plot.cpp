@@ -1,0 +1,396 @@
+#include "io/plot.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include "core/atomic_file.hpp"
+#include "io/png.hpp"
+
+namespace lambert {
+namespace {
+
+constexpr int kPanelW = 560, kPanelH = 420;
+constexpr int kLeft = 72, kRight = 16, kTop = 36, kBottom = 52;  // plot-area margins
+constexpr int kLegendRow = 16;                                   // px per legend entry
+
+struct Frame {                            // data -> pixel mapping of one panel
+  double x0 = 0, x1 = 1, y0 = 0, y1 = 1;  // data range (y in log10 when log_y)
+  bool log_y = true;
+  int ox = 0;  // panel x offset in the image
+  bool valid(double y) const { return std::isfinite(y) && (!log_y || y > 0.0); }
+  double px(double x) const {
+    return ox + kLeft + (x - x0) / (x1 - x0) * (kPanelW - kLeft - kRight);
+  }
+  double py(double y) const {
+    const double v = log_y ? std::log10(y) : y;
+    return kTop + (y1 - v) / (y1 - y0) * (kPanelH - kTop - kBottom);
+  }
+};
+
+// A "nice" step (1, 2 or 5 times a power of ten) giving about `count` ticks over `span`.
+double nice_step(double span, int count) {
+  const double raw = span / count;
+  const double p = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 5.0})
+    if (raw <= m * p) return m * p;
+  return 10.0 * p;
+}
+
+Frame make_frame(const Plot& plot, int ox) {
+  Frame f;
+  f.log_y = plot.log_y;
+  f.ox = ox;
+  double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin;
+  double ymin = xmin, ymax = -xmin;
+  for (const auto& s : plot.series)
+    for (size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
+      if (!f.valid(s.y[k]) || !std::isfinite(s.x[k])) continue;
+      xmin = std::min(xmin, s.x[k]);
+      xmax = std::max(xmax, s.x[k]);
+      const double v = f.log_y ? std::log10(s.y[k]) : s.y[k];
+      ymin = std::min(ymin, v);
+      ymax = std::max(ymax, v);
+    }
+  if (!std::isfinite(xmin)) xmin = 0, xmax = 1, ymin = 0, ymax = 1;
+  f.x0 = std::min(0.0, xmin);
+  f.x1 = xmax > f.x0 ? xmax : f.x0 + 1.0;
+  const double step = nice_step(f.x1 - f.x0, 6);
+  f.x1 = std::ceil(f.x1 / step) * step;
+  if (f.log_y) {
+    f.y0 = std::floor(ymin);
+    f.y1 = std::ceil(ymax);
+  } else {
+    const double ys = nice_step(std::max(ymax - ymin, 1e-300), 6);
+    f.y0 = std::floor(ymin / ys) * ys;
+    f.y1 = std::ceil(ymax / ys) * ys;
+  }
+  if (f.y1 <= f.y0) f.y1 = f.y0 + 1.0;
+  return f;
+}
+
+std::vector<double> y_ticks(const Frame& f) {
+  std::vector<double> t;
+  if (f.log_y) {
+    const int decades = static_cast<int>(f.y1 - f.y0);
+    const int every = std::max(1, (decades + 9) / 10);
+    for (double e = f.y0; e <= f.y1 + 1e-9; e += every) t.push_back(std::pow(10.0, e));
+  } else {
+    const double s = nice_step(f.y1 - f.y0, 6);
+    for (double v = f.y0; v <= f.y1 + 1e-9 * s; v += s) t.push_back(v);
+  }
+  return t;
+}
+
+std::vector<double> x_ticks(const Frame& f) {
+  std::vector<double> t;
+  const double s = nice_step(f.x1 - f.x0, 6);
+  for (double v = f.x0; v <= f.x1 + 1e-9 * s; v += s) t.push_back(v);
+  return t;
+}
+
+std::string escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '<')
+      o += "&lt;";
+    else if (c == '>')
+      o += "&gt;";
+    else if (c == '&')
+      o += "&amp;";
+    else if (c == '"')
+      o += "&quot;";
+    else
+      o += c;
+  }
+  return o;
+}
+
+std::string hex(std::size_t k) {
+  const auto c = plot_color(k);
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "#%02x%02x%02x", c[0], c[1], c[2]);
+  return buf;
+}
+
+std::string tick_label(double v, bool log) {
+  char buf[32];
+  if (log)
+    std::snprintf(buf, sizeof buf, "1e%d", static_cast<int>(std::lround(std::log10(v))));
+  else
+    std::snprintf(buf, sizeof buf, "%g", std::abs(v) < 1e-12 ? 0.0 : v);
+  return buf;
+}
+
+// Legend box position: top-right of the plot area.
+int legend_x(const Frame& f) { return f.ox + kPanelW - kRight - 150; }
+int legend_y(int k) { return kTop + 8 + k * kLegendRow; }
+
+// RGB raster with thick anti-alias-free lines.
+struct Raster {
+  int w, h;
+  std::vector<std::uint8_t> rgb;
+  Raster(int width, int height) : w(width), h(height), rgb(3 * width * height, 255) {}
+  void dot(int x, int y, std::array<std::uint8_t, 3> c, int r) {
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx) {
+        const int X = x + dx, Y = y + dy;
+        if (X < 0 || Y < 0 || X >= w || Y >= h) continue;
+        std::copy(c.begin(), c.end(), rgb.begin() + 3 * (static_cast<size_t>(Y) * w + X));
+      }
+  }
+  void line(double x0, double y0, double x1, double y1, std::array<std::uint8_t, 3> c, int r) {
+    const int n = static_cast<int>(std::ceil(std::max(std::abs(x1 - x0), std::abs(y1 - y0)))) + 1;
+    for (int k = 0; k <= n; ++k) {
+      const double t = static_cast<double>(k) / n;
+      dot(static_cast<int>(std::lround(x0 + t * (x1 - x0))),
+          static_cast<int>(std::lround(y0 + t * (y1 - y0))), c, r);
+    }
+  }
+};
+
+// Calls seg(x0, y0, x1, y1) for every drawable segment of a series (pixel coordinates).
+template <typename Seg>
+void for_segments(const Frame& f, const PlotSeries& s, Seg seg) {
+  bool have = false;
+  double px = 0, py = 0;
+  for (size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
+    if (!f.valid(s.y[k]) || !std::isfinite(s.x[k])) continue;
+    const double x = f.px(s.x[k]), y = f.py(s.y[k]);
+    if (have)
+      seg(px, py, x, y);
+    else
+      seg(x, y, x, y);
+    px = x, py = y, have = true;
+  }
+}
+
+}  // namespace
+
+std::array<std::uint8_t, 3> plot_color(std::size_t k) {
+  // Tableau 10: distinguishable, colour-blind friendly enough for 8 solvers.
+  static const std::array<std::uint8_t, 3> kPalette[] = {
+      {31, 119, 180}, {255, 127, 14},  {44, 160, 44},   {214, 39, 40},  {148, 103, 189},
+      {140, 86, 75},  {227, 119, 194}, {127, 127, 127}, {188, 189, 34}, {23, 190, 207}};
+  return kPalette[k % (sizeof kPalette / sizeof kPalette[0])];
+}
+
+std::string plots_svg(const std::vector<Plot>& panels) {
+  std::ostringstream o;
+  const int width = kPanelW * static_cast<int>(std::max<size_t>(1, panels.size()));
+  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << kPanelH
+    << "\" viewBox=\"0 0 " << width << ' ' << kPanelH
+    << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
+    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  for (size_t p = 0; p < panels.size(); ++p) {
+    const Plot& plot = panels[p];
+    const Frame f = make_frame(plot, static_cast<int>(p) * kPanelW);
+    const double l = f.px(f.x0), r = f.px(f.x1), t = kTop, b = kPanelH - kBottom;
+    for (double v : y_ticks(f)) {
+      const double y = f.py(v);
+      o << "<line x1=\"" << l << "\" y1=\"" << y << "\" x2=\"" << r << "\" y2=\"" << y
+        << "\" stroke=\"#e0e0e0\"/>\n<text x=\"" << l - 6 << "\" y=\"" << y + 4
+        << "\" text-anchor=\"end\">" << tick_label(v, f.log_y) << "</text>\n";
+    }
+    for (double v : x_ticks(f)) {
+      const double x = f.px(v);
+      o << "<line x1=\"" << x << "\" y1=\"" << t << "\" x2=\"" << x << "\" y2=\"" << b
+        << "\" stroke=\"#e0e0e0\"/>\n<text x=\"" << x << "\" y=\"" << b + 16
+        << "\" text-anchor=\"middle\">" << tick_label(v, false) << "</text>\n";
+    }
+    o << "<rect x=\"" << l << "\" y=\"" << t << "\" width=\"" << r - l << "\" height=\"" << b - t
+      << "\" fill=\"none\" stroke=\"black\"/>\n"
+      << "<text x=\"" << (l + r) / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">"
+      << escape(plot.title) << "</text>\n<text x=\"" << (l + r) / 2 << "\" y=\"" << b + 38
+      << "\" text-anchor=\"middle\">" << escape(plot.x_label) << "</text>\n"
+      << "<text transform=\"translate(" << f.ox + 16 << ',' << (t + b) / 2
+      << ") rotate(-90)\" text-anchor=\"middle\">" << escape(plot.y_label) << "</text>\n";
+    for (size_t k = 0; k < plot.series.size(); ++k) {
+      o << "<polyline fill=\"none\" stroke-width=\"2\" stroke=\"" << hex(k) << "\" points=\"";
+      for_segments(f, plot.series[k],
+                   [&](double, double, double x1, double y1) { o << x1 << ',' << y1 << ' '; });
+      o << "\"/>\n";
+      const int lx = legend_x(f), ly = legend_y(static_cast<int>(k));
+      o << "<line x1=\"" << lx << "\" y1=\"" << ly << "\" x2=\"" << lx + 24 << "\" y2=\"" << ly
+        << "\" stroke-width=\"4\" stroke=\"" << hex(k) << "\"/>\n<text x=\"" << lx + 30 << "\" y=\""
+        << ly + 4 << "\">" << escape(plot.series[k].name) << " (" << hex(k) << ")</text>\n";
+    }
+  }
+  o << "</svg>\n";
+  return o.str();
+}
+
+void write_plots_svg(const std::string& path, const std::vector<Plot>& panels) {
+  const std::string svg = plots_svg(panels);
+  write_stream_atomically(path, [&](std::ostream& out) { out << svg; });
+}
+
+void write_plots_png(const std::string& path, const std::vector<Plot>& panels) {
+  Raster img(kPanelW * static_cast<int>(std::max<size_t>(1, panels.size())), kPanelH);
+  const std::array<std::uint8_t, 3> grid{224, 224, 224}, black{0, 0, 0};
+  for (size_t p = 0; p < panels.size(); ++p) {
+    const Plot& plot = panels[p];
+    const Frame f = make_frame(plot, static_cast<int>(p) * kPanelW);
+    const double l = f.px(f.x0), r = f.px(f.x1), t = kTop, b = kPanelH - kBottom;
+    for (double v : y_ticks(f)) img.line(l, f.py(v), r, f.py(v), grid, 0);
+    for (double v : x_ticks(f)) img.line(f.px(v), t, f.px(v), b, grid, 0);
+    for (double v : y_ticks(f)) img.line(l - 5, f.py(v), l, f.py(v), black, 0);
+    for (double v : x_ticks(f)) img.line(f.px(v), b, f.px(v), b + 5, black, 0);
+    img.line(l, t, r, t, black, 0);
+    img.line(l, b, r, b, black, 0);
+    img.line(l, t, l, b, black, 0);
+    img.line(r, t, r, b, black, 0);
+    for (size_t k = 0; k < plot.series.size(); ++k) {
+      const auto c = plot_color(k);
+      for_segments(f, plot.series[k], [&](double x0, double y0, double x1, double y1) {
+        img.line(x0, y0, x1, y1, c, 1);
+      });
+      const int lx = legend_x(f), ly = legend_y(static_cast<int>(k));
+      img.line(lx, ly, lx + 24, ly, c, 2);
+    }
+  }
+  write_png(path, img.w, img.h, img.rgb);
+}
+
+// ---- Log-log scatter plots -------------------------------------------------------------
+
+namespace {
+
+struct LogFrame {                         // log10(data) -> pixel mapping of one log-log panel
+  double x0 = 0, x1 = 1, y0 = 0, y1 = 1;  // decades spanned
+  int ox = 0;
+  static bool valid(double x, double y) {
+    return std::isfinite(x) && std::isfinite(y) && x > 0.0 && y > 0.0;
+  }
+  double px(double x) const {
+    return ox + kLeft + (std::log10(x) - x0) / (x1 - x0) * (kPanelW - kLeft - kRight);
+  }
+  double py(double y) const {
+    return kTop + (y1 - std::log10(y)) / (y1 - y0) * (kPanelH - kTop - kBottom);
+  }
+};
+
+LogFrame make_log_frame(const Plot& plot, int ox) {
+  LogFrame f;
+  f.ox = ox;
+  double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin, ymin = xmin, ymax = -xmin;
+  for (const auto& s : plot.series)
+    for (size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
+      if (!LogFrame::valid(s.x[k], s.y[k])) continue;
+      xmin = std::min(xmin, std::log10(s.x[k]));
+      xmax = std::max(xmax, std::log10(s.x[k]));
+      ymin = std::min(ymin, std::log10(s.y[k]));
+      ymax = std::max(ymax, std::log10(s.y[k]));
+    }
+  if (!std::isfinite(xmin)) xmin = 0, xmax = 1, ymin = 0, ymax = 1;
+  f.x0 = std::floor(xmin);
+  f.x1 = std::max(std::ceil(xmax), f.x0 + 1.0);
+  f.y0 = std::floor(ymin);
+  f.y1 = std::max(std::ceil(ymax), f.y0 + 1.0);
+  return f;
+}
+
+// Powers of ten from 10^lo to 10^hi, at most ~10 of them.
+std::vector<double> decade_ticks(double lo, double hi) {
+  std::vector<double> t;
+  const int every = std::max(1, static_cast<int>(hi - lo + 9) / 10);
+  for (double e = lo; e <= hi + 1e-9; e += every) t.push_back(std::pow(10.0, e));
+  return t;
+}
+
+}  // namespace
+
+std::string loglog_svg(const std::vector<Plot>& panels) {
+  std::ostringstream o;
+  const int width = kPanelW * static_cast<int>(std::max<size_t>(1, panels.size()));
+  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << kPanelH
+    << "\" viewBox=\"0 0 " << width << ' ' << kPanelH
+    << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
+    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  for (size_t p = 0; p < panels.size(); ++p) {
+    const Plot& plot = panels[p];
+    const LogFrame f = make_log_frame(plot, static_cast<int>(p) * kPanelW);
+    const double l = f.ox + kLeft, r = f.ox + kPanelW - kRight, t = kTop, b = kPanelH - kBottom;
+    for (double v : decade_ticks(f.y0, f.y1)) {
+      const double y = f.py(v);
+      o << "<line x1=\"" << l << "\" y1=\"" << y << "\" x2=\"" << r << "\" y2=\"" << y
+        << "\" stroke=\"#e0e0e0\"/>\n<text x=\"" << l - 6 << "\" y=\"" << y + 4
+        << "\" text-anchor=\"end\">" << tick_label(v, true) << "</text>\n";
+    }
+    for (double v : decade_ticks(f.x0, f.x1)) {
+      const double x = f.px(v);
+      o << "<line x1=\"" << x << "\" y1=\"" << t << "\" x2=\"" << x << "\" y2=\"" << b
+        << "\" stroke=\"#e0e0e0\"/>\n<text x=\"" << x << "\" y=\"" << b + 16
+        << "\" text-anchor=\"middle\">" << tick_label(v, true) << "</text>\n";
+    }
+    o << "<rect x=\"" << l << "\" y=\"" << t << "\" width=\"" << r - l << "\" height=\"" << b - t
+      << "\" fill=\"none\" stroke=\"black\"/>\n"
+      << "<text x=\"" << (l + r) / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">"
+      << escape(plot.title) << "</text>\n<text x=\"" << (l + r) / 2 << "\" y=\"" << b + 38
+      << "\" text-anchor=\"middle\">" << escape(plot.x_label) << "</text>\n"
+      << "<text transform=\"translate(" << f.ox + 16 << ',' << (t + b) / 2
+      << ") rotate(-90)\" text-anchor=\"middle\">" << escape(plot.y_label) << "</text>\n";
+    for (size_t k = 0; k < plot.series.size(); ++k) {
+      const PlotSeries& s = plot.series[k];
+      std::ostringstream pts, marks;
+      for (size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+        if (!LogFrame::valid(s.x[i], s.y[i])) continue;
+        pts << f.px(s.x[i]) << ',' << f.py(s.y[i]) << ' ';
+        marks << "<circle cx=\"" << f.px(s.x[i]) << "\" cy=\"" << f.py(s.y[i])
+              << "\" r=\"3.5\" fill=\"" << hex(k) << "\"/>\n";
+      }
+      o << "<polyline fill=\"none\" stroke-width=\"1.5\" stroke=\"" << hex(k) << "\" points=\""
+        << pts.str() << "\"/>\n"
+        << marks.str();
+      const int lx = f.ox + kPanelW - kRight - 150,
+                ly = kTop + 8 + static_cast<int>(k) * kLegendRow;
+      o << "<line x1=\"" << lx << "\" y1=\"" << ly << "\" x2=\"" << lx + 24 << "\" y2=\"" << ly
+        << "\" stroke-width=\"4\" stroke=\"" << hex(k) << "\"/>\n<text x=\"" << lx + 30 << "\" y=\""
+        << ly + 4 << "\">" << escape(s.name) << " (" << hex(k) << ")</text>\n";
+    }
+  }
+  o << "</svg>\n";
+  return o.str();
+}
+
+void write_loglog_svg(const std::string& path, const std::vector<Plot>& panels) {
+  const std::string svg = loglog_svg(panels);
+  write_stream_atomically(path, [&](std::ostream& out) { out << svg; });
+}
+
+void write_loglog_png(const std::string& path, const std::vector<Plot>& panels) {
+  Raster img(kPanelW * static_cast<int>(std::max<size_t>(1, panels.size())), kPanelH);
+  const std::array<std::uint8_t, 3> grid{224, 224, 224}, black{0, 0, 0};
+  for (size_t p = 0; p < panels.size(); ++p) {
+    const Plot& plot = panels[p];
+    const LogFrame f = make_log_frame(plot, static_cast<int>(p) * kPanelW);
+    const double l = f.ox + kLeft, r = f.ox + kPanelW - kRight, t = kTop, b = kPanelH - kBottom;
+    for (double v : decade_ticks(f.y0, f.y1)) img.line(l, f.py(v), r, f.py(v), grid, 0);
+    for (double v : decade_ticks(f.x0, f.x1)) img.line(f.px(v), t, f.px(v), b, grid, 0);
+    img.line(l, t, r, t, black, 0);
+    img.line(l, b, r, b, black, 0);
+    img.line(l, t, l, b, black, 0);
+    img.line(r, t, r, b, black, 0);
+    for (size_t k = 0; k < plot.series.size(); ++k) {
+      const PlotSeries& s = plot.series[k];
+      const auto c = plot_color(k);
+      bool have = false;
+      double qx = 0, qy = 0;
+      for (size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+        if (!LogFrame::valid(s.x[i], s.y[i])) continue;
+        const double x = f.px(s.x[i]), y = f.py(s.y[i]);
+        if (have) img.line(qx, qy, x, y, c, 0);
+        img.dot(static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y)), c, 3);
+        qx = x, qy = y, have = true;
+      }
+      const int lx = f.ox + kPanelW - kRight - 150,
+                ly = kTop + 8 + static_cast<int>(k) * kLegendRow;
+      img.line(lx, ly, lx + 24, ly, c, 2);
+    }
+  }
+  write_png(path, img.w, img.h, img.rgb);
+}
+
+}  // namespace lambert

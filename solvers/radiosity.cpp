@@ -1,0 +1,165 @@
+#include "solvers/radiosity.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "core/error.hpp"
+#include "core/timer.hpp"
+#include "solvers/system.hpp"
+
+namespace lambert {
+namespace {
+
+struct SolverEntry {
+  const char* name;
+  const char* description;
+  ChannelSolver solve;
+};
+
+// The registry: a table of functions chosen by name.
+const SolverEntry kSolvers[] = {
+    {"jacobi", "Jacobi: B <- B + (E - K B) / diag(K), all rows from the previous iterate",
+     solve_jacobi},
+    {"gauss-seidel", "Gauss-Seidel gathering, one row at a time with the newest values",
+     solve_gauss_seidel},
+    {"sor", "successive over-relaxation of Gauss-Seidel (--omega)", solve_sor},
+    {"southwell",
+     "Southwell / progressive refinement: shoot from the largest unshot power (Cohen 1988)",
+     solve_southwell},
+    {"bicgstab", "Eigen BiCGSTAB, matrix-free, --preconditioner none|diagonal|ilut",
+     solve_bicgstab},
+    {"gmres", "Eigen GMRES(m) (unsupported module), --restart m, --preconditioner", solve_gmres},
+    {"cg", "Eigen conjugate gradient on the symmetric system diag(A/rho) K (needs reciprocal F)",
+     solve_cg},
+    {"direct", "Eigen SparseLU (dense LU when F is over 10% full): the reference", solve_direct},
+};
+
+const SolverEntry& find_solver(const std::string& name) {
+  for (const auto& s : kSolvers)
+    if (name == s.name) return s;
+  std::string names;
+  for (const auto& s : kSolvers) names += std::string(names.empty() ? "" : ", ") + s.name;
+  throw UsageError("unknown solver '" + name + "' (known: " + names + ")");
+}
+
+void validate_options(const SolveOptions& o) {
+  if (!(o.tol > 0.0) || !(o.tol < 1.0))
+    throw UsageError("--tol must be in (0, 1), got " + std::to_string(o.tol));
+  if (o.max_iterations < 1) throw UsageError("--max-iter must be at least 1");
+  if (!(o.omega > 0.0 && o.omega < 2.0))
+    throw UsageError("--omega must be in (0, 2) for SOR to converge, got " +
+                     std::to_string(o.omega));
+  if (o.preconditioner != "none" && o.preconditioner != "diagonal" && o.preconditioner != "ilut")
+    throw UsageError("unknown preconditioner '" + o.preconditioner +
+                     "' (known: none, diagonal, ilut)");
+  if (o.restart < 1) throw UsageError("--restart must be at least 1");
+  if (o.solver == "cg" && o.preconditioner == "ilut")
+    throw UsageError("cg needs a symmetric preconditioner: use --preconditioner none or diagonal");
+}
+
+int severity(SolveStatus s) {
+  return s == SolveStatus::Converged ? 0 : s == SolveStatus::MaxIterations ? 1 : 2;
+}
+
+}  // namespace
+
+const char* to_string(SolveStatus status) {
+  switch (status) {
+    case SolveStatus::Converged:
+      return "converged";
+    case SolveStatus::MaxIterations:
+      return "max-iterations";
+    case SolveStatus::NumericalIssue:
+      return "numerical-issue";
+  }
+  return "unknown";
+}
+
+std::vector<SolverInfo> solver_registry() {
+  std::vector<SolverInfo> out;
+  for (const auto& s : kSolvers) out.push_back({s.name, s.description});
+  return out;
+}
+
+std::vector<std::string> solver_names() {
+  std::vector<std::string> out;
+  for (const auto& s : kSolvers) out.emplace_back(s.name);
+  return out;
+}
+
+void validate_problem(const RadiosityProblem& p) {
+  if (p.F == nullptr) throw UsageError("radiosity problem without a form-factor matrix");
+  const Eigen::Index n = p.area.size();
+  if (p.F->rows() != n || p.F->cols() != n || p.rho.rows() != n || p.emission.rows() != n)
+    throw UsageError("radiosity problem sizes disagree: F " + std::to_string(p.F->rows()) + "x" +
+                     std::to_string(p.F->cols()) + ", " + std::to_string(n) + " areas, " +
+                     std::to_string(p.rho.rows()) + " rho rows, " +
+                     std::to_string(p.emission.rows()) + " emission rows");
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!(p.area[i] > 0.0) || !std::isfinite(p.area[i]))
+      throw UsageError("patch " + std::to_string(i) + " has non-positive area");
+    for (int c = 0; c < 3; ++c) {
+      if (!(p.rho(i, c) >= 0.0 && p.rho(i, c) < 1.0))
+        throw UsageError("patch " + std::to_string(i) + ": rho must be in [0, 1)");
+      if (!(p.emission(i, c) >= 0.0) || !std::isfinite(p.emission(i, c)))
+        throw UsageError("patch " + std::to_string(i) + ": emission must be finite and >= 0");
+    }
+  }
+}
+
+double relative_residual(const RadiosityProblem& problem, const Eigen::MatrixX3d& B, int channel) {
+  const ChannelSystem s = make_channel_system(problem, channel, 1);
+  return s.relative_residual_uncounted(B.col(channel));
+}
+
+// Energy bookkeeping (power, W in scene units). H = F B is the irradiance: the power that
+// reaches patch i is sum_j A_j B_j F_ji = A_i sum_j F_ij B_j = A_i H_i by reciprocity.
+// Absorbed: a fraction (1 - rho_i) of it. Escaped: patch i's exitance times the fraction of
+// its hemisphere that sees no patch, A_i B_i (1 - sum_j F_ij). With sum_i A_i H_i =
+// sum_j A_j B_j sum_i F_ji (reciprocity), emitted - absorbed - escaped = sum A (E + rho H - B)
+// = sum A r: zero for an exact solution. Cost: one product with F.
+EnergyBalance energy_balance(const RadiosityProblem& problem, const Eigen::MatrixX3d& B,
+                             int channel) {
+  const SparseRowMatrix& F = *problem.F;
+  const Eigen::VectorXd b = B.col(channel);
+  Eigen::VectorXd h;
+  multiply_f(F, b, h, 1);
+  const Eigen::VectorXd row_sum = F * Eigen::VectorXd::Ones(F.cols());
+  const Eigen::VectorXd& a = problem.area;
+  EnergyBalance e;
+  e.emitted = a.dot(problem.emission.col(channel));
+  e.absorbed = a.dot((1.0 - problem.rho.col(channel).array()).matrix().cwiseProduct(h));
+  e.escaped = a.dot(b.cwiseProduct((1.0 - row_sum.array()).matrix()));
+  const double imbalance = std::abs(e.emitted - e.absorbed - e.escaped);
+  e.relative_imbalance = e.emitted > 0.0 ? imbalance / e.emitted : imbalance;
+  return e;
+}
+
+RadiositySolution solve_radiosity(const RadiosityProblem& problem, const SolveOptions& options) {
+  const SolverEntry& entry = find_solver(options.solver);
+  validate_options(options);
+  validate_problem(problem);
+  const Timer timer;
+  const Eigen::Index n = problem.area.size();
+  RadiositySolution sol;
+  sol.B = Eigen::MatrixX3d::Zero(n, 3);
+  for (int c = 0; c < 3; ++c) {
+    const ChannelSystem system = make_channel_system(problem, c, options.threads);
+    ChannelReport& report = sol.channels[c];
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+    if (system.e_norm == 0.0) {
+      // Nothing emitted in this channel: B = 0 solves K B = 0 exactly.
+      record(report, 0, 0.0, 0.0);
+    } else {
+      report = entry.solve(system, options, b);
+      report.matvecs = system.matvecs;
+    }
+    sol.B.col(c) = b;
+    if (severity(report.status) > severity(sol.status)) sol.status = report.status;
+  }
+  sol.seconds = timer.seconds();
+  for (int c = 0; c < 3; ++c) sol.energy[c] = energy_balance(problem, sol.B, c);
+  return sol;
+}
+
+}  // namespace lambert

@@ -1,0 +1,77 @@
+#pragma once
+// One colour channel of the radiosity system, K = I - diag(rho) F, applied matrix-free on the
+// shared F, and the pieces every solver shares (residual, history). Internal to solvers/.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+
+#include "core/sparse.hpp"
+#include "core/timer.hpp"
+#include "solvers/radiosity.hpp"
+
+namespace lambert {
+
+/// y = F x for a row-major F, rows split over `threads` (1 = serial).
+/// Cost O(nnz(F)); bandwidth-bound (12 bytes of F per entry plus gathers of x).
+/// Thread safety: reads F and x, writes y only.
+void multiply_f(const SparseRowMatrix& F, const Eigen::VectorXd& x, Eigen::VectorXd& y,
+                int threads);
+
+/// One channel c: K = I - diag(rho) F with the shared F; counts the products it performs.
+struct ChannelSystem {
+  const SparseRowMatrix* F = nullptr;
+  Eigen::VectorXd rho;     ///< rho_c per patch
+  Eigen::VectorXd E;       ///< E_c per patch
+  Eigen::VectorXd area;    ///< A per patch
+  Eigen::VectorXd f_diag;  ///< F_ii (0 for planar patches; kept for generality)
+  double e_norm = 0.0;     ///< ||E||_2
+  int threads = 1;
+  mutable std::int64_t matvecs = 0;  ///< products with F performed so far
+
+  std::int32_t size() const { return static_cast<std::int32_t>(E.size()); }
+  /// y = K x = x - rho .* (F x); one counted product.
+  void apply_k(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+  /// ||E - K B||_2 / ||E||_2 (the one stopping rule); one counted product.
+  double relative_residual(const Eigen::VectorXd& B) const;
+  /// The same, without counting (for history replays and reports outside the timing).
+  double relative_residual_uncounted(const Eigen::VectorXd& B) const;
+};
+
+/// Builds channel c of the problem.
+ChannelSystem make_channel_system(const RadiosityProblem& problem, int channel, int threads);
+
+/// Appends history points to a report.
+inline void record(ChannelReport& report, int iteration, double residual, double seconds) {
+  report.history_iteration.push_back(iteration);
+  report.residual_history.push_back(residual);
+  report.time_history.push_back(seconds);
+}
+
+/// The per-channel solver functions. Each starts from its own initial guess (documented in
+/// its source), writes the solution to B (size N) and returns the report with history point
+/// 0 (the initial guess). The caller copies system.matvecs into the report.
+using ChannelSolver = ChannelReport (*)(const ChannelSystem& system, const SolveOptions& options,
+                                        Eigen::VectorXd& B);
+
+ChannelReport solve_jacobi(const ChannelSystem& system, const SolveOptions& options,
+                           Eigen::VectorXd& B);  ///< jacobi
+ChannelReport solve_gauss_seidel(const ChannelSystem& system, const SolveOptions& options,
+                                 Eigen::VectorXd& B);  ///< gauss-seidel (omega 1)
+ChannelReport solve_sor(const ChannelSystem& system, const SolveOptions& options,
+                        Eigen::VectorXd& B);  ///< sor (options.omega)
+ChannelReport solve_southwell(const ChannelSystem& system, const SolveOptions& options,
+                              Eigen::VectorXd& B);  ///< southwell / progressive refinement
+ChannelReport solve_bicgstab(const ChannelSystem& system, const SolveOptions& options,
+                             Eigen::VectorXd& B);  ///< bicgstab
+ChannelReport solve_gmres(const ChannelSystem& system, const SolveOptions& options,
+                          Eigen::VectorXd& B);  ///< gmres
+ChannelReport solve_cg(const ChannelSystem& system, const SolveOptions& options,
+                       Eigen::VectorXd& B);  ///< cg on diag(A/rho) K
+ChannelReport solve_direct(const ChannelSystem& system, const SolveOptions& options,
+                           Eigen::VectorXd& B);  ///< direct (SparseLU)
+
+/// K = I - diag(rho) F assembled (one channel at a time; for direct and ILUT only).
+SparseRowMatrix assemble_k(const ChannelSystem& system);
+
+}  // namespace lambert

@@ -1,0 +1,94 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/cli.hpp"
+#include "common/temp_dir.hpp"
+
+namespace lambert {
+namespace {
+
+int run(std::vector<std::string> args) {
+  args.insert(args.begin(), "lambert");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  return run_cli(static_cast<int>(argv.size()), argv.data());
+}
+
+std::vector<std::string> lines(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> out;
+  for (std::string l; std::getline(in, l);) out.push_back(l);
+  return out;
+}
+
+std::uintmax_t size_of(const std::string& path) {
+  std::error_code ec;
+  const auto s = std::filesystem::file_size(path, ec);
+  return ec ? 0 : s;
+}
+
+// Column `name` of a CSV data line (no quoted fields in these tables).
+std::string column(const std::string& header, const std::string& line, const std::string& name) {
+  std::stringstream h(header), l(line);
+  for (std::string k, v; std::getline(h, k, ',') && std::getline(l, v, ',');)
+    if (k == name) return v;
+  return "";
+}
+
+}  // namespace
+
+TEST(AccuracyCommand, TinyAnalyticCaseWritesTableCsvAndPlots) {
+  testing::TempDir dir;
+  const std::string prefix = dir.file("acc");
+  ASSERT_EQ(run({"accuracy", "--case", "perpendicular_squares", "--max-edge", "0.5", "-q",
+                 "--mc-samples", "4", "--hybrid-samples", "4", "--hemicube-res", "16,32",
+                 "--symmetrize", "-o", prefix}),
+            kExitOk);
+  for (const char* suffix : {"_table.csv", "_surfaces.csv", "_error_vs_time.svg", "_error_vs_time.png"})
+    EXPECT_GT(size_of(prefix + suffix), 0u) << suffix;
+  const auto table = lines(prefix + "_table.csv");
+  // Header, the reference, mc k=4, hybrid k=4, hemicube and hemicube-sym at N=16 and 32.
+  ASSERT_EQ(table.size(), 1u + 1u + 1u + 1u + 4u);
+  EXPECT_EQ(column(table[0], table[1], "setting"), "reference");
+  EXPECT_EQ(column(table[0], table[4], "estimator"), "hemicube");
+  EXPECT_EQ(column(table[0], table[4], "setting"), "N=16");
+  // The symmetrized hemicube is reciprocal to rounding (relative 1e-12 of F ~ 0.2 is far
+  // above the 4 ulp the symmetrization leaves); the plain one is not.
+  EXPECT_LT(std::stod(column(table[0], table[5], "reciprocity")), 1e-12);
+  EXPECT_GT(std::stod(column(table[0], table[4], "reciprocity")), 1e-12);
+  // The hybrid estimator is exact for this unoccluded case to its quadrature error (~1e-5
+  // for neighbours, see FormFactorHybrid.IsExactForUnoccludedPairs).
+  EXPECT_LT(std::stod(column(table[0], table[3], "F_exact_abs_err")), 1e-5);
+  const std::string svg = [&] {
+    std::ifstream in(prefix + "_error_vs_time.svg");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }();
+  EXPECT_NE(svg.find("<svg"), std::string::npos);
+  EXPECT_NE(svg.find("hemicube"), std::string::npos);
+}
+
+TEST(AccuracyCommand, SceneWithoutClosedFormUsesAHybridReference) {
+  testing::TempDir dir;
+  const std::string out = dir.path().string() + "/";
+  ASSERT_EQ(run({"accuracy", "--patches", "40", "-q", "--estimators", "hemicube",
+                 "--hemicube-res", "16", "--reference-samples", "16", "-o", out}),
+            kExitOk);
+  const auto table = lines(out + "accuracy_table.csv");
+  ASSERT_EQ(table.size(), 3u);
+  EXPECT_EQ(column(table[0], table[1], "estimator"), "hybrid");
+  EXPECT_EQ(column(table[0], table[1], "setting"), "reference");
+  EXPECT_GT(size_of(out + "accuracy_error_vs_time.png"), 0u);
+}
+
+TEST(AccuracyCommand, SceneAndCaseTogetherIsAUsageError) {
+  EXPECT_EQ(run({"accuracy", "some.obj", "--case", "unit_cube", "-q"}), kExitUsage);
+}
+
+}  // namespace lambert

@@ -1,0 +1,137 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/cli.hpp"
+#include "common/temp_dir.hpp"
+#include "io/exr.hpp"
+
+namespace lambert {
+namespace {
+
+int run(std::vector<std::string> args) {
+  args.insert(args.begin(), "lambert");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  return run_cli(static_cast<int>(argv.size()), argv.data());
+}
+
+// A tiny open box (unit cube without its z = 0 face, faces pointing inward) lit by an
+// emissive patch on the ceiling; without a .camera sidecar the default camera looks in
+// through the opening from -z.
+void write_tiny_scene(const lambert::testing::TempDir& dir) {
+  dir.write("tiny.mtl",
+            "newmtl white\nKd 0.6 0.6 0.6\n"
+            "newmtl red\nKd 0.7 0.1 0.1\n"
+            "newmtl light\nKd 0.2 0.2 0.2\nKe 10 9 8\n");
+  dir.write("tiny.obj",
+            "mtllib tiny.mtl\n"
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+            "v 0.4 0.999 0.4\nv 0.6 0.999 0.4\nv 0.6 0.999 0.6\nv 0.4 0.999 0.6\n"
+            "g back\nusemtl white\nf 5 8 7 6\n"
+            "g floor\nusemtl white\nf 1 5 6 2\n"
+            "g ceiling\nusemtl white\nf 4 3 7 8\n"
+            "g left\nusemtl red\nf 1 4 8 5\n"
+            "g right\nusemtl white\nf 2 6 7 3\n"
+            "g light\nusemtl light\nf 9 10 11 12\n");
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+TEST(RunCommand, TinySceneProducesEveryFile) {
+  lambert::testing::TempDir dir;
+  write_tiny_scene(dir);
+  const std::string out = dir.file("results");  // does not exist yet: created by run
+  ::testing::internal::CaptureStdout();
+  const int code = run({"run", dir.file("tiny.obj"), "-o", out, "--patches", "80", "--samples",
+                        "4", "--size", "40x30", "-q", "-j", "2"});
+  const std::string stdout_text = ::testing::internal::GetCapturedStdout();
+  ASSERT_EQ(code, kExitOk) << stdout_text;
+  for (const char* f : {"tiny.exr", "tiny.png", "tiny_vertices.exr", "tiny.ply", "report.json"}) {
+    const std::string path = out + "/" + f;
+    ASSERT_TRUE(std::filesystem::exists(path)) << path;
+    EXPECT_GT(std::filesystem::file_size(path), 0u) << path;
+    EXPECT_NE(stdout_text.find(path), std::string::npos) << "summary does not list " << path;
+  }
+  // Nothing else (no temporaries) is left in the output directory.
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(out),
+                          std::filesystem::directory_iterator()),
+            5);
+  EXPECT_EQ(slurp(out + "/tiny.png").substr(1, 3), "PNG");
+  EXPECT_EQ(slurp(out + "/tiny.ply").substr(0, 4), "ply\n");
+  const std::string report = slurp(out + "/report.json");
+  for (const char* key : {"\"energy_balance\"", "\"vertex_power\"", "\"seconds\"", "\"files\""})
+    EXPECT_NE(report.find(key), std::string::npos) << key;
+  const Image img = read_image_exr(out + "/tiny.exr");
+  EXPECT_EQ(img.width, 40);
+  EXPECT_EQ(img.height, 30);
+  const VertexExr v = read_vertex_exr(out + "/tiny_vertices.exr");
+  EXPECT_GT(v.vertex_count, 80);
+  EXPECT_EQ(v.info.surface_names.size(), 6u);
+  // The summary reports the stages.
+  for (const char* word : {"patches", "rays", "solver", "energy", "time", "files"})
+    EXPECT_NE(stdout_text.find(word), std::string::npos) << word;
+}
+
+TEST(RunCommand, NamePrefixAndBuiltInCornellBox) {
+  lambert::testing::TempDir dir;
+  ::testing::internal::CaptureStdout();
+  const int code = run({"run", "-o", dir.file("o"), "--patches", "150", "--samples", "2",
+                        "--size", "32x32", "--antialias", "1", "-q"});
+  ::testing::internal::GetCapturedStdout();
+  ASSERT_EQ(code, kExitOk);
+  for (const char* f : {"cornell.exr", "cornell.png", "cornell_vertices.exr", "cornell.ply"})
+    EXPECT_TRUE(std::filesystem::exists(dir.file("o/") + f)) << f;
+  ::testing::internal::CaptureStdout();
+  EXPECT_EQ(run({"run", "-o", dir.file("o"), "--name", "x", "--patches", "60", "--samples", "2",
+                 "--size", "16x16", "--flat", "-q"}),
+            kExitOk);
+  ::testing::internal::GetCapturedStdout();
+  EXPECT_TRUE(std::filesystem::exists(dir.file("o/x.png")));
+}
+
+TEST(RenderCommand, RendersASolvedCsvAndRefusesOneForAnotherMesh) {
+  lambert::testing::TempDir dir;
+  write_tiny_scene(dir);
+  const std::string scene = dir.file("tiny.obj");
+  ::testing::internal::CaptureStdout();
+  ASSERT_EQ(run({"solve", scene, "--patches", "60", "--samples", "4", "-o", dir.file("B.csv"), "-q"}),
+            kExitOk);
+  EXPECT_EQ(run({"render", scene, "--patches", "60", "--radiosity", dir.file("B.csv"), "-o",
+                 dir.file("img.exr"), "--size", "24x24", "--vertex-exr", dir.file("v.exr"), "--ply",
+                 dir.file("m.ply"), "-q"}),
+            kExitOk);
+  ::testing::internal::GetCapturedStdout();
+  for (const char* f : {"img.exr", "img.png", "v.exr", "m.ply"})
+    EXPECT_TRUE(std::filesystem::exists(dir.file(f))) << f;
+  // The same CSV on a different meshing: a one-line error (exit 1), nothing written.
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(run({"render", scene, "--patches", "200", "--radiosity", dir.file("B.csv"), "-o",
+                 dir.file("bad.exr"), "-q"}),
+            kExitFailure);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("B.csv"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("bad.exr")));
+}
+
+TEST(RenderCommand, BadOptionsAreUsageErrors) {
+  EXPECT_EQ(run({"render", "--size", "12", "-q"}), kExitUsage);
+  EXPECT_EQ(run({"render", "--antialias", "0", "-q"}), kExitUsage);
+  EXPECT_EQ(run({"render", "--exposure", "bright", "-q"}), kExitUsage);
+  EXPECT_EQ(run({"run", "--vertex-interp", "cubic", "-q"}), kExitUsage);
+  EXPECT_EQ(run({"run", "--eye", "1", "2", "-q"}), kExitUsage);
+}
+
+}  // namespace lambert

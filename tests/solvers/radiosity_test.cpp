@@ -1,0 +1,336 @@
+#include "solvers/radiosity.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/sampling.hpp"
+
+namespace lambert {
+namespace {
+
+// A problem that owns its F (RadiosityProblem only points at it).
+struct OwnedProblem {
+  SparseRowMatrix F;
+  RadiosityProblem p;
+  OwnedProblem() = default;
+  OwnedProblem(const OwnedProblem&) = delete;
+};
+
+// Reciprocal F from a symmetric non-negative "exchange" matrix G (G_ij = A_i F_ij).
+SparseRowMatrix f_from_exchange(const Eigen::MatrixXd& G, const Eigen::VectorXd& area) {
+  const Eigen::MatrixXd F = area.cwiseInverse().asDiagonal() * G;
+  return F.sparseView(0.0, 0.0);  // keep every non-zero
+}
+
+// A random symmetric exchange matrix with about `density` of its entries non-zero and zero
+// diagonal (planar patches).
+Eigen::MatrixXd random_exchange(int n, double density, std::uint64_t seed) {
+  Rng rng(seed);
+  Eigen::MatrixXd W = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j)
+      if (rng.uniform() < density) W(i, j) = W(j, i) = 0.05 + rng.uniform();
+  return W;
+}
+
+// Closed enclosure: symmetric G = D W D with row sums exactly A (symmetric Sinkhorn scaling),
+// so F = G / A is reciprocal and every row of F sums to 1 (up to rounding).
+void make_enclosure(OwnedProblem& o, int n, std::uint64_t seed) {
+  Rng rng(seed + 7);
+  Eigen::VectorXd area(n);
+  for (int i = 0; i < n; ++i) area[i] = 0.5 + 4.0 * rng.uniform();
+  const Eigen::MatrixXd W = random_exchange(n, 0.6, seed);
+  Eigen::VectorXd d = Eigen::VectorXd::Ones(n);
+  for (int it = 0; it < 2000; ++it) {
+    const Eigen::VectorXd wd = W * d;
+    d = (d.array() * area.array() / wd.array()).sqrt().matrix();  // fixed point: d .* W d = A
+  }
+  const Eigen::MatrixXd G = d.asDiagonal() * W * d.asDiagonal();
+  o.F = f_from_exchange(0.5 * (G + G.transpose()), area);
+  o.p.F = &o.F;
+  o.p.area = area;
+}
+
+// Open random system: reciprocal F with row sums in [0.3, 0.95] (energy escapes).
+void make_open(OwnedProblem& o, int n, std::uint64_t seed, double zero_rho_fraction) {
+  Rng rng(seed);
+  Eigen::VectorXd area(n);
+  for (int i = 0; i < n; ++i) area[i] = 0.2 + 2.0 * rng.uniform();
+  Eigen::MatrixXd G = random_exchange(n, 0.2, seed + 1);
+  // Scale G uniformly so that the largest row sum of F is 0.95.
+  const double max_row = (area.cwiseInverse().asDiagonal() * G).rowwise().sum().maxCoeff();
+  G *= 0.95 / max_row;
+  o.F = f_from_exchange(G, area);
+  o.p.F = &o.F;
+  o.p.area = area;
+  o.p.rho.resize(n, 3);
+  o.p.emission = Eigen::MatrixX3d::Zero(n, 3);
+  for (int i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      o.p.rho(i, c) = rng.uniform() < zero_rho_fraction ? 0.0 : 0.9 * rng.uniform();
+      if (i % 17 == 0) o.p.emission(i, c) = 1.0 + 10.0 * rng.uniform();
+    }
+  }
+}
+
+const std::vector<std::string> kIterative = {"jacobi",   "gauss-seidel", "sor", "southwell",
+                                             "bicgstab", "gmres",        "cg"};
+
+SolveOptions options_for(const std::string& solver, double tol) {
+  SolveOptions o;
+  o.solver = solver;
+  o.tol = tol;
+  o.max_iterations = 100000;
+  o.omega = 1.2;
+  o.record_history = false;
+  return o;
+}
+
+// The bound of STYLE.md: ||rho F||_inf <= rho_max < 1, so ||K^-1||_inf <= 1/(1 - rho_max) and
+// ||B - B*||_inf <= ||r||_inf / (1 - rho_max) <= tol ||E||_2 / (1 - rho_max).
+double error_bound(const RadiosityProblem& p, int c, double tol) {
+  return tol * p.emission.col(c).norm() / (1.0 - p.rho.col(c).maxCoeff());
+}
+
+TEST(SolverRegistry, ListsEverySolverOnce) {
+  const auto names = solver_names();
+  EXPECT_EQ(names, (std::vector<std::string>{"jacobi", "gauss-seidel", "sor", "southwell",
+                                             "bicgstab", "gmres", "cg", "direct"}));
+  for (const auto& s : solver_registry()) EXPECT_FALSE(s.description.empty()) << s.name;
+  EXPECT_STREQ(to_string(SolveStatus::MaxIterations), "max-iterations");
+}
+
+TEST(SolveRadiosity, FurnaceGivesEOverOneMinusRhoForEverySolver) {
+  OwnedProblem o;
+  const int n = 40;
+  make_enclosure(o, n, 11);
+  const Eigen::VectorXd row_sum = o.F * Eigen::VectorXd::Ones(n);
+  const double defect = (row_sum.array() - 1.0).abs().maxCoeff();
+  ASSERT_LT(defect, 1e-12) << "the synthetic enclosure is not closed";
+  const Eigen::Vector3d rho(0.3, 0.6, 0.9);
+  const Eigen::Vector3d e(1.0, 2.0, 0.5);
+  o.p.rho = rho.transpose().replicate(n, 1);
+  o.p.emission = e.transpose().replicate(n, 1);
+  const double tol = 1e-10;
+  for (const auto& name : solver_names()) {
+    const RadiositySolution s = solve_radiosity(o.p, options_for(name, tol));
+    EXPECT_EQ(s.status, SolveStatus::Converged) << name;
+    for (int c = 0; c < 3; ++c) {
+      const double exact = e[c] / (1.0 - rho[c]);
+      // Solver bound plus the row-sum defect: K B* = E + rho (1 - rowsum) B*, an extra
+      // residual of at most rho * defect * B* per row, amplified by 1/(1 - rho).
+      const double bound = error_bound(o.p, c, tol) + rho[c] * defect * exact / (1.0 - rho[c]) +
+                           1e-13 * exact;  // rounding of O(N) sums
+      for (int i = 0; i < n; ++i) ASSERT_NEAR(s.B(i, c), exact, bound) << name << " c" << c;
+    }
+  }
+}
+
+TEST(SolveRadiosity, TwoFacingPatchesMatchClosedForm) {
+  // Two patches of areas 2 and 1 that see each other: A1 F12 = A2 F21.
+  OwnedProblem o;
+  const double a1 = 2.0, a2 = 1.0, f12 = 0.2, f21 = a1 * f12 / a2;
+  Eigen::MatrixXd F(2, 2);
+  F << 0.0, f12, f21, 0.0;
+  o.F = F.sparseView();
+  o.p.F = &o.F;
+  o.p.area = Eigen::Vector2d(a1, a2);
+  o.p.rho.resize(2, 3);
+  o.p.rho << 0.5, 0.7, 0.0, 0.8, 0.3, 0.9;
+  o.p.emission.resize(2, 3);
+  o.p.emission << 1.0, 0.0, 3.0, 2.0, 5.0, 1.0;
+  const double tol = 1e-12;
+  for (const auto& name : solver_names()) {
+    const RadiositySolution s = solve_radiosity(o.p, options_for(name, tol));
+    EXPECT_EQ(s.status, SolveStatus::Converged) << name;
+    for (int c = 0; c < 3; ++c) {
+      const double r1 = o.p.rho(0, c), r2 = o.p.rho(1, c);
+      const double e1 = o.p.emission(0, c), e2 = o.p.emission(1, c);
+      const double den = 1.0 - r1 * r2 * f12 * f21;
+      const double b1 = (e1 + r1 * f12 * e2) / den;
+      const double b2 = (e2 + r2 * f21 * e1) / den;
+      const double bound = error_bound(o.p, c, tol) + 1e-14 * std::max(b1, b2);  // + rounding
+      EXPECT_NEAR(s.B(0, c), b1, bound) << name << " c" << c;
+      EXPECT_NEAR(s.B(1, c), b2, bound) << name << " c" << c;
+    }
+  }
+}
+
+TEST(SolveRadiosity, EverySolverAgreesWithDirectOnRandomReciprocalSystems) {
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    OwnedProblem o;
+    make_open(o, 150, seed, seed == 3 ? 0.2 : 0.0);  // seed 3: some rho = 0 (cg eliminates)
+    const double tol = 1e-9;
+    const RadiositySolution ref = solve_radiosity(o.p, options_for("direct", tol));
+    ASSERT_EQ(ref.status, SolveStatus::Converged);
+    for (const auto& name : kIterative) {
+      for (const std::string pre : {"diagonal", "none", "ilut"}) {
+        if (pre != "diagonal" && name != "bicgstab" && name != "gmres") continue;
+        SolveOptions opt = options_for(name, tol);
+        opt.preconditioner = pre;
+        const RadiositySolution s = solve_radiosity(o.p, opt);
+        EXPECT_EQ(s.status, SolveStatus::Converged) << name << " " << pre << " seed " << seed;
+        for (int c = 0; c < 3; ++c) {
+          // Both solutions are within their residual bound of the exact one.
+          const double bound = error_bound(o.p, c, tol + ref.channels[c].residual);
+          EXPECT_LE((s.B.col(c) - ref.B.col(c)).lpNorm<Eigen::Infinity>(), bound)
+              << name << " " << pre << " seed " << seed << " c" << c;
+        }
+      }
+    }
+  }
+}
+
+TEST(SolveRadiosity, ReportedResidualIsTheTrueResidual) {
+  OwnedProblem o;
+  make_open(o, 120, 5, 0.1);
+  for (const auto& name : solver_names()) {
+    SolveOptions opt = options_for(name, 1e-8);
+    opt.record_history = true;
+    const RadiositySolution s = solve_radiosity(o.p, opt);
+    for (int c = 0; c < 3; ++c) {
+      const ChannelReport& r = s.channels[c];
+      const double truth = relative_residual(o.p, s.B, c);
+      // Both are the same computation up to the rounding of an O(nnz) sum (1e-15 relative).
+      EXPECT_NEAR(r.residual, truth, 1e-12) << name;
+      EXPECT_LE(r.residual, 1e-8) << name;
+      ASSERT_FALSE(r.residual_history.empty()) << name;
+      EXPECT_EQ(r.history_iteration.front(), 0) << name;
+      EXPECT_EQ(r.history_iteration.back(), r.iterations) << name;
+      EXPECT_TRUE(std::is_sorted(r.history_iteration.begin(), r.history_iteration.end())) << name;
+      EXPECT_EQ(r.residual_history.size(), r.time_history.size()) << name;
+      EXPECT_GT(r.matvecs, 0) << name;
+    }
+  }
+}
+
+TEST(SolveRadiosity, InputsAreNotModified) {
+  OwnedProblem o;
+  make_open(o, 80, 9, 0.1);
+  const SparseRowMatrix f_before = o.F;
+  const Eigen::MatrixX3d rho = o.p.rho, e = o.p.emission;
+  const Eigen::VectorXd a = o.p.area;
+  for (const auto& name : solver_names()) {
+    solve_radiosity(o.p, options_for(name, 1e-8));
+    EXPECT_EQ(o.p.emission, e) << name;
+    EXPECT_EQ(o.p.rho, rho) << name;
+    EXPECT_EQ(o.p.area, a) << name;
+    EXPECT_EQ((o.F - f_before).norm(), 0.0) << name;
+  }
+}
+
+TEST(SolveRadiosity, OneIterationReportsMaxIterations) {
+  OwnedProblem o;
+  make_open(o, 100, 4, 0.0);
+  for (const auto& name : kIterative) {
+    SolveOptions opt = options_for(name, 1e-12);
+    opt.max_iterations = 1;
+    const RadiositySolution s = solve_radiosity(o.p, opt);
+    EXPECT_EQ(s.status, SolveStatus::MaxIterations) << name;
+    EXPECT_EQ(s.channels[0].iterations, 1) << name;
+    EXPECT_GT(s.channels[0].residual, 1e-12) << name;
+  }
+}
+
+TEST(SolveRadiosity, ChannelWithoutEmissionIsZeroAndConverged) {
+  OwnedProblem o;
+  make_open(o, 50, 6, 0.0);
+  o.p.emission.col(1).setZero();
+  for (const auto& name : solver_names()) {
+    const RadiositySolution s = solve_radiosity(o.p, options_for(name, 1e-8));
+    EXPECT_EQ(s.channels[1].status, SolveStatus::Converged) << name;
+    EXPECT_EQ(s.channels[1].iterations, 0) << name;
+    EXPECT_EQ(s.B.col(1).lpNorm<Eigen::Infinity>(), 0.0) << name;
+  }
+}
+
+TEST(EnergyBalance, DirectSolutionBalancesToOnePartInABillion) {
+  OwnedProblem o;
+  make_open(o, 150, 8, 0.1);
+  const RadiositySolution s = solve_radiosity(o.p, options_for("direct", 1e-12));
+  for (int c = 0; c < 3; ++c) {
+    const EnergyBalance& e = s.energy[c];
+    EXPECT_GT(e.escaped, 0.0);
+    EXPECT_GT(e.absorbed, 0.0);
+    // emitted - absorbed - escaped = sum A r (reciprocal F), |.| <= ||A||_2 ||r||_2 ~ 1e-15.
+    EXPECT_LE(e.relative_imbalance, 1e-9) << c;
+  }
+}
+
+TEST(EnergyBalance, ImbalanceIsBoundedByTheResidualForIterativeSolvers) {
+  OwnedProblem o;
+  make_open(o, 150, 10, 0.0);
+  for (const auto& name : kIterative) {
+    const RadiositySolution s = solve_radiosity(o.p, options_for(name, 1e-6));
+    for (int c = 0; c < 3; ++c) {
+      const EnergyBalance& e = s.energy[c];
+      // |emitted - absorbed - escaped| = |sum A_i r_i| <= ||A||_2 ||r||_2 (Cauchy-Schwarz),
+      // ||r||_2 = residual * ||E||_2; plus 1e-12 relative for rounding of the sums.
+      const double bound =
+          o.p.area.norm() * s.channels[c].residual * o.p.emission.col(c).norm() / e.emitted + 1e-12;
+      EXPECT_LE(e.relative_imbalance, bound) << name << " c" << c;
+    }
+  }
+}
+
+TEST(EnergyBalance, ClosedFurnaceHasNoEscape) {
+  OwnedProblem o;
+  make_enclosure(o, 30, 3);
+  o.p.rho = Eigen::MatrixX3d::Constant(30, 3, 0.5);
+  o.p.emission = Eigen::MatrixX3d::Constant(30, 3, 1.0);
+  const RadiositySolution s = solve_radiosity(o.p, options_for("direct", 1e-12));
+  // Row sums are 1 to 1e-12 (checked in the furnace test), so escaped / emitted <= ~1e-12 * B/E.
+  EXPECT_LE(std::abs(s.energy[0].escaped), 1e-10 * s.energy[0].emitted);
+  EXPECT_NEAR(s.energy[0].absorbed, s.energy[0].emitted, 1e-9 * s.energy[0].emitted);
+}
+
+TEST(SolveRadiosity, CgHandlesZeroReflectanceRowsExactly) {
+  OwnedProblem o;
+  make_open(o, 100, 12, 0.5);
+  const RadiositySolution ref = solve_radiosity(o.p, options_for("direct", 1e-12));
+  const RadiositySolution s = solve_radiosity(o.p, options_for("cg", 1e-10));
+  EXPECT_EQ(s.status, SolveStatus::Converged);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_LE((s.B.col(c) - ref.B.col(c)).lpNorm<Eigen::Infinity>(),
+              error_bound(o.p, c, 1e-10 + ref.channels[c].residual));
+    for (int i = 0; i < 100; ++i) {  // rho = 0: B = E (K's row is e_i), up to rounding
+      if (o.p.rho(i, c) == 0.0) {
+        EXPECT_NEAR(s.B(i, c), o.p.emission(i, c), 1e-12);
+      }
+    }
+  }
+}
+
+TEST(SolveRadiosity, SouthwellRefinesWhenFIsNotReciprocal) {
+  OwnedProblem o;
+  make_open(o, 100, 13, 0.0);
+  // Perturb F by 2% per entry, breaking reciprocity but keeping row sums below 1.
+  Rng rng(99);
+  for (int k = 0; k < o.F.outerSize(); ++k)
+    for (SparseRowMatrix::InnerIterator it(o.F, k); it; ++it)
+      it.valueRef() *= 0.98 + 0.02 * rng.uniform();
+  const RadiositySolution s = solve_radiosity(o.p, options_for("southwell", 1e-9));
+  EXPECT_EQ(s.status, SolveStatus::Converged);
+  EXPECT_LE(relative_residual(o.p, s.B, 0), 1e-9);
+}
+
+TEST(SolveRadiosity, InvalidRequestsAreUsageErrors) {
+  OwnedProblem o;
+  make_open(o, 10, 1, 0.0);
+  EXPECT_THROW(solve_radiosity(o.p, options_for("magic", 1e-8)), UsageError);
+  SolveOptions bad = options_for("sor", 1e-8);
+  bad.omega = 2.5;
+  EXPECT_THROW(solve_radiosity(o.p, bad), UsageError);
+  bad = options_for("cg", 1e-8);
+  bad.preconditioner = "ilut";
+  EXPECT_THROW(solve_radiosity(o.p, bad), UsageError);
+  o.p.rho(0, 0) = 1.0;
+  EXPECT_THROW(solve_radiosity(o.p, options_for("direct", 1e-8)), UsageError);
+}
+
+}  // namespace
+}  // namespace lambert
