@@ -32,7 +32,8 @@ std::string render_settings(const RenderOptions& o, const LoadedScene& s, const 
 
 CLI::App* add_render_command(CLI::App& app, RenderOptions& opts) {
   auto* cmd = app.add_subcommand(
-      "render", "Render the radiosity solution (HDR EXR + sRGB PNG), optionally per-vertex EXR/PLY");
+      "render",
+      "Render the radiosity solution (HDR EXR + sRGB PNG), optionally per-vertex EXR/PLY");
   opts.scene.default_patches = 2000;
   add_scene_options(cmd, opts.scene);
   add_run_options(cmd, opts.run);
@@ -40,8 +41,9 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opts) {
   add_solve_options(cmd, opts.solver, true);
   add_camera_options(cmd, opts.camera);
   add_shade_options(cmd, opts.shade);
-  cmd->add_option("--radiosity", opts.radiosity,
-                  "Per-patch radiosity CSV from `lambert solve` (instead of computing F and solving)");
+  cmd->add_option(
+      "--radiosity", opts.radiosity,
+      "Per-patch radiosity CSV from `lambert solve` (instead of computing F and solving)");
   cmd->add_option("-o,--output", opts.output, "Rendered linear HDR image (OpenEXR)")
       ->capture_default_str();
   cmd->add_option("--png", opts.png, "Tone-mapped sRGB preview (default: --output with .png)");
@@ -69,8 +71,9 @@ int run_render(const RenderOptions& opts) {
   const double ev = choose_exposure(opts.shade, image);
   OutputPaths paths;
   paths.image_exr = opts.output;
-  paths.png = opts.png.empty() ? std::filesystem::path(opts.output).replace_extension(".png").string()
-                               : opts.png;
+  paths.png = opts.png.empty()
+                  ? std::filesystem::path(opts.output).replace_extension(".png").string()
+                  : opts.png;
   paths.vertex_exr = opts.vertex_exr;
   paths.ply = opts.ply;
   const auto written =

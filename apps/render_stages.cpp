@@ -52,8 +52,9 @@ Camera make_camera(const Scene& scene, const CameraArgs& args) {
   }
   const Eigen::Vector3d forward = cam.look_at - cam.eye;
   if (!(forward.norm() > 0) || !(forward.normalized().cross(cam.up.normalized()).norm() > 1e-6))
-    throw UsageError("camera: --look-at must differ from --eye and --up must not be parallel "
-                     "to the view direction");
+    throw UsageError(
+        "camera: --look-at must differ from --eye and --up must not be parallel "
+        "to the view direction");
   return cam;
 }
 
@@ -111,11 +112,12 @@ RadiosityResult compute_radiosity(const LoadedScene& scene, const FormFactorArgs
   return r;
 }
 
-ShadedField shade_vertices(const PatchMesh& mesh, const Eigen::MatrixX3d& B, const ShadeArgs& args) {
+ShadedField shade_vertices(const PatchMesh& mesh, const Eigen::MatrixX3d& B,
+                           const ShadeArgs& args) {
   const Timer timer;
   ShadedField s;
-  s.field = interpolate_to_vertices(mesh, B, parse_vertex_interpolation(args.vertex_interp),
-                                    &s.power);
+  s.field =
+      interpolate_to_vertices(mesh, B, parse_vertex_interpolation(args.vertex_interp), &s.power);
   s.seconds = timer.seconds();
   return s;
 }
@@ -133,14 +135,15 @@ Image render_scene(const PatchMesh& mesh, const Eigen::MatrixX3d& B, const Verte
   settings.progress = !run.quiet;
   Image img = render(mesh, bvh, camera, B, field, settings, stats);
   if (stats) stats->seconds = timer.seconds();  // including the BVH build
-  log_info("render: " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
-           ", " + std::to_string(args.antialias * args.antialias) + " samples/pixel, " +
+  log_info("render: " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + ", " +
+           std::to_string(args.antialias * args.antialias) + " samples/pixel, " +
            (args.flat ? "flat" : "Gouraud") + " shading in " + format_duration(timer.seconds()));
   return img;
 }
 
 double choose_exposure(const ShadeArgs& args, const Image& image) {
-  return args.exposure == "auto" ? auto_exposure(image) : std::strtod(args.exposure.c_str(), nullptr);
+  return args.exposure == "auto" ? auto_exposure(image)
+                                 : std::strtod(args.exposure.c_str(), nullptr);
 }
 
 std::vector<std::string> write_outputs(const OutputPaths& paths, const PatchMesh& mesh,

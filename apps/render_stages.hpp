@@ -41,8 +41,8 @@ void add_shade_options(CLI::App* cmd, ShadeArgs& args);
 
 /// The radiosity B of every patch and how it was obtained.
 struct RadiosityResult {
-  Eigen::MatrixX3d B;  ///< N x 3
-  bool solved = false;  ///< false when read from a CSV
+  Eigen::MatrixX3d B;          ///< N x 3
+  bool solved = false;         ///< false when read from a CSV
   RadiositySolution solution;  ///< valid when solved
   FormFactorStats ff_stats;    ///< valid when solved (rays 0 when F was loaded)
   std::int64_t ff_entries = 0;

@@ -184,17 +184,19 @@ void print_summary(const Report& rp) {
                 e.escaped, e.relative_imbalance);
   }
   const auto [after, before] = worst_power_error(rp.shaded.power);
-  std::printf("vertices   power error per surface (max) %.2e with %s interpolation "
-              "(area-weighted alone: %.2e)\n",
-              after, rp.opts.shade.vertex_interp.c_str(), before);
+  std::printf(
+      "vertices   power error per surface (max) %.2e with %s interpolation "
+      "(area-weighted alone: %.2e)\n",
+      after, rp.opts.shade.vertex_interp.c_str(), before);
   std::printf("image      %dx%d, %d samples/pixel, exposure %+.2f EV\n", rp.camera.width,
               rp.camera.height, rp.opts.shade.antialias * rp.opts.shade.antialias, rp.ev);
-  std::printf("time       load+mesh %s, form factors %s, solve %s, vertices %s, render %s, "
-              "write %s; total %s\n",
-              format_duration(rp.t.load).c_str(), format_duration(rp.t.form_factors).c_str(),
-              format_duration(rp.t.solve).c_str(), format_duration(rp.t.vertices).c_str(),
-              format_duration(rp.t.render).c_str(), format_duration(rp.t.write).c_str(),
-              format_duration(rp.t.total()).c_str());
+  std::printf(
+      "time       load+mesh %s, form factors %s, solve %s, vertices %s, render %s, "
+      "write %s; total %s\n",
+      format_duration(rp.t.load).c_str(), format_duration(rp.t.form_factors).c_str(),
+      format_duration(rp.t.solve).c_str(), format_duration(rp.t.vertices).c_str(),
+      format_duration(rp.t.render).c_str(), format_duration(rp.t.write).c_str(),
+      format_duration(rp.t.total()).c_str());
   std::printf("files\n");
   for (const auto& f : rp.files) std::printf("           %s\n", f.c_str());
 }
@@ -219,8 +221,9 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& opts) {
   add_shade_options(cmd, opts.shade);
   cmd->add_option("-o,--output", opts.output_dir, "Output directory (created if needed)")
       ->capture_default_str();
-  cmd->add_option("--name", opts.name,
-                  "File name prefix (default: the scene file's stem; cornell for the built-in box)");
+  cmd->add_option(
+      "--name", opts.name,
+      "File name prefix (default: the scene file's stem; cornell for the built-in box)");
   return cmd;
 }
 
@@ -228,8 +231,9 @@ int run_run(const RunOptions& opts) {
   apply_run_options(opts.run);
   StageTimes t;
   Timer timer;
-  stage(1, "loading and meshing " + (opts.scene.scene.empty() ? std::string("the built-in Cornell box")
-                                                              : opts.scene.scene));
+  stage(1,
+        "loading and meshing " + (opts.scene.scene.empty() ? std::string("the built-in Cornell box")
+                                                           : opts.scene.scene));
   const LoadedScene loaded = load_scene(opts.scene);
   const Camera camera = make_camera(loaded.scene, opts.camera);
   t.load = timer.seconds();
@@ -245,10 +249,10 @@ int run_run(const RunOptions& opts) {
     throw IoError(opts.output_dir + ": cannot create the output directory" +
                   (ec ? ": " + ec.message() : std::string()));
 
-  stage(2, "form factors (" + (opts.ff.ff_file.empty()
-                                    ? opts.ff.estimator + ", " + std::to_string(opts.ff.samples) +
-                                          " samples per pair"
-                                    : "from " + opts.ff.ff_file) +
+  stage(2, "form factors (" +
+               (opts.ff.ff_file.empty() ? opts.ff.estimator + ", " +
+                                              std::to_string(opts.ff.samples) + " samples per pair"
+                                        : "from " + opts.ff.ff_file) +
                ")");
   RadiosityResult r;
   timer.reset();
@@ -266,7 +270,8 @@ int run_run(const RunOptions& opts) {
 
   stage(5, "rendering " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
   RenderStats rs;
-  const Image image = render_scene(loaded.mesh, r.B, shaded.field, camera, opts.shade, opts.run, &rs);
+  const Image image =
+      render_scene(loaded.mesh, r.B, shaded.field, camera, opts.shade, opts.run, &rs);
   t.render = rs.seconds;
   const double ev = choose_exposure(opts.shade, image);
 

@@ -25,8 +25,8 @@ struct Bilinear {
 };
 
 Bilinear quad_of(const PatchMesh& mesh, const Patch& p) {
-  return {mesh.vertices[p.vertices[0]], mesh.vertices[p.vertices[1]],
-          mesh.vertices[p.vertices[2]], mesh.vertices[p.vertices[3]]};
+  return {mesh.vertices[p.vertices[0]], mesh.vertices[p.vertices[1]], mesh.vertices[p.vertices[2]],
+          mesh.vertices[p.vertices[3]]};
 }
 
 double relative(const Eigen::Vector3d& value, const Eigen::Vector3d& reference) {
@@ -107,11 +107,10 @@ Eigen::Vector3d integrate_patch(const PatchMesh& mesh, const VertexField& field,
   for (double u : {kGauss0, kGauss1}) {
     for (double v : {kGauss0, kGauss1}) {
       const double jac = p.normal.dot(q.du(v).cross(q.dv(u)));
-      const Eigen::Vector3d fv = ((1 - u) * (1 - v) * field.values.row(c[0]) +
-                                  u * (1 - v) * field.values.row(c[1]) +
-                                  u * v * field.values.row(c[2]) +
-                                  (1 - u) * v * field.values.row(c[3]))
-                                     .transpose();
+      const Eigen::Vector3d fv =
+          ((1 - u) * (1 - v) * field.values.row(c[0]) + u * (1 - v) * field.values.row(c[1]) +
+           u * v * field.values.row(c[2]) + (1 - u) * v * field.values.row(c[3]))
+              .transpose();
       sum += 0.25 * jac * fv;
     }
   }
@@ -170,7 +169,8 @@ VertexField interpolate_to_vertices(const PatchMesh& mesh, const Eigen::MatrixX3
   return f;
 }
 
-std::array<double, 4> patch_weights(const PatchMesh& mesh, std::int32_t i, const Eigen::Vector3d& x) {
+std::array<double, 4> patch_weights(const PatchMesh& mesh, std::int32_t i,
+                                    const Eigen::Vector3d& x) {
   const Patch& p = mesh.patches[i];
   if (p.vertex_count == 3) {
     // Barycentric coordinates by least squares in the triangle's plane.

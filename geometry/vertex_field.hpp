@@ -80,8 +80,8 @@ struct VertexField {
 struct SurfacePower {
   std::string name;
   double area = 0.0;
-  Eigen::Vector3d patch_power = Eigen::Vector3d::Zero();  ///< sum_i A_i b_i per channel
-  Eigen::Vector3d field_power = Eigen::Vector3d::Zero();  ///< ∫ f dA per channel (exact)
+  Eigen::Vector3d patch_power = Eigen::Vector3d::Zero();          ///< sum_i A_i b_i per channel
+  Eigen::Vector3d field_power = Eigen::Vector3d::Zero();          ///< ∫ f dA per channel (exact)
   Eigen::Vector3d area_weighted_power = Eigen::Vector3d::Zero();  ///< ∫ f dA before rescale
   Eigen::Vector3d scale = Eigen::Vector3d::Ones();  ///< rescale applied (1 for AreaWeighted)
 
@@ -111,6 +111,7 @@ std::vector<SurfacePower> surface_power(const PatchMesh& mesh, const Eigen::Matr
 /// Interpolation weights of a point inside patch i: barycentric (triangles, weights for
 /// corners 0..2) or bilinear (quads, corners 0..3) from the position `p` on the patch plane.
 /// Points slightly outside (ray-hit rounding) are clamped onto the patch.
-std::array<double, 4> patch_weights(const PatchMesh& mesh, std::int32_t i, const Eigen::Vector3d& p);
+std::array<double, 4> patch_weights(const PatchMesh& mesh, std::int32_t i,
+                                    const Eigen::Vector3d& p);
 
 }  // namespace lambert

@@ -20,8 +20,8 @@ namespace lambert {
 namespace {
 
 // Vertex channels in the order the layout lists them.
-const char* const kVertexChannels[] = {"R",   "G",   "B",   "P.x",    "P.y", "P.z",
-                                       "N.x", "N.y", "N.z", "surface"};
+const char* const kVertexChannels[] = {"R",   "G",   "B",   "P.x", "P.y",
+                                       "P.z", "N.x", "N.y", "N.z", "surface"};
 constexpr int kVertexChannelCount = 10;
 
 const char* const kVertexLayoutText =
@@ -40,8 +40,8 @@ void write_planes(const std::string& path, int width, int height, const Planes& 
       Imf::FrameBuffer fb;
       for (const auto& name : order) {
         const auto& plane = planes.at(name);
-        fb.insert(name, Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(
-                                                    plane.data())),
+        fb.insert(name, Imf::Slice(Imf::FLOAT,
+                                   const_cast<char*>(reinterpret_cast<const char*>(plane.data())),
                                    sizeof(float), sizeof(float) * static_cast<size_t>(width)));
       }
       Imf::OutputFile file(tmp.c_str(), header);
@@ -102,7 +102,8 @@ void add_info(Imf::Header& h, const ExrInfo& info) {
 void write_vertex_exr(const std::string& path, const VertexField& field, const ExrInfo& info) {
   const std::int64_t n = field.size();
   LAMBERT_CHECK(n > 0, "vertex EXR: no vertices");
-  LAMBERT_CHECK(n < (std::int64_t{1} << 24), "vertex EXR: surface/vertex ids exceed float precision");
+  LAMBERT_CHECK(n < (std::int64_t{1} << 24),
+                "vertex EXR: surface/vertex ids exceed float precision");
   LAMBERT_CHECK(field.values.rows() == n, "vertex EXR: values do not match the vertices");
   const int width = static_cast<int>(std::min<std::int64_t>(n, kVertexExrWidth));
   const int height = static_cast<int>((n + width - 1) / width);
@@ -136,8 +137,7 @@ VertexExr read_vertex_exr(const std::string& path) {
   const auto* count = header.findTypedAttribute<Imf::IntAttribute>("vertexCount");
   if (!count) throw IoError(path + ": EXR has no vertexCount attribute (not a vertex EXR)");
   out.vertex_count = count->value();
-  if (out.vertex_count < 0 ||
-      out.vertex_count > static_cast<std::int64_t>(out.width) * out.height)
+  if (out.vertex_count < 0 || out.vertex_count > static_cast<std::int64_t>(out.width) * out.height)
     throw IoError(path + ": vertexCount " + std::to_string(out.vertex_count) +
                   " does not fit the image size");
   out.info.units = string_attribute(header, "units");

@@ -24,8 +24,8 @@ constexpr int kVertexExrWidth = 1024;
 
 /// Descriptive header attributes written with an EXR.
 struct ExrInfo {
-  std::string units;     ///< what the pixel values mean and their units
-  std::string settings;  ///< the settings that produced the data (one line)
+  std::string units;                       ///< what the pixel values mean and their units
+  std::string settings;                    ///< the settings that produced the data (one line)
   std::vector<std::string> surface_names;  ///< vertex EXR: surface index -> name
 };
 
@@ -33,8 +33,8 @@ struct ExrInfo {
 struct VertexExr {
   int width = 0;
   int height = 0;
-  std::int64_t vertex_count = 0;        ///< the vertexCount attribute
-  Eigen::MatrixX3d radiosity;           ///< vertex_count x 3 (R, G, B)
+  std::int64_t vertex_count = 0;  ///< the vertexCount attribute
+  Eigen::MatrixX3d radiosity;     ///< vertex_count x 3 (R, G, B)
   std::vector<Eigen::Vector3d> positions;
   std::vector<Eigen::Vector3d> normals;
   std::vector<std::int32_t> surface;

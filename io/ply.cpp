@@ -10,11 +10,11 @@
 
 namespace lambert {
 
-void write_ply(const std::string& path, const PatchMesh& mesh, const VertexField& field,
-               double ev, const std::string& comment) {
-  LAMBERT_CHECK(field.patch_corners.size() == mesh.patches.size() &&
-                    field.values.rows() == field.size(),
-                "ply: vertex field does not match the mesh");
+void write_ply(const std::string& path, const PatchMesh& mesh, const VertexField& field, double ev,
+               const std::string& comment) {
+  LAMBERT_CHECK(
+      field.patch_corners.size() == mesh.patches.size() && field.values.rows() == field.size(),
+      "ply: vertex field does not match the mesh");
   write_stream_atomically(path, [&](std::ostream& out) {
     out << "ply\nformat ascii 1.0\n";
     out << "comment written by lambert " << LAMBERT_VERSION << "\n";

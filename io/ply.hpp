@@ -17,7 +17,7 @@ namespace lambert {
 
 /// Writes `field` on `mesh` as a coloured PLY with exposure `ev` (stops), atomically.
 /// `comment` (one line) is added to the header. Throws IoError.
-void write_ply(const std::string& path, const PatchMesh& mesh, const VertexField& field,
-               double ev, const std::string& comment = "");
+void write_ply(const std::string& path, const PatchMesh& mesh, const VertexField& field, double ev,
+               const std::string& comment = "");
 
 }  // namespace lambert

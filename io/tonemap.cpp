@@ -17,8 +17,8 @@ double auto_exposure(const Image& image) {
   std::int64_t n = 0;
   const size_t count = image.alpha.size();
   for (size_t k = 0; k < count; ++k) {
-    const double lum = 0.2126 * image.rgb[3 * k] + 0.7152 * image.rgb[3 * k + 1] +
-                       0.0722 * image.rgb[3 * k + 2];
+    const double lum =
+        0.2126 * image.rgb[3 * k] + 0.7152 * image.rgb[3 * k + 1] + 0.0722 * image.rgb[3 * k + 2];
     // Pixels that see nothing lit (misses, back faces, unlit surfaces) carry no exposure
     // information; a log of 0 would drive the mean to -inf.
     if (!(lum > 0.0) || !std::isfinite(lum)) continue;

@@ -2,19 +2,19 @@
 // Tone mapping of linear radiance to 8-bit sRGB for previews (PNG, PLY vertex colours).
 //
 // The mapping is a pure exposure followed by the sRGB opto-electronic transfer function:
-//   v = 2^EV · L  (L linear radiance, W m^-2 sr^-1),  c = OETF(clamp(v, 0, 1)),  byte = round(255 c)
+//   v = 2^EV · L  (L linear radiance, W m^-2 sr^-1),  c = OETF(clamp(v, 0, 1)),  byte = round(255
+//   c)
 // with OETF(x) = 12.92 x for x <= 0.0031308, else 1.055 x^(1/2.4) − 0.055 (IEC 61966-2-1).
 // No curve beyond the clip: colours stay proportional to radiance below white, so colour
 // bleeding and shadow gradients read as they are; emitters (far brighter) clip to white.
 // Automatic exposure (Reinhard et al. 2002, "key value"): EV = log2(kKey / L̄), L̄ the
 // geometric mean of the Rec.709 luminance over the pixels that see a lit surface.
 
+#include <Eigen/Core>
 #include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "geometry/render.hpp"
 

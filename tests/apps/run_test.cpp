@@ -54,8 +54,8 @@ TEST(RunCommand, TinySceneProducesEveryFile) {
   write_tiny_scene(dir);
   const std::string out = dir.file("results");  // does not exist yet: created by run
   ::testing::internal::CaptureStdout();
-  const int code = run({"run", dir.file("tiny.obj"), "-o", out, "--patches", "80", "--samples",
-                        "4", "--size", "40x30", "-q", "-j", "2"});
+  const int code = run({"run", dir.file("tiny.obj"), "-o", out, "--patches", "80", "--samples", "4",
+                        "--size", "40x30", "-q", "-j", "2"});
   const std::string stdout_text = ::testing::internal::GetCapturedStdout();
   ASSERT_EQ(code, kExitOk) << stdout_text;
   for (const char* f : {"tiny.exr", "tiny.png", "tiny_vertices.exr", "tiny.ply", "report.json"}) {
@@ -87,8 +87,8 @@ TEST(RunCommand, TinySceneProducesEveryFile) {
 TEST(RunCommand, NamePrefixAndBuiltInCornellBox) {
   lambert::testing::TempDir dir;
   ::testing::internal::CaptureStdout();
-  const int code = run({"run", "-o", dir.file("o"), "--patches", "150", "--samples", "2",
-                        "--size", "32x32", "--antialias", "1", "-q"});
+  const int code = run({"run", "-o", dir.file("o"), "--patches", "150", "--samples", "2", "--size",
+                        "32x32", "--antialias", "1", "-q"});
   ::testing::internal::GetCapturedStdout();
   ASSERT_EQ(code, kExitOk);
   for (const char* f : {"cornell.exr", "cornell.png", "cornell_vertices.exr", "cornell.ply"})
@@ -106,8 +106,9 @@ TEST(RenderCommand, RendersASolvedCsvAndRefusesOneForAnotherMesh) {
   write_tiny_scene(dir);
   const std::string scene = dir.file("tiny.obj");
   ::testing::internal::CaptureStdout();
-  ASSERT_EQ(run({"solve", scene, "--patches", "60", "--samples", "4", "-o", dir.file("B.csv"), "-q"}),
-            kExitOk);
+  ASSERT_EQ(
+      run({"solve", scene, "--patches", "60", "--samples", "4", "-o", dir.file("B.csv"), "-q"}),
+      kExitOk);
   EXPECT_EQ(run({"render", scene, "--patches", "60", "--radiosity", dir.file("B.csv"), "-o",
                  dir.file("img.exr"), "--size", "24x24", "--vertex-exr", dir.file("v.exr"), "--ply",
                  dir.file("m.ply"), "-q"}),

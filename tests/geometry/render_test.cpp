@@ -18,9 +18,9 @@ Scene open_box() {
                                 {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
   add_polygon(s, "back", kWhite, {p[4], p[7], p[6], p[5]});   // z = 1, normal -z
   add_polygon(s, "floor", kWhite, {p[0], p[4], p[5], p[1]});  // y = 0, normal +y
-  add_polygon(s, "left", kWhite, {p[0], p[3], p[7]});           // x = 0, normal +x
+  add_polygon(s, "left", kWhite, {p[0], p[3], p[7]});         // x = 0, normal +x
   add_polygon(s, "left", kWhite, {p[0], p[7], p[4]});
-  add_polygon(s, "right", kWhite, {p[1], p[5], p[6]});          // x = 1, normal -x
+  add_polygon(s, "right", kWhite, {p[1], p[5], p[6]});  // x = 1, normal -x
   add_polygon(s, "right", kWhite, {p[1], p[6], p[2]});
   add_polygon(s, "ceiling", kWhite, {p[3], p[2], p[6], p[7]});  // y = 1, normal -y
   return s;
@@ -89,7 +89,8 @@ TEST(Render, GouraudReproducesALinearFieldAtTheHitPoint) {
   const Bvh bvh(mesh);
   auto f = [](const Eigen::Vector3d& x) { return 1.0 + 0.5 * x.x() + 0.25 * x.y() + x.z(); };
   VertexField field = build_shading_vertices(mesh);
-  for (std::int32_t k = 0; k < field.size(); ++k) field.values.row(k).setConstant(f(field.positions[k]));
+  for (std::int32_t k = 0; k < field.size(); ++k)
+    field.values.row(k).setConstant(f(field.positions[k]));
   const Eigen::MatrixX3d B = Eigen::MatrixX3d::Ones(mesh.size(), 3);  // unused (Gouraud)
   RenderSettings o;
   o.antialias = 1;

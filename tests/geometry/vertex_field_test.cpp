@@ -16,7 +16,7 @@ const Material kWhite{"white", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::
 // and triangle subdivision.
 Scene test_scene() {
   Scene s;
-  const Eigen::Vector3d p[8] = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0},
+  const Eigen::Vector3d p[8] = {{0, 0, 0},   {2, 0, 0},   {2, 1, 0},   {0, 1, 0},
                                 {0, 0, 1.5}, {2, 0, 1.5}, {2, 1, 1.5}, {0, 1, 1.5}};
   add_polygon(s, "box", kWhite, {p[0], p[3], p[2], p[1]});  // z = 0
   add_polygon(s, "box", kWhite, {p[0], p[1], p[5], p[4]});  // y = 0
@@ -54,8 +54,8 @@ TEST(VertexField, SplitsAtSurfacesAndCreasesOnly) {
     }
     // Grid points are computed as (1-u) a + u b: exact to a few ulps of the coordinates.
     auto on = [](double a, double b) { return std::abs(a - b) < 1e-12; };
-    const int on_planes = (on(x.x(), 0) || on(x.x(), 2)) + (on(x.y(), 0) || on(x.y(), 1)) +
-                          on(x.z(), 0);
+    const int on_planes =
+        (on(x.x(), 0) || on(x.x(), 2)) + (on(x.y(), 0) || on(x.y(), 1)) + on(x.z(), 0);
     const int expected = std::max(1, on_planes);
     EXPECT_EQ(per_mesh_vertex[static_cast<std::int32_t>(v)], expected)
         << "vertex " << x.transpose();
@@ -87,10 +87,12 @@ TEST(VertexField, LinearFieldIsExactAtInteriorVerticesOfUniformGrids) {
   Scene s;
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  add_polygon(s, "rect", kWhite, {R * Eigen::Vector3d(0, 0, 0), R * Eigen::Vector3d(3, 0, 0),
-                                  R * Eigen::Vector3d(3, 2, 0), R * Eigen::Vector3d(0, 2, 0)});
-  add_polygon(s, "tri", kWhite, {R * Eigen::Vector3d(4, 0, 0), R * Eigen::Vector3d(7, 0, 0),
-                                 R * Eigen::Vector3d(5, 2.5, 0)});
+  add_polygon(s, "rect", kWhite,
+              {R * Eigen::Vector3d(0, 0, 0), R * Eigen::Vector3d(3, 0, 0),
+               R * Eigen::Vector3d(3, 2, 0), R * Eigen::Vector3d(0, 2, 0)});
+  add_polygon(
+      s, "tri", kWhite,
+      {R * Eigen::Vector3d(4, 0, 0), R * Eigen::Vector3d(7, 0, 0), R * Eigen::Vector3d(5, 2.5, 0)});
   const PatchMesh mesh = mesh_scene(s, {0.4, 0});
   Eigen::MatrixX3d patch(mesh.size(), 3);
   for (std::int32_t i = 0; i < mesh.size(); ++i)
