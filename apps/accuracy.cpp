@@ -26,7 +26,7 @@
 #include "core/timer.hpp"
 #include "geometry/analytic.hpp"
 #include "geometry/formfactors/analysis.hpp"
-#include "geometry/formfactors/kernels.hpp"
+#include "geometry/formfactors/reference.hpp"
 #include "io/plot.hpp"
 
 namespace lambert {
@@ -130,58 +130,8 @@ Study make_study(const AccuracyOptions& opts) {
   throw UsageError("accuracy: unknown --case '" + opts.analytic_case + "'");
 }
 
-// (1/A_a) ∫_{A_a} F(x -> b) dA_x by composite Gauss-Legendre: s x s cells of order m in
-// patch a's parameter square. The integrand is smooth for distant pairs (order 8 gives
-// ~1e-10 for d > 3 diameters, see hybrid.cpp's (size/2d)^(2m) argument) and has a
-// log-singular derivative along an edge shared with b, which 6 x 6 cells of order 16
-// (9216 nodes) resolve to ~1e-8 (checked against Howell C-14 for the shared-edge case).
-double quadrature_factor(const ff::PatchGeom& a, const ff::PatchGeom& b) {
-  const double q = (a.centroid - b.centroid).norm() / std::max(a.diameter, b.diameter);
-  const int cells = q > 3.0 ? 1 : q > 1.2 ? 2 : 6;
-  const int order = q > 3.0 ? 8 : 16;
-  const ff::GaussRule rule = ff::gauss_legendre(order);
-  double sum = 0.0;
-  for (int cu = 0; cu < cells; ++cu)
-    for (int cv = 0; cv < cells; ++cv)
-      for (int u = 0; u < order; ++u)
-        for (int v = 0; v < order; ++v) {
-          double jac;
-          const Eigen::Vector3d x = ff::quadrature_point(a, (cu + rule.x[u]) / cells,
-                                                         (cv + rule.x[v]) / cells, jac);
-          sum += rule.w[u] * rule.w[v] * jac * ff::point_to_patch(x, a.normal, b);
-        }
-  return sum / (cells * cells * a.area);
-}
-
-// The per-patch quadrature reference for unoccluded (analytic) cases, rows in parallel.
-FormFactors quadrature_reference(const PatchMesh& mesh, int threads) {
-  Timer timer;
-  const std::vector<ff::PatchGeom> geom = ff::patch_geometry(mesh);
-  const std::int32_t n = mesh.size();
-  const double eps = 1e-12 * mesh.scale;  // as kPlaneEps in formfactors.cpp
-  std::vector<std::vector<std::pair<std::int32_t, double>>> rows(n);
-  parallel_for(n, 1, threads, [&](std::int64_t b, std::int64_t e) {
-    for (std::int64_t i = b; i < e; ++i)
-      for (std::int32_t j = 0; j < n; ++j) {
-        if (j == i || !ff::can_exchange(geom[i], geom[j], eps)) continue;
-        const double f = quadrature_factor(geom[i], geom[j]);
-        if (f > 0.0) rows[i].emplace_back(j, f);
-      }
-  });
-  std::vector<Eigen::Triplet<double, std::int32_t>> t;
-  for (std::int32_t i = 0; i < n; ++i)
-    for (const auto& [j, f] : rows[i]) t.emplace_back(i, j, f);
-  FormFactors out;
-  out.F.resize(n, n);
-  out.F.setFromTriplets(t.begin(), t.end());
-  out.options.estimator = "quadrature";
-  out.stats.seconds = timer.seconds();
-  return out;
-}
-
 // Per-patch comparison of F with the reference (union of both sparsity patterns).
 void compare_factors(const PatchMesh& mesh, const SparseF& F, const SparseF& ref, AccuracyRow& row) {
-  const std::vector<ff::PatchGeom> geom = ff::patch_geometry(mesh);
   const SparseF diff = F - ref;
   const Eigen::VectorXd ones = Eigen::VectorXd::Ones(mesh.size());
   row.max_row_err = (diff * ones).cwiseAbs().maxCoeff();
@@ -189,13 +139,10 @@ void compare_factors(const PatchMesh& mesh, const SparseF& F, const SparseF& ref
   std::int64_t count = 0;
   for (std::int32_t i = 0; i < diff.outerSize(); ++i) {
     for (SparseF::InnerIterator it(diff, i); it; ++it) {
-      const ff::PatchGeom& gi = geom[i];
-      const ff::PatchGeom& gj = geom[it.col()];
       const double e = std::abs(it.value());
       sum2 += e * e;
       ++count;
-      const double ratio =
-          (gi.centroid - gj.centroid).norm() / std::max(gi.diameter, gj.diameter);
+      const double ratio = proximity(mesh, i, static_cast<std::int32_t>(it.col()));
       double& bucket = ratio < kNearDiameters ? row.max_err_near : row.max_err_far;
       bucket = std::max(bucket, e);
       if (e > row.max_err) {
@@ -447,7 +394,7 @@ int run_accuracy(const AccuracyOptions& opts) {
   FormFactors ref;
   if (analytic) {
     log_info("accuracy: reference by quadrature of the exact point-to-patch factor");
-    ref = quadrature_reference(mesh, opts.run.threads);
+    ref = unoccluded_quadrature(mesh, opts.run.threads);
   } else {
     FormFactorOptions o = base;
     o.estimator = "hybrid";
