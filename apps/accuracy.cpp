@@ -231,17 +231,6 @@ std::string spec_setting(const RunSpec& s) {
   return (s.estimator == "hemicube" ? "N=" : "k=") + std::to_string(s.value);
 }
 
-std::string output_base(const std::string& out) {
-  namespace fs = std::filesystem;
-  if (!out.empty() && (out.back() == '/' || fs::is_directory(out))) {
-    std::error_code ec;
-    fs::create_directories(out, ec);
-    if (ec) throw IoError(out + ": cannot create directory: " + ec.message());
-    return (fs::path(out) / "accuracy").string();
-  }
-  return out;
-}
-
 void write_table_csv(const std::string& path, const Study& study, const std::vector<AccuracyRow>& rows) {
   write_stream_atomically(path, [&](std::ostream& out) {
     out << "scene,estimator,setting,seconds,nnz,F_ab,F_exact_abs_err,max_abs_err,rms_abs_err,"
@@ -450,7 +439,7 @@ int run_accuracy(const AccuracyOptions& opts) {
 
   print_table(study, rows);
   print_failure_modes(rows);
-  const std::string base_path = output_base(opts.output);
+  const std::string base_path = output_prefix(opts.output, "accuracy");
   const std::string csv = base_path + "_table.csv", surf = base_path + "_surfaces.csv";
   const std::string svg = base_path + "_error_vs_time.svg", png = base_path + "_error_vs_time.png";
   write_table_csv(csv, study, rows);

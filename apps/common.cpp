@@ -1,5 +1,8 @@
 #include "apps/common.hpp"
 
+#include <filesystem>
+
+#include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/obj_loader.hpp"
 
@@ -26,6 +29,17 @@ void apply_run_options(const RunArgs& args) {
   set_log_level(args.quiet     ? LogLevel::Quiet
                 : args.verbose ? LogLevel::Verbose
                                : LogLevel::Normal);
+}
+
+std::string output_prefix(const std::string& output, const std::string& name) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!output.empty() && (output.back() == '/' || fs::is_directory(output, ec))) {
+    fs::create_directories(output, ec);
+    if (ec) throw IoError(output + ": cannot create directory: " + ec.message());
+    return (fs::path(output) / name).string();
+  }
+  return output;
 }
 
 LoadedScene load_scene(const SceneArgs& args) {

@@ -40,6 +40,10 @@ struct LoadedScene {
   double max_edge = 0.0;  ///< the --max-edge actually used (0 = one element per face)
 };
 
+/// Where a command writing several files puts them: for -o DIR (an existing directory, or
+/// a name ending in '/', created if needed) the prefix DIR/<name>; otherwise -o is the prefix.
+std::string output_prefix(const std::string& output, const std::string& name);
+
 /// Loads the scene (or the built-in Cornell box) and meshes it.
 LoadedScene load_scene(const SceneArgs& args);
 

@@ -25,18 +25,6 @@ struct CompareRow {
   double max_diff = 0.0;     ///< max_i,c |B - B_direct|
 };
 
-// -o DIR (existing directory or ending in '/'): DIR/compare; otherwise a file prefix.
-std::string output_base(const std::string& out) {
-  namespace fs = std::filesystem;
-  if (!out.empty() && (out.back() == '/' || fs::is_directory(out))) {
-    std::error_code ec;
-    fs::create_directories(out, ec);
-    if (ec) throw IoError(out + ": cannot create directory: " + ec.message());
-    return (fs::path(out) / "compare").string();
-  }
-  return out;
-}
-
 // The channel the plot shows: the one with the most emitted power.
 int plot_channel(const RadiosityProblem& p) {
   int best = 0;
@@ -117,7 +105,7 @@ int run_compare(const CompareOptions& opts) {
   const RadiosityProblem problem = make_problem(loaded.mesh, ff.F);
   std::vector<std::string> names = opts.solvers.empty() ? solver_names() : opts.solvers;
   names.erase(std::unique(names.begin(), names.end()), names.end());
-  const std::string base = output_base(opts.output);
+  const std::string base = output_prefix(opts.output, "compare");
 
   std::vector<CompareRow> rows;
   for (const auto& name : names) {

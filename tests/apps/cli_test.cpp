@@ -1,4 +1,5 @@
 #include "apps/cli.hpp"
+#include "common/run_cli.hpp"
 
 #include <gtest/gtest.h>
 
@@ -6,13 +7,10 @@
 #include <vector>
 
 namespace lambert {
+
+using testing::run;
+using testing::slurp;
 namespace {
-int run(std::vector<std::string> args) {
-  args.insert(args.begin(), "lambert");
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  return run_cli(static_cast<int>(argv.size()), argv.data());
-}
 }  // namespace
 
 TEST(Cli, HelpAndVersionSucceed) {

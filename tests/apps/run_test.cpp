@@ -7,18 +7,16 @@
 #include <vector>
 
 #include "apps/cli.hpp"
+#include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
 #include "io/exr.hpp"
 
 namespace lambert {
+
+using testing::run;
+using testing::slurp;
 namespace {
 
-int run(std::vector<std::string> args) {
-  args.insert(args.begin(), "lambert");
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  return run_cli(static_cast<int>(argv.size()), argv.data());
-}
 
 // A tiny open box (unit cube without its z = 0 face, faces pointing inward) lit by an
 // emissive patch on the ceiling; without a .camera sidecar the default camera looks in
@@ -40,12 +38,6 @@ void write_tiny_scene(const lambert::testing::TempDir& dir) {
             "g light\nusemtl light\nf 9 10 11 12\n");
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 }  // namespace
 

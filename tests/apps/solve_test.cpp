@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "apps/cli.hpp"
+#include "common/run_cli.hpp"
 #include "apps/common.hpp"
 #include "apps/problem.hpp"
 #include "common/temp_dir.hpp"
@@ -18,14 +19,11 @@
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
+
+using testing::run;
+using testing::slurp;
 namespace {
 
-int run(std::vector<std::string> args) {
-  args.insert(args.begin(), "lambert");
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  return run_cli(static_cast<int>(argv.size()), argv.data());
-}
 
 std::vector<std::string> read_lines(const std::string& path) {
   std::ifstream in(path);

@@ -1,0 +1,29 @@
+#pragma once
+// Runs the lambert CLI in-process, as the tests' stand-in for the `lambert` binary.
+
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/cli.hpp"
+
+namespace lambert::testing {
+
+/// run_cli with argv = {"lambert", args...}; returns the exit code.
+inline int run(std::vector<std::string> args) {
+  args.insert(args.begin(), "lambert");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  return run_cli(static_cast<int>(argv.size()), argv.data());
+}
+
+/// The whole content of a file ("" if it cannot be read).
+inline std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace lambert::testing
