@@ -1,7 +1,7 @@
 #pragma once
 // Line plots (e.g. solver convergence: residual vs iteration and vs time) written as SVG
-// (axes, ticks, labels, legend) and as PNG (the same curves and legend swatches rasterised
-// without text; the SVG legend names the colours).
+// (axes, ticks, labels, legend) and as PNG (the same plot rasterised, its text drawn in a small
+// built-in bitmap font).
 
 #include <array>
 #include <cstdint>
@@ -35,8 +35,9 @@ std::string plots_svg(const std::vector<Plot>& panels);
 /// Writes plots_svg atomically. Throws IoError.
 void write_plots_svg(const std::string& path, const std::vector<Plot>& panels);
 
-/// Writes the panels side by side as an RGB PNG with the same layout as the SVG (curves,
-/// axes, grid and legend swatches; no text), atomically. Throws IoError.
+/// Writes the panels side by side as an RGB PNG with the same layout and text as the SVG
+/// (curves, axes, grid, tick labels, titles, a legend box naming each colour), atomically.
+/// Throws IoError.
 void write_plots_png(const std::string& path, const std::vector<Plot>& panels);
 
 // Log-log scatter plots (e.g. error vs time of several estimators): both axes base-10
@@ -49,7 +50,8 @@ std::string loglog_svg(const std::vector<Plot>& panels);
 /// Writes loglog_svg atomically. Throws IoError.
 void write_loglog_svg(const std::string& path, const std::vector<Plot>& panels);
 
-/// Writes the log-log panels as an RGB PNG with the SVG's layout (no text), atomically.
+/// Writes the log-log panels as an RGB PNG with the SVG's layout and text, atomically.
+/// Throws IoError.
 void write_loglog_png(const std::string& path, const std::vector<Plot>& panels);
 
 }  // namespace lambert
