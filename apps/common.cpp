@@ -31,6 +31,19 @@ void apply_run_options(const RunArgs& args) {
                                : LogLevel::Normal);
 }
 
+CLI::Validator output_file_check() {
+  return CLI::Validator(
+      [](std::string& path) -> std::string {
+        namespace fs = std::filesystem;
+        const fs::path dir = fs::path(path).parent_path();
+        std::error_code ec;
+        if (!dir.empty() && !fs::is_directory(dir, ec))
+          return "cannot write '" + path + "': directory '" + dir.string() + "' does not exist";
+        return "";
+      },
+      "FILE");
+}
+
 std::string output_prefix(const std::string& output, const std::string& name) {
   namespace fs = std::filesystem;
   std::error_code ec;

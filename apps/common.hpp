@@ -40,6 +40,10 @@ struct LoadedScene {
   double max_edge = 0.0;  ///< the --max-edge actually used (0 = one element per face)
 };
 
+/// CLI11 check for an output file option: its directory must exist (checked before any
+/// work, so a long computation never ends in a failed write).
+CLI::Validator output_file_check();
+
 /// Where a command writing several files puts them: for -o DIR (an existing directory, or
 /// a name ending in '/', created if needed) the prefix DIR/<name>; otherwise -o is the prefix.
 std::string output_prefix(const std::string& output, const std::string& name);

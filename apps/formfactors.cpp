@@ -137,8 +137,10 @@ CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts) {
   add_run_options(cmd, opts.run);
   add_ff_options(cmd, opts.ff, false);
   cmd->add_option("-o,--output", opts.output,
-                  "Output: F.mtx (Matrix Market), F.bin (binary), or JSON with --by-surface/--point");
-  cmd->add_option("--report", opts.report, "Diagnostics JSON (default: OUTPUT with .report.json)");
+                  "Output: F.mtx (Matrix Market), F.bin (binary), or JSON with --by-surface/--point")
+      ->check(output_file_check());
+  cmd->add_option("--report", opts.report, "Diagnostics JSON (default: OUTPUT with .report.json)")
+      ->check(output_file_check());
   cmd->add_flag("--stderr", opts.with_stderr, "Also estimate and save per-entry standard errors (binary format)");
   auto* by = cmd->add_flag("--by-surface", opts.by_surface, "Write the surface-to-surface view-factor table as JSON");
   auto* pt = cmd->add_option("--point", opts.point, "Sensor point X,Y,Z (differential area)")

@@ -45,10 +45,14 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opts) {
       "--radiosity", opts.radiosity,
       "Per-patch radiosity CSV from `lambert solve` (instead of computing F and solving)");
   cmd->add_option("-o,--output", opts.output, "Rendered linear HDR image (OpenEXR)")
+      ->check(output_file_check())
       ->capture_default_str();
-  cmd->add_option("--png", opts.png, "Tone-mapped sRGB preview (default: --output with .png)");
-  cmd->add_option("--vertex-exr", opts.vertex_exr, "Also write the per-vertex radiosity EXR");
-  cmd->add_option("--ply", opts.ply, "Also write the coloured patch mesh as PLY");
+  cmd->add_option("--png", opts.png, "Tone-mapped sRGB preview (default: --output with .png)")
+      ->check(output_file_check());
+  cmd->add_option("--vertex-exr", opts.vertex_exr, "Also write the per-vertex radiosity EXR")
+      ->check(output_file_check());
+  cmd->add_option("--ply", opts.ply, "Also write the coloured patch mesh as PLY")
+      ->check(output_file_check());
   return cmd;
 }
 

@@ -71,6 +71,7 @@ CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts) {
   cmd->add_option("-o,--output", opts.output,
                   "Per-patch radiosity CSV (patch,surface,area,R,G,B); the summary goes to the "
                   "same name with .json")
+      ->check(output_file_check())
       ->capture_default_str();
   add_run_options(cmd, opts.run);
   return cmd;

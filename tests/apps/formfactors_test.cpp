@@ -108,3 +108,15 @@ TEST(FormFactorsCommand, SavedMatrixIsRefusedForAnotherMeshing) {
 }
 
 }  // namespace lambert
+
+namespace lambert {
+
+TEST(FormFactorsCommand, OutputIntoAMissingDirectoryIsRefusedBeforeAnyWork) {
+  testing::TempDir dir;
+  // A usage error (exit 2) from the option check, before the scene is even loaded.
+  EXPECT_EQ(testing::run({"formfactors", "-q", "-o", dir.file("missing/F.bin")}), kExitUsage);
+  EXPECT_EQ(testing::run({"solve", "-q", "-o", dir.file("missing/B.csv")}), kExitUsage);
+  EXPECT_EQ(testing::run({"render", "-q", "--png", dir.file("missing/x.png")}), kExitUsage);
+}
+
+}  // namespace lambert
