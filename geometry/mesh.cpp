@@ -51,7 +51,12 @@ SurfaceElements collect(const Scene& scene, std::int32_t surface) {
       out.elements.push_back(e);
       continue;
     }
+    const double diam = polygon_diameter(poly);
     for (const auto& t : triangulate(poly)) {
+      // Skip slivers of a degenerate triangulation (collinear corners): zero area, no normal.
+      // Same relative threshold as the loader's zero-area test.
+      const double area = 0.5 * (poly[t[1]] - poly[t[0]]).cross(poly[t[2]] - poly[t[0]]).norm();
+      if (area <= 1e-10 * diam * diam) continue;
       Element e;
       for (int k = 0; k < 3; ++k) e.v[k] = local(poly[t[k]]);
       out.elements.push_back(e);

@@ -112,7 +112,9 @@ FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t
   const auto nnz = r.get<std::int64_t>();
   const auto hash = r.get<std::uint64_t>();
   const auto len = r.get<std::uint32_t>();
-  if (n < 0 || nnz < 0 || nnz > n * n || n > INT32_MAX || len > (1u << 20))
+  // Bounds before any allocation: a corrupt header must not trigger a huge allocation or
+  // signed overflow (n <= INT32_MAX makes n * n fit in 64 bits).
+  if (n < 0 || n > INT32_MAX || nnz < 0 || nnz > n * n || nnz > INT32_MAX || len > (1u << 20))
     throw IoError(path + ": corrupt form-factor file header");
   std::string settings(len, '\0');
   r.get(settings.data(), len);
@@ -169,7 +171,8 @@ FormFactors read_matrix_market(std::istream& in, const std::string& path,
                             "this scene");
   std::int64_t rows = 0, cols = 0, nnz = 0;
   std::istringstream size_line(line);
-  if (!(size_line >> rows >> cols >> nnz) || rows != cols || nnz < 0)
+  if (!(size_line >> rows >> cols >> nnz) || rows != cols || rows < 0 || rows > INT32_MAX ||
+      nnz < 0 || nnz > rows * rows || nnz > INT32_MAX)
     throw IoError(path + ":" + std::to_string(lineno) + ": malformed size line");
   check_identity(path, meta.mesh_hash, rows, expected_hash, expected_n);
   std::vector<Eigen::Triplet<double, std::int32_t>> t;

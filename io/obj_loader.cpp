@@ -307,9 +307,18 @@ Scene load_obj(const std::string& path, LoadReport* report) {
       std::set<int> distinct;
       for (int k = 0; k < nv; ++k) {
         const int vi = mesh.indices[offset + k].vertex_index;
+        // A corner repeating the previous one (same index or position) adds nothing to
+        // the polygon but would leave a zero-length edge: collapse it.
+        if (!poly.empty() && (vi == face.vertices.back() || scene.vertices[vi] == poly.back()))
+          continue;
         face.vertices.push_back(vi);
         distinct.insert(vi);
         poly.push_back(scene.vertices[vi]);
+      }
+      while (poly.size() > 1 && poly.back() == poly.front()) {
+        poly.pop_back();
+        distinct.erase(face.vertices.back());
+        face.vertices.pop_back();
       }
       offset += nv;
       const double diam = polygon_diameter(poly);

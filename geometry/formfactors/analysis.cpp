@@ -92,19 +92,30 @@ PointFactors point_form_factors(const PatchMesh& mesh, const Eigen::Vector3d& po
       const double unocc = ff::point_to_patch(point, n, geom[j]);
       if (unocc <= 0.0) continue;
       const Kronecker4 seq(hash_keys(options.seed, 0xFFFFFFFFull, static_cast<std::uint64_t>(j)));
-      int seen = 0, used = 0;
+      // Kernel-weighted visible fraction (see hybrid.cpp): Σ K V / Σ K with y uniform on j.
+      double num = 0.0, den = 0.0, num2 = 0.0, den2 = 0.0;
+      int used = 0;
       for (int s = 0; s < options.samples; ++s) {
         double jac;
         const Eigen::Vector3d y = ff::sample_patch(geom[j], seq.get(s, 0), seq.get(s, 1), jac);
-        if ((y - point).dot(n) <= 0.0) continue;  // behind the sensor's horizon
+        const Eigen::Vector3d d = y - point;
+        const double r2 = d.squaredNorm();
+        const double k = r2 > 0.0 ? n.dot(d) * -geom[j].normal.dot(d) / (r2 * r2) : 0.0;
+        if (!(k > 0.0)) continue;  // behind the sensor's horizon
         ++used;
-        seen += ff::visible(bvh, point, n, y, geom[j].normal, offset);
+        const double v = ff::visible(bvh, point, n, y, geom[j].normal, offset) ? 1.0 : 0.0;
+        num += k * v;
+        den += k;
+        num2 += k * k * v;
+        den2 += k * k;
       }
       rays[j] = used;
-      if (used == 0) continue;
-      const double frac = static_cast<double>(seen) / used;
+      if (den <= 0.0) continue;
+      const double frac = num / den;
       f[j] = unocc * frac;
-      var[j] = used > 1 ? unocc * unocc * frac * (1 - frac) / (used - 1) : 0.0;
+      // Delta-method variance of the ratio: Σ k² (v - frac)² / (Σ k)², with v² = v.
+      const double s2 = num2 * (1 - 2 * frac) + frac * frac * den2;
+      var[j] = used > 1 ? unocc * unocc * std::max(0.0, s2) / (den * den) : 0.0;
     }
   });
   PointFactors out;

@@ -148,15 +148,28 @@ const std::vector<EstimatorEntry>& registry() {
   return table;
 }
 
-// Drops entries below the threshold, and their standard errors (same sparsity pattern).
+// Drops the pairs whose factors are both below the threshold: F_ij and F_ji go together,
+// so a reciprocal F stays reciprocal (cg, southwell and the energy balance rely on it).
+// Standard errors (same sparsity pattern) follow their entries.
 void apply_threshold(FormFactors& ff, double threshold) {
   if (threshold <= 0.0) return;
-  if (ff.stderr_F.nonZeros() > 0) {
-    for (std::int32_t k = 0; k < ff.F.nonZeros(); ++k)
-      if (ff.F.valuePtr()[k] < threshold) ff.stderr_F.valuePtr()[k] = std::nan("");
-    ff.stderr_F.prune([](std::int32_t, std::int32_t, double v) { return !std::isnan(v); });
+  const bool with_err = ff.stderr_F.nonZeros() > 0;
+  std::vector<char> keep(ff.F.nonZeros());
+  for (std::int32_t i = 0; i < ff.F.rows(); ++i) {
+    for (auto k = ff.F.outerIndexPtr()[i]; k < ff.F.outerIndexPtr()[i + 1]; ++k) {
+      const std::int32_t j = ff.F.innerIndexPtr()[k];
+      keep[k] = ff.F.valuePtr()[k] >= threshold || ff.F.coeff(j, i) >= threshold;
+    }
   }
-  ff.F.prune([threshold](std::int32_t, std::int32_t, double v) { return v >= threshold; });
+  // Mark dropped entries with NaN (never a form factor), then prune them.
+  for (std::int32_t k = 0; k < ff.F.nonZeros(); ++k) {
+    if (keep[k]) continue;
+    ff.F.valuePtr()[k] = std::nan("");
+    if (with_err) ff.stderr_F.valuePtr()[k] = std::nan("");
+  }
+  auto not_nan = [](std::int32_t, std::int32_t, double v) { return !std::isnan(v); };
+  ff.F.prune(not_nan);
+  if (with_err) ff.stderr_F.prune(not_nan);
 }
 
 }  // namespace

@@ -3,10 +3,12 @@
 // From the side of patch a towards patch b:
 //   G_a = Σ_n w_n F(x_n -> b) · vis,   w_n = Gauss-Legendre weight x Jacobian at node x_n,
 // where F(x -> b) is the exact point-to-patch factor (Lambert's contour formula, horizon
-// clipped) and vis = Σ_r w_{n_r} F(x_{n_r} -> b) V_r / Σ_r w_{n_r} F(x_{n_r} -> b) the
-// visible fraction from rays r, each from a node n_r to a sample point on b (Kronecker
-// lattice). With no blocker vis = 1 and G_a is the unoccluded G to quadrature accuracy:
-// no 1/r² singularity, so patches sharing an edge are as cheap as distant ones.
+// clipped) and vis = Σ_r w_{n_r} K(x_{n_r}, y_r) V_r / Σ_r w_{n_r} K(x_{n_r}, y_r) the
+// kernel-weighted visible fraction from rays r, each from a node n_r to a point y_r
+// uniform on the part of b in front of a (Kronecker lattice), K = cosθ_x cosθ_y / r².
+// With no blocker vis = 1 exactly and G_a is the unoccluded G to quadrature accuracy: the
+// 1/r² singularity only enters the ratio vis, where it cancels unless rays are blocked, so
+// patches sharing an edge are as cheap as distant ones.
 // The node count grows as the patches get closer (order 2 far away .. 12 for neighbours).
 // Both sides are estimated with half the rays each and averaged. The variance combines the
 // ratio estimator's delta-method variance of each side and the quadrature disagreement
@@ -79,7 +81,7 @@ SideEstimate one_side(const PairContext& ctx, const PatchGeom& a, const PatchGeo
   const GaussRule rule = gauss_legendre(m);
   thread_local std::vector<PatchGeom> pieces, targets;
   thread_local std::vector<Eigen::Vector3d> xs;
-  thread_local std::vector<double> wf, target_cdf;
+  thread_local std::vector<double> nw, wf, target_cdf;
   integration_domain(a, b, pieces);
   // Visibility rays go to points of b in front of a's plane only (every node x lies in that
   // plane, so the horizon is the same for all): points beyond it are not "blocked", they
@@ -88,6 +90,7 @@ SideEstimate one_side(const PairContext& ctx, const PatchGeom& a, const PatchGeo
   target_cdf.clear();
   for (const PatchGeom& t : targets) target_cdf.push_back((target_cdf.empty() ? 0.0 : target_cdf.back()) + t.area);
   xs.clear();
+  nw.clear();
   wf.clear();
   // Node points and their unoccluded contributions w_n F(x_n -> b).
   for (const PatchGeom& piece : pieces) {
@@ -95,7 +98,8 @@ SideEstimate one_side(const PairContext& ctx, const PatchGeom& a, const PatchGeo
       for (int v = 0; v < m; ++v) {
         double jac;
         xs.push_back(quadrature_point(piece, rule.x[u], rule.x[v], jac));
-        wf.push_back(rule.w[u] * rule.w[v] * jac * point_to_patch(xs.back(), a.normal, b));
+        nw.push_back(rule.w[u] * rule.w[v] * jac);
+        wf.push_back(nw.back() * point_to_patch(xs.back(), a.normal, b));
         out.unoccluded += wf.back();
       }
     }
@@ -120,11 +124,20 @@ SideEstimate one_side(const PairContext& ctx, const PatchGeom& a, const PatchGeo
         std::lower_bound(target_cdf.begin(), target_cdf.end(), pick) - target_cdf.begin(),
         targets.size() - 1);
     const Eigen::Vector3d y = sample_patch(targets[t], seq.get(r, 2), seq.get(r, 3), jb);
+    // Weight of the ray: node weight x kernel K(x_n, y). The visible fraction must be
+    // kernel-weighted: with y uniform on b, Σ_r K V / Σ_r K -> ∫ K V dA / ∫ K dA per node,
+    // whereas an unweighted fraction of b's area would be biased wherever a blocker shades
+    // the near (high-K) part of b differently from the far part.
+    const Eigen::Vector3d d = y - xs[n];
+    const double r2 = d.squaredNorm();
+    const double kernel = r2 > 0.0 ? a.normal.dot(d) * -b.normal.dot(d) / (r2 * r2) : 0.0;
+    if (!(kernel > 0.0)) continue;
+    const double w = nw[n] * kernel;
     const bool vis = visible(ctx.bvh, xs[n], a.normal, y, b.normal, ctx.offset);
     ++out.rays;
-    num += vis ? wf[n] : 0.0;
-    den += wf[n];
-    samples.emplace_back(wf[n], vis);
+    num += vis ? w : 0.0;
+    den += w;
+    samples.emplace_back(w, vis);
   }
   if (den <= 0.0) {
     // No usable ray (every node saw b only beyond the horizon of its sample): keep the

@@ -202,3 +202,63 @@ TEST(FormFactors, FloorRunningUnderAWallMatchesTheClosedForm) {
 }
 
 }  // namespace lambert
+
+namespace lambert {
+
+// Half of the receiver is shaded by a plate just in front of it, right above the emitter,
+// which is the left half of the opposite square: the near (high-kernel) half of b is
+// hidden. The exact G is that of the unshaded configuration a -> (right half of b), which
+// hybrid computes exactly (no blocker); an area-weighted visible fraction would give 1/2 of
+// G(a -> b) instead, ~25 % too high here. The plate sits 1e-3 in front of b, so its
+// penumbra on b is a band < 1e-3 wide: G changes by < 1e-3 relative (the bound used).
+TEST(FormFactors, PartlyShadedReceiverUsesTheKernelWeightedVisibleFraction) {
+  Material m{"m", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
+  Scene open;
+  add_polygon(open, "a", m, {{0, 0, 0}, {0.5, 0, 0}, {0.5, 1, 0}, {0, 1, 0}});        // +z
+  add_polygon(open, "c", m, {{0.5, 0, 1}, {0.5, 1, 1}, {1, 1, 1}, {1, 0, 1}});        // -z
+  Scene shaded;
+  add_polygon(shaded, "a", m, {{0, 0, 0}, {0.5, 0, 0}, {0.5, 1, 0}, {0, 1, 0}});
+  add_polygon(shaded, "b", m, {{0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1}});
+  add_polygon(shaded, "plate", m, {{-2, -2, 0.999}, {0.5, -2, 0.999}, {0.5, 3, 0.999}, {-2, 3, 0.999}});
+  FormFactorOptions o;
+  o.samples = 4;
+  o.progress = false;
+  const FormFactors ref = compute_form_factors(mesh_scene(open, {}), o);
+  const double exact = ref.F.coeff(0, 1) * 0.5;  // G = A_a F_ac, A_a = 0.5
+  for (const std::string est : {"hybrid", "mc"}) {
+    o.estimator = est;
+    o.samples = est == "mc" ? 1 << 16 : 256;
+    o.with_stderr = true;
+    const PatchMesh mesh = mesh_scene(shaded, {est == "mc" ? 0.0 : 0.25, 0});
+    const auto [f, se] = surface_factor(mesh, compute_form_factors(mesh, o));
+    EXPECT_NEAR(f * 0.5, exact, 1e-3 * exact + 4 * se * 0.5) << est << " se " << se;
+  }
+}
+
+}  // namespace lambert
+
+namespace lambert {
+
+TEST(FormFactors, ThresholdDropsPairsTogetherAndKeepsReciprocity) {
+  // Patches of very different sizes: F_ij and F_ji differ by the area ratio, so a per-entry
+  // threshold would keep one and drop the other.
+  Scene s;
+  Material m{"m", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
+  add_polygon(s, "big", m, {{0, 0, 0}, {4, 0, 0}, {4, 4, 0}, {0, 4, 0}});
+  add_polygon(s, "small", m, {{1, 1, 1}, {1, 1.1, 1}, {1.1, 1.1, 1}, {1.1, 1, 1}});
+  FormFactorOptions o;
+  o.samples = 4;
+  o.progress = false;
+  const PatchMesh mesh = mesh_scene(s, {});
+  const FormFactors all = compute_form_factors(mesh, o);
+  const double f_small = all.F.coeff(1, 0), f_big = all.F.coeff(0, 1);
+  ASSERT_GT(f_small, 10 * f_big);
+  o.threshold = std::sqrt(f_small * f_big);  // between the two
+  const FormFactors kept = compute_form_factors(mesh, o);
+  EXPECT_EQ(kept.F.coeff(0, 1), f_big);
+  EXPECT_EQ(kept.F.coeff(1, 0), f_small);
+  o.threshold = 2 * f_small;  // above both
+  EXPECT_EQ(compute_form_factors(mesh, o).F.nonZeros(), 0);
+}
+
+}  // namespace lambert

@@ -179,3 +179,21 @@ TEST(ObjLoader, EmptySceneIsAnErrorAndNoEmitterOnlyAWarning) {
 }
 
 }  // namespace lambert
+
+namespace lambert {
+
+TEST(ObjLoader, RepeatedCornersAreCollapsedAndNeverMakeZeroAreaPatches) {
+  testing::TempDir dir;
+  dir.write("s.mtl", kMtl);
+  // f 1 2 3 3 and a fourth vertex at the third one's position: both are the unit triangle.
+  const std::string obj =
+      "mtllib s.mtl\ng t\nusemtl white\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 1 1 0\n"
+      "f 1 2 3 3\nf 1 2 3 4\nf 1 1 2 3\n";
+  const Scene s = load_obj(dir.write("s.obj", obj));
+  ASSERT_EQ(s.faces.size(), 3u);
+  for (const auto& f : s.faces) EXPECT_EQ(f.vertices.size(), 3u);
+  const PatchMesh m = mesh_scene(s, {0.3, 0});
+  for (const auto& p : m.patches) EXPECT_GT(p.area, 0.0);
+}
+
+}  // namespace lambert
