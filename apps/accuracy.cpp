@@ -23,6 +23,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/parallel.hpp"
+#include "core/sampling.hpp"
 #include "core/timer.hpp"
 #include "geometry/analytic.hpp"
 #include "geometry/formfactors/analysis.hpp"
@@ -362,6 +363,7 @@ CLI::App* add_accuracy_command(CLI::App& app, AccuracyOptions& opts) {
       ->capture_default_str();
   cmd->add_option("-o,--output", opts.output,
                   "Output directory (existing or ending in /) or file prefix")
+      ->check(output_prefix_check())
       ->capture_default_str();
   add_run_options(cmd, opts.run);
   return cmd;
@@ -388,6 +390,9 @@ int run_accuracy(const AccuracyOptions& opts) {
     FormFactorOptions o = base;
     o.estimator = "hybrid";
     o.samples = opts.reference_samples;
+    // Its own random streams: sharing the runs' lattice shifts would correlate their errors
+    // with the reference's and make them look smaller than they are.
+    o.seed = hash_keys(opts.run.seed, 0x7265666572656E63ull);
     o.with_stderr = true;
     log_info("accuracy: reference hybrid k=" + std::to_string(o.samples));
     ref = compute_form_factors(mesh, o);

@@ -44,6 +44,15 @@ CLI::Validator output_file_check() {
       "FILE");
 }
 
+CLI::Validator output_prefix_check() {
+  return CLI::Validator(
+      [](std::string& out) -> std::string {
+        if (!out.empty() && out.back() == '/') return "";  // created when writing
+        return output_file_check()(out);
+      },
+      "DIR/|PREFIX");
+}
+
 std::string output_prefix(const std::string& output, const std::string& name) {
   namespace fs = std::filesystem;
   std::error_code ec;

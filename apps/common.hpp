@@ -44,6 +44,10 @@ struct LoadedScene {
 /// work, so a long computation never ends in a failed write).
 CLI::Validator output_file_check();
 
+/// CLI11 check for an output prefix option (see output_prefix): a name ending in '/' is a
+/// directory to create; otherwise the prefix's directory must exist.
+CLI::Validator output_prefix_check();
+
 /// Where a command writing several files puts them: for -o DIR (an existing directory, or
 /// a name ending in '/', created if needed) the prefix DIR/<name>; otherwise -o is the prefix.
 std::string output_prefix(const std::string& output, const std::string& name);

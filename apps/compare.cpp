@@ -93,6 +93,7 @@ CLI::App* add_compare_command(CLI::App& app, CompareOptions& opts) {
       ->check(CLI::IsMember(solver_names()));
   cmd->add_option("-o,--output", opts.output,
                   "Output directory (existing or ending in /) or file prefix")
+      ->check(output_prefix_check())
       ->capture_default_str();
   add_run_options(cmd, opts.run);
   return cmd;
@@ -104,7 +105,12 @@ int run_compare(const CompareOptions& opts) {
   const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);
   const RadiosityProblem problem = make_problem(loaded.mesh, ff.F);
   std::vector<std::string> names = opts.solvers.empty() ? solver_names() : opts.solvers;
-  names.erase(std::unique(names.begin(), names.end()), names.end());
+  // Drop repeated names, keeping the first occurrence's order.
+  std::vector<std::string> unique_names;
+  for (const auto& n : names)
+    if (std::find(unique_names.begin(), unique_names.end(), n) == unique_names.end())
+      unique_names.push_back(n);
+  names = unique_names;
   const std::string base = output_prefix(opts.output, "compare");
 
   std::vector<CompareRow> rows;

@@ -184,6 +184,8 @@ int run_formfactors(const FormFactorsOptions& opts) {
   log_info("wrote " + opts.output);
   const std::string report =
       !opts.report.empty() ? opts.report : fs::path(opts.output).replace_extension(".report.json").string();
+  if (report == opts.output)
+    throw UsageError("formfactors: --report and -o name the same file '" + report + "'");
   write_stream_atomically(report, [&](std::ostream& out) { write_diagnostics_json(out, scene, ff, d, settings); });
   log_info("wrote " + report);
   return 0;

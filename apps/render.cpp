@@ -4,6 +4,7 @@
 
 #include "apps/cli.hpp"
 #include "apps/commands.hpp"
+#include "core/error.hpp"
 #include "apps/solve_args.hpp"
 #include "core/log.hpp"
 #include "io/radiosity_csv.hpp"
@@ -78,6 +79,9 @@ int run_render(const RenderOptions& opts) {
   paths.png = opts.png.empty()
                   ? std::filesystem::path(opts.output).replace_extension(".png").string()
                   : opts.png;
+  if (paths.png == opts.output)
+    throw UsageError("render: the EXR (-o) and the PNG (--png) would both be written to '" +
+                     opts.output + "'");
   paths.vertex_exr = opts.vertex_exr;
   paths.ply = opts.ply;
   const auto written =

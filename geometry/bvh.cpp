@@ -11,9 +11,14 @@ namespace lambert {
 namespace {
 
 // Embree's error callback runs inside Embree's C frames: it must log, never throw.
-void embree_error(void*, RTCError code, const char* str) {
-  log_warn(std::string("embree error ") + std::to_string(static_cast<int>(code)) + ": " +
-           (str ? str : ""));
+void embree_error(void*, RTCError code, const char* str) noexcept {
+  try {
+    log_warn(std::string("embree error ") + std::to_string(static_cast<int>(code)) + ": " +
+             (str ? str : ""));
+  } catch (...) {
+    // Logging failed (out of memory): nothing safe is left to do inside Embree's frames;
+    // check_device() still reports the error code after the call returns.
+  }
 }
 
 void check_device(RTCDevice device, const char* what) {

@@ -80,7 +80,9 @@ std::unordered_map<std::uint64_t, std::int64_t> edge_counts(const SurfaceElement
       const auto a = e.v[k], b = e.v[(k + 1) % e.n];
       const double len = (s.points[a] - s.points[b]).norm();
       std::int64_t n = 1;
-      if (max_edge > 0) n = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(len / max_edge)));
+      // Capped at 1e9 segments so that counts and their products stay inside int64; any
+      // such mesh is refused by mesh_scene's patch limit anyway.
+      if (max_edge > 0) n = static_cast<std::int64_t>(std::clamp(std::ceil(len / max_edge), 1.0, 1e9));
       count[edge_key(a, b)] = n;
     }
   }
@@ -268,6 +270,13 @@ PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options) {
       max_edge = dlo < dhi ? lo : hi;
     }
   }
+
+  std::int64_t predicted = 0;
+  for (const auto& s : surfaces) predicted += count_patches(s, max_edge);
+  if (predicted > kMaxPatches)
+    throw UsageError("meshing with max edge " + std::to_string(max_edge) + " would make " +
+                     std::to_string(predicted) + " patches (limit " + std::to_string(kMaxPatches) +
+                     "): choose a larger --max-edge");
 
   PatchMesh mesh;
   for (const auto& s : scene.surfaces) mesh.surface_names.push_back(s.name);

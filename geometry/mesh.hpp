@@ -39,6 +39,9 @@ struct PatchMesh {
   std::vector<Eigen::Vector3d> corners(std::int32_t i) const;
 };
 
+/// Largest mesh lambert builds (F would need ~1e16 entries beyond it anyway).
+constexpr std::int64_t kMaxPatches = 100000000;
+
 /// Meshing target. Exactly one of max_edge > 0 or target_patches > 0 is used
 /// (max_edge wins when both are set); with neither, every face becomes one element.
 struct MeshOptions {
@@ -50,7 +53,7 @@ struct MeshOptions {
 /// are triangulated first. Each element edge of length L shared within a surface gets
 /// n = ceil(L / max_edge) segments, raised until every triangle has equal counts on its
 /// three edges and every quad on opposite edges (a monotone fixpoint), so neighbours agree.
-/// Complexity O(faces + patches).
+/// Throws UsageError if the mesh would exceed kMaxPatches. Complexity O(faces + patches).
 PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options);
 
 /// A stable 64-bit hash of the meshed geometry (vertices, patches, surfaces), which is all

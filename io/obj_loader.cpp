@@ -219,6 +219,8 @@ Camera read_camera(const std::string& path) {
     else throw SceneError(where(path, lineno) + ": unknown camera key '" + key + "'");
   }
   if (!have_eye || !have_at) throw SceneError(path + ": camera needs 'eye' and 'look_at'");
+  if (vfov >= 180.0)
+    throw SceneError(path + ": 'vfov' must be below 180 degrees (a pinhole cannot see more)");
   if (focal > 0 && film > 0) vfov = 2.0 * std::atan(0.5 * film / focal) * 180.0 / M_PI;
   if (vfov > 0) cam.vfov_degrees = vfov;
   cam.defined = true;

@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 
+#include "core/error.hpp"
 #include "geometry/polygon.hpp"
 
 namespace lambert {
@@ -106,6 +107,15 @@ TEST(Mesh, HashDependsOnGeometryOnly) {
   b.materials[0].rho = Eigen::Vector3d::Constant(0.1);
   EXPECT_EQ(mesh_hash(mesh_scene(a, {0.5, 0})), mesh_hash(mesh_scene(b, {0.5, 0})));
   EXPECT_NE(mesh_hash(mesh_scene(a, {0.5, 0})), mesh_hash(mesh_scene(a, {0.4, 0})));
+}
+
+}  // namespace lambert
+
+namespace lambert {
+
+TEST(Mesh, TinyMaxEdgeIsRefusedBeforeAllocating) {
+  // 1e-6 on a unit-sized scene means ~1e12 patches: a clear UsageError, not an allocation.
+  EXPECT_THROW(mesh_scene(mixed_scene(), {1e-6, 0}), UsageError);
 }
 
 }  // namespace lambert
