@@ -267,13 +267,16 @@ void write_surfaces_csv(const std::string& path, const std::vector<AccuracyRow>&
 // Error-vs-time panels, one series per estimator family (points in table order).
 std::vector<Plot> error_plots(const std::vector<AccuracyRow>& rows, bool analytic) {
   Plot f, b;
+  f.log_x = f.markers = true;
   f.title = "RMS |F - F_ref| per patch pair vs time";
   f.x_label = "form-factor time (s)";
   f.y_label = "RMS abs error of F";
   b.title = "max relative B difference per surface vs time";
+  b.log_x = b.markers = true;
   b.x_label = f.x_label;
   b.y_label = "max |B - B_ref| / B_ref";
   Plot e;
+  e.log_x = e.markers = true;
   e.title = "surface factor error vs time (closed form)";
   e.x_label = f.x_label;
   e.y_label = "max |F_GH - exact|";
@@ -450,8 +453,8 @@ int run_accuracy(const AccuracyOptions& opts) {
   write_table_csv(csv, study, rows);
   write_surfaces_csv(surf, rows, ref_row.surfaces);
   const std::vector<Plot> plots = error_plots(rows, analytic);
-  write_loglog_svg(svg, plots);
-  write_loglog_png(png, plots);
+  write_plots_svg(svg, plots);
+  write_plots_png(png, plots);
   std::printf("wrote %s, %s, %s, %s\n", csv.c_str(), surf.c_str(), svg.c_str(), png.c_str());
   return kExitOk;
 }

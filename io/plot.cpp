@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 #include <string_view>
+#include <tuple>
 #include <utility>
 
 #include "core/atomic_file.hpp"
@@ -19,13 +20,18 @@ constexpr int kPanelW = 560, kPanelH = 420;
 constexpr int kLeft = 72, kRight = 16, kTop = 36, kBottom = 52;  // plot-area margins
 constexpr int kLegendRow = 16;                                   // px per legend entry
 
-struct Frame {                            // data -> pixel mapping of one panel
-  double x0 = 0, x1 = 1, y0 = 0, y1 = 1;  // data range (y in log10 when log_y)
-  bool log_y = true;
+struct Frame {  // data -> pixel mapping of one panel; ranges in axis space (log10 if log)
+  double x0 = 0, x1 = 1, y0 = 0, y1 = 1;
+  bool log_x = false, log_y = true;
   int ox = 0;  // panel x offset in the image
-  bool valid(double y) const { return std::isfinite(y) && (!log_y || y > 0.0); }
+  bool valid(double x, double y) const {
+    return std::isfinite(x) && std::isfinite(y) && (!log_x || x > 0.0) && (!log_y || y > 0.0);
+  }
+  double left() const { return ox + kLeft; }              // plot-area edges, pixels
+  double right() const { return ox + kPanelW - kRight; }
   double px(double x) const {
-    return ox + kLeft + (x - x0) / (x1 - x0) * (kPanelW - kLeft - kRight);
+    const double v = log_x ? std::log10(x) : x;
+    return ox + kLeft + (v - x0) / (x1 - x0) * (kPanelW - kLeft - kRight);
   }
   double py(double y) const {
     const double v = log_y ? std::log10(y) : y;
@@ -42,55 +48,50 @@ double nice_step(double span, int count) {
   return 10.0 * p;
 }
 
+// Axis range [lo, hi] (axis space) covering [vmin, vmax]: whole decades on a log axis;
+// nice-step multiples on a linear one, from 0 when `from_zero` (iterations, seconds).
+std::pair<double, double> axis_range(double vmin, double vmax, bool log, bool from_zero) {
+  if (log) return {std::floor(vmin), std::max(std::ceil(vmax), std::floor(vmin) + 1.0)};
+  const double lo0 = from_zero ? std::min(0.0, vmin) : vmin;
+  const double step = nice_step(std::max(vmax - lo0, 1e-300), 6);
+  const double lo = std::floor(lo0 / step) * step, hi = std::ceil(vmax / step) * step;
+  return {lo, hi > lo ? hi : lo + 1.0};
+}
+
 Frame make_frame(const Plot& plot, int ox) {
   Frame f;
+  f.log_x = plot.log_x;
   f.log_y = plot.log_y;
   f.ox = ox;
   double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin;
   double ymin = xmin, ymax = -xmin;
   for (const auto& s : plot.series)
     for (size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
-      if (!f.valid(s.y[k]) || !std::isfinite(s.x[k])) continue;
-      xmin = std::min(xmin, s.x[k]);
-      xmax = std::max(xmax, s.x[k]);
+      if (!f.valid(s.x[k], s.y[k])) continue;
+      const double u = f.log_x ? std::log10(s.x[k]) : s.x[k];
       const double v = f.log_y ? std::log10(s.y[k]) : s.y[k];
+      xmin = std::min(xmin, u);
+      xmax = std::max(xmax, u);
       ymin = std::min(ymin, v);
       ymax = std::max(ymax, v);
     }
   if (!std::isfinite(xmin)) xmin = 0, xmax = 1, ymin = 0, ymax = 1;
-  f.x0 = std::min(0.0, xmin);
-  f.x1 = xmax > f.x0 ? xmax : f.x0 + 1.0;
-  const double step = nice_step(f.x1 - f.x0, 6);
-  f.x1 = std::ceil(f.x1 / step) * step;
-  if (f.log_y) {
-    f.y0 = std::floor(ymin);
-    f.y1 = std::ceil(ymax);
-  } else {
-    const double ys = nice_step(std::max(ymax - ymin, 1e-300), 6);
-    f.y0 = std::floor(ymin / ys) * ys;
-    f.y1 = std::ceil(ymax / ys) * ys;
-  }
-  if (f.y1 <= f.y0) f.y1 = f.y0 + 1.0;
+  std::tie(f.x0, f.x1) = axis_range(xmin, xmax, f.log_x, true);
+  std::tie(f.y0, f.y1) = axis_range(ymin, ymax, f.log_y, false);
   return f;
 }
 
-std::vector<double> y_ticks(const Frame& f) {
+// Tick values (data space) over [lo, hi] (axis space): at most ~10 decades on a log axis,
+// about 6 nice steps on a linear one.
+std::vector<double> ticks(double lo, double hi, bool log) {
   std::vector<double> t;
-  if (f.log_y) {
-    const int decades = static_cast<int>(f.y1 - f.y0);
-    const int every = std::max(1, (decades + 9) / 10);
-    for (double e = f.y0; e <= f.y1 + 1e-9; e += every) t.push_back(std::pow(10.0, e));
+  if (log) {
+    const int every = std::max(1, static_cast<int>(hi - lo + 9) / 10);
+    for (double e = lo; e <= hi + 1e-9; e += every) t.push_back(std::pow(10.0, e));
   } else {
-    const double s = nice_step(f.y1 - f.y0, 6);
-    for (double v = f.y0; v <= f.y1 + 1e-9 * s; v += s) t.push_back(v);
+    const double step = nice_step(hi - lo, 6);
+    for (double v = lo; v <= hi + 1e-9 * step; v += step) t.push_back(v);
   }
-  return t;
-}
-
-std::vector<double> x_ticks(const Frame& f) {
-  std::vector<double> t;
-  const double s = nice_step(f.x1 - f.x0, 6);
-  for (double v = f.x0; v <= f.x1 + 1e-9 * s; v += s) t.push_back(v);
   return t;
 }
 
@@ -246,7 +247,7 @@ void for_segments(const Frame& f, const PlotSeries& s, Seg seg) {
   bool have = false;
   double px = 0, py = 0;
   for (size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
-    if (!f.valid(s.y[k]) || !std::isfinite(s.x[k])) continue;
+    if (!f.valid(s.x[k], s.y[k])) continue;
     const double x = f.px(s.x[k]), y = f.py(s.y[k]);
     if (have)
       seg(px, py, x, y);
@@ -276,18 +277,18 @@ std::string plots_svg(const std::vector<Plot>& panels) {
   for (size_t p = 0; p < panels.size(); ++p) {
     const Plot& plot = panels[p];
     const Frame f = make_frame(plot, static_cast<int>(p) * kPanelW);
-    const double l = f.px(f.x0), r = f.px(f.x1), t = kTop, b = kPanelH - kBottom;
-    for (double v : y_ticks(f)) {
+    const double l = f.left(), r = f.right(), t = kTop, b = kPanelH - kBottom;
+    for (double v : ticks(f.y0, f.y1, f.log_y)) {
       const double y = f.py(v);
       o << "<line x1=\"" << l << "\" y1=\"" << y << "\" x2=\"" << r << "\" y2=\"" << y
         << "\" stroke=\"#e0e0e0\"/>\n<text x=\"" << l - 6 << "\" y=\"" << y + 4
         << "\" text-anchor=\"end\">" << tick_label(v, f.log_y) << "</text>\n";
     }
-    for (double v : x_ticks(f)) {
+    for (double v : ticks(f.x0, f.x1, f.log_x)) {
       const double x = f.px(v);
       o << "<line x1=\"" << x << "\" y1=\"" << t << "\" x2=\"" << x << "\" y2=\"" << b
         << "\" stroke=\"#e0e0e0\"/>\n<text x=\"" << x << "\" y=\"" << b + 16
-        << "\" text-anchor=\"middle\">" << tick_label(v, false) << "</text>\n";
+        << "\" text-anchor=\"middle\">" << tick_label(v, f.log_x) << "</text>\n";
     }
     o << "<rect x=\"" << l << "\" y=\"" << t << "\" width=\"" << r - l << "\" height=\"" << b - t
       << "\" fill=\"none\" stroke=\"black\"/>\n"
@@ -298,9 +299,14 @@ std::string plots_svg(const std::vector<Plot>& panels) {
       << ") rotate(-90)\" text-anchor=\"middle\">" << escape(plot.y_label) << "</text>\n";
     for (size_t k = 0; k < plot.series.size(); ++k) {
       o << "<polyline fill=\"none\" stroke-width=\"2\" stroke=\"" << hex(k) << "\" points=\"";
-      for_segments(f, plot.series[k],
-                   [&](double, double, double x1, double y1) { o << x1 << ',' << y1 << ' '; });
-      o << "\"/>\n";
+      std::ostringstream marks;
+      for_segments(f, plot.series[k], [&](double, double, double x1, double y1) {
+        o << x1 << ',' << y1 << ' ';
+        if (plot.markers)
+          marks << "<circle cx=\"" << x1 << "\" cy=\"" << y1 << "\" r=\"3.5\" fill=\"" << hex(k)
+                << "\"/>\n";
+      });
+      o << "\"/>\n" << marks.str();
       const int lx = legend_x(f), ly = legend_y(static_cast<int>(k));
       o << "<line x1=\"" << lx << "\" y1=\"" << ly << "\" x2=\"" << lx + 24 << "\" y2=\"" << ly
         << "\" stroke-width=\"4\" stroke=\"" << hex(k) << "\"/>\n<text x=\"" << lx + 30 << "\" y=\""
@@ -321,164 +327,25 @@ void write_plots_png(const std::string& path, const std::vector<Plot>& panels) {
   for (size_t p = 0; p < panels.size(); ++p) {
     const Plot& plot = panels[p];
     const Frame f = make_frame(plot, static_cast<int>(p) * kPanelW);
-    const Area a{f.px(f.x0), f.px(f.x1), kTop, kPanelH - kBottom, f.ox};
-    for (double v : y_ticks(f)) {
+    const Area a{f.left(), f.right(), kTop, kPanelH - kBottom, f.ox};
+    for (double v : ticks(f.y0, f.y1, f.log_y)) {
       img.line(a.l, f.py(v), a.r, f.py(v), kGrid, 0);
       img.line(a.l - 5, f.py(v), a.l, f.py(v), kBlack, 0);
       put_text(img, a.l - 8, f.py(v), tick_label(v, f.log_y), Anchor::kEnd);
     }
-    for (double v : x_ticks(f)) {
+    for (double v : ticks(f.x0, f.x1, f.log_x)) {
       img.line(f.px(v), a.t, f.px(v), a.b, kGrid, 0);
       img.line(f.px(v), a.b, f.px(v), a.b + 5, kBlack, 0);
-      put_text(img, f.px(v), a.b + 13, tick_label(v, false), Anchor::kMiddle);
+      put_text(img, f.px(v), a.b + 13, tick_label(v, f.log_x), Anchor::kMiddle);
     }
     img.outline(a.l, a.t, a.r, a.b, kBlack);
     for (size_t k = 0; k < plot.series.size(); ++k) {
       const auto c = plot_color(k);
       for_segments(f, plot.series[k], [&](double x0, double y0, double x1, double y1) {
         img.line(x0, y0, x1, y1, c, 1);
+        if (plot.markers)
+          img.dot(static_cast<int>(std::lround(x1)), static_cast<int>(std::lround(y1)), c, 3);
       });
-    }
-    draw_legend(img, plot, a);
-    draw_titles(img, plot, a);
-  }
-  write_png(path, img.width, img.height, img.rgb);
-}
-
-// ---- Log-log scatter plots -------------------------------------------------------------
-
-namespace {
-
-struct LogFrame {                         // log10(data) -> pixel mapping of one log-log panel
-  double x0 = 0, x1 = 1, y0 = 0, y1 = 1;  // decades spanned
-  int ox = 0;
-  static bool valid(double x, double y) {
-    return std::isfinite(x) && std::isfinite(y) && x > 0.0 && y > 0.0;
-  }
-  double px(double x) const {
-    return ox + kLeft + (std::log10(x) - x0) / (x1 - x0) * (kPanelW - kLeft - kRight);
-  }
-  double py(double y) const {
-    return kTop + (y1 - std::log10(y)) / (y1 - y0) * (kPanelH - kTop - kBottom);
-  }
-};
-
-LogFrame make_log_frame(const Plot& plot, int ox) {
-  LogFrame f;
-  f.ox = ox;
-  double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin, ymin = xmin, ymax = -xmin;
-  for (const auto& s : plot.series)
-    for (size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
-      if (!LogFrame::valid(s.x[k], s.y[k])) continue;
-      xmin = std::min(xmin, std::log10(s.x[k]));
-      xmax = std::max(xmax, std::log10(s.x[k]));
-      ymin = std::min(ymin, std::log10(s.y[k]));
-      ymax = std::max(ymax, std::log10(s.y[k]));
-    }
-  if (!std::isfinite(xmin)) xmin = 0, xmax = 1, ymin = 0, ymax = 1;
-  f.x0 = std::floor(xmin);
-  f.x1 = std::max(std::ceil(xmax), f.x0 + 1.0);
-  f.y0 = std::floor(ymin);
-  f.y1 = std::max(std::ceil(ymax), f.y0 + 1.0);
-  return f;
-}
-
-// Powers of ten from 10^lo to 10^hi, at most ~10 of them.
-std::vector<double> decade_ticks(double lo, double hi) {
-  std::vector<double> t;
-  const int every = std::max(1, static_cast<int>(hi - lo + 9) / 10);
-  for (double e = lo; e <= hi + 1e-9; e += every) t.push_back(std::pow(10.0, e));
-  return t;
-}
-
-}  // namespace
-
-std::string loglog_svg(const std::vector<Plot>& panels) {
-  std::ostringstream o;
-  const int width = kPanelW * static_cast<int>(std::max<size_t>(1, panels.size()));
-  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << kPanelH
-    << "\" viewBox=\"0 0 " << width << ' ' << kPanelH
-    << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
-    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  for (size_t p = 0; p < panels.size(); ++p) {
-    const Plot& plot = panels[p];
-    const LogFrame f = make_log_frame(plot, static_cast<int>(p) * kPanelW);
-    const double l = f.ox + kLeft, r = f.ox + kPanelW - kRight, t = kTop, b = kPanelH - kBottom;
-    for (double v : decade_ticks(f.y0, f.y1)) {
-      const double y = f.py(v);
-      o << "<line x1=\"" << l << "\" y1=\"" << y << "\" x2=\"" << r << "\" y2=\"" << y
-        << "\" stroke=\"#e0e0e0\"/>\n<text x=\"" << l - 6 << "\" y=\"" << y + 4
-        << "\" text-anchor=\"end\">" << tick_label(v, true) << "</text>\n";
-    }
-    for (double v : decade_ticks(f.x0, f.x1)) {
-      const double x = f.px(v);
-      o << "<line x1=\"" << x << "\" y1=\"" << t << "\" x2=\"" << x << "\" y2=\"" << b
-        << "\" stroke=\"#e0e0e0\"/>\n<text x=\"" << x << "\" y=\"" << b + 16
-        << "\" text-anchor=\"middle\">" << tick_label(v, true) << "</text>\n";
-    }
-    o << "<rect x=\"" << l << "\" y=\"" << t << "\" width=\"" << r - l << "\" height=\"" << b - t
-      << "\" fill=\"none\" stroke=\"black\"/>\n"
-      << "<text x=\"" << (l + r) / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">"
-      << escape(plot.title) << "</text>\n<text x=\"" << (l + r) / 2 << "\" y=\"" << b + 38
-      << "\" text-anchor=\"middle\">" << escape(plot.x_label) << "</text>\n"
-      << "<text transform=\"translate(" << f.ox + 16 << ',' << (t + b) / 2
-      << ") rotate(-90)\" text-anchor=\"middle\">" << escape(plot.y_label) << "</text>\n";
-    for (size_t k = 0; k < plot.series.size(); ++k) {
-      const PlotSeries& s = plot.series[k];
-      std::ostringstream pts, marks;
-      for (size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-        if (!LogFrame::valid(s.x[i], s.y[i])) continue;
-        pts << f.px(s.x[i]) << ',' << f.py(s.y[i]) << ' ';
-        marks << "<circle cx=\"" << f.px(s.x[i]) << "\" cy=\"" << f.py(s.y[i])
-              << "\" r=\"3.5\" fill=\"" << hex(k) << "\"/>\n";
-      }
-      o << "<polyline fill=\"none\" stroke-width=\"1.5\" stroke=\"" << hex(k) << "\" points=\""
-        << pts.str() << "\"/>\n"
-        << marks.str();
-      const int lx = f.ox + kPanelW - kRight - 150,
-                ly = kTop + 8 + static_cast<int>(k) * kLegendRow;
-      o << "<line x1=\"" << lx << "\" y1=\"" << ly << "\" x2=\"" << lx + 24 << "\" y2=\"" << ly
-        << "\" stroke-width=\"4\" stroke=\"" << hex(k) << "\"/>\n<text x=\"" << lx + 30 << "\" y=\""
-        << ly + 4 << "\">" << escape(s.name) << " (" << hex(k) << ")</text>\n";
-    }
-  }
-  o << "</svg>\n";
-  return o.str();
-}
-
-void write_loglog_svg(const std::string& path, const std::vector<Plot>& panels) {
-  const std::string svg = loglog_svg(panels);
-  write_stream_atomically(path, [&](std::ostream& out) { out << svg; });
-}
-
-void write_loglog_png(const std::string& path, const std::vector<Plot>& panels) {
-  Raster img(kPanelW * static_cast<int>(std::max<size_t>(1, panels.size())), kPanelH);
-  for (size_t p = 0; p < panels.size(); ++p) {
-    const Plot& plot = panels[p];
-    const LogFrame f = make_log_frame(plot, static_cast<int>(p) * kPanelW);
-    const Area a{f.ox + static_cast<double>(kLeft), f.ox + static_cast<double>(kPanelW - kRight),
-                 kTop, kPanelH - kBottom, f.ox};
-    for (double v : decade_ticks(f.y0, f.y1)) {
-      img.line(a.l, f.py(v), a.r, f.py(v), kGrid, 0);
-      put_text(img, a.l - 8, f.py(v), tick_label(v, true), Anchor::kEnd);
-    }
-    for (double v : decade_ticks(f.x0, f.x1)) {
-      img.line(f.px(v), a.t, f.px(v), a.b, kGrid, 0);
-      put_text(img, f.px(v), a.b + 13, tick_label(v, true), Anchor::kMiddle);
-    }
-    img.outline(a.l, a.t, a.r, a.b, kBlack);
-    for (size_t k = 0; k < plot.series.size(); ++k) {
-      const PlotSeries& s = plot.series[k];
-      const auto c = plot_color(k);
-      bool have = false;
-      double qx = 0, qy = 0;
-      for (size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-        if (!LogFrame::valid(s.x[i], s.y[i])) continue;
-        const double x = f.px(s.x[i]), y = f.py(s.y[i]);
-        if (have) img.line(qx, qy, x, y, c, 0);
-        img.dot(static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y)), c, 3);
-        qx = x, qy = y, have = true;
-      }
     }
     draw_legend(img, plot, a);
     draw_titles(img, plot, a);

@@ -10,7 +10,8 @@
 
 namespace lambert {
 
-/// One curve: points (x_k, y_k); points with y <= 0 or non-finite are skipped on a log axis.
+/// One curve: points (x_k, y_k), joined in order; non-finite points, and points <= 0 on a
+/// log axis, are skipped.
 struct PlotSeries {
   std::string name;
   std::vector<double> x;
@@ -22,7 +23,9 @@ struct Plot {
   std::string title;
   std::string x_label;
   std::string y_label;
-  bool log_y = true;  ///< base-10 logarithmic y axis
+  bool log_x = false;   ///< base-10 logarithmic x axis (else linear from 0)
+  bool log_y = true;    ///< base-10 logarithmic y axis
+  bool markers = false;  ///< a dot at every point (scatter-like plots such as error vs time)
   std::vector<PlotSeries> series;
 };
 
@@ -39,19 +42,5 @@ void write_plots_svg(const std::string& path, const std::vector<Plot>& panels);
 /// (curves, axes, grid, tick labels, titles, a legend box naming each colour), atomically.
 /// Throws IoError.
 void write_plots_png(const std::string& path, const std::vector<Plot>& panels);
-
-// Log-log scatter plots (e.g. error vs time of several estimators): both axes base-10
-// logarithmic, a marker at every point, the points of a series joined in the order given.
-// Plot::log_y is ignored; points with x <= 0, y <= 0 or non-finite are skipped.
-
-/// The panels side by side as an SVG document, log-log (each panel 560 x 420 px).
-std::string loglog_svg(const std::vector<Plot>& panels);
-
-/// Writes loglog_svg atomically. Throws IoError.
-void write_loglog_svg(const std::string& path, const std::vector<Plot>& panels);
-
-/// Writes the log-log panels as an RGB PNG with the SVG's layout and text, atomically.
-/// Throws IoError.
-void write_loglog_png(const std::string& path, const std::vector<Plot>& panels);
 
 }  // namespace lambert

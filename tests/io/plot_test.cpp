@@ -60,12 +60,14 @@ TEST(PlotPng, HasSignatureAndPanelSize) {
   EXPECT_EQ(png[24], 8);  // bit depth
   EXPECT_EQ(png[25], 2);  // colour type: RGB
 
-  write_loglog_png(path,
-                   {residual_plot("a", "mc"), residual_plot("b", "mc"), residual_plot("c", "mc")});
-  const std::string loglog = read_all(path);
-  ASSERT_GE(loglog.size(), 33u);
-  EXPECT_EQ(be32(loglog, 16), 3u * 560u);
-  EXPECT_EQ(be32(loglog, 20), 420u);
+  std::vector<Plot> loglog = {residual_plot("a", "mc"), residual_plot("b", "mc"),
+                              residual_plot("c", "mc")};
+  for (Plot& p : loglog) p.log_x = p.markers = true;
+  write_plots_png(path, loglog);
+  const std::string three = read_all(path);
+  ASSERT_GE(three.size(), 33u);
+  EXPECT_EQ(be32(three, 16), 3u * 560u);
+  EXPECT_EQ(be32(three, 20), 420u);
 }
 
 // The text is part of the raster: plots that differ only in a legend name or a title give
