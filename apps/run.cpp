@@ -101,12 +101,7 @@ void write_report(std::ostream& out, const Report& rp) {
   j.key("energy_balance");
   j.begin_array();
   for (const auto& e : r.solution.energy) {
-    j.begin_object();
-    j.field("emitted", e.emitted);
-    j.field("absorbed", e.absorbed);
-    j.field("escaped", e.escaped);
-    j.field("relative_imbalance", e.relative_imbalance);
-    j.end_object();
+    write_energy_json(j, e);
   }
   j.end_array();
 

@@ -44,12 +44,7 @@ void write_channel(JsonWriter& j, const ChannelReport& r, const EnergyBalance& e
   j.field("seconds", r.seconds);
   if (!r.note.empty()) j.field("note", r.note);
   j.key("energy");
-  j.begin_object();
-  j.field("emitted", e.emitted);
-  j.field("absorbed", e.absorbed);
-  j.field("escaped", e.escaped);
-  j.field("relative_imbalance", e.relative_imbalance);
-  j.end_object();
+  write_energy_json(j, e);
   j.key("history");
   j.begin_object();
   std::vector<double> its(r.history_iteration.begin(), r.history_iteration.end());

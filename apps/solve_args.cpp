@@ -48,4 +48,13 @@ std::string csv_number(double v) {
   return buf;
 }
 
+void write_energy_json(JsonWriter& j, const EnergyBalance& e) {
+  j.begin_object();
+  j.field("emitted", e.emitted);
+  j.field("absorbed", e.absorbed);
+  j.field("escaped", e.escaped);
+  j.field("relative_imbalance", e.relative_imbalance);
+  j.end_object();
+}
+
 }  // namespace lambert
