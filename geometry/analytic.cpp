@@ -24,6 +24,26 @@ double parallel_rectangles_factor(double a, double b, double c) {
           Y * std::sqrt(X2) * std::atan(Y / std::sqrt(X2)) - X * std::atan(X) - Y * std::atan(Y));
 }
 
+double parallel_rectangles_G(double x0, double x1, double y0, double y1, double u0, double u1,
+                             double v0, double v1, double h) {
+  // G = (1/2π) Σ (-1)^(i+j+k+l) g(x_i - u_k, y_j - v_l) with
+  // g(p, q) = q sqrt(p² + h²) atan(q / sqrt(p² + h²)) + p sqrt(q² + h²) atan(p / sqrt(q² + h²))
+  //           - (h² / 2) ln(p² + q² + h²).
+  auto g = [h](double p, double q) {
+    const double ph = std::sqrt(p * p + h * h), qh = std::sqrt(q * q + h * h);
+    return q * ph * std::atan(q / ph) + p * qh * std::atan(p / qh) -
+           0.5 * h * h * std::log(p * p + q * q + h * h);
+  };
+  const double xs[2] = {x0, x1}, ys[2] = {y0, y1}, us[2] = {u0, u1}, vs[2] = {v0, v1};
+  double sum = 0.0;
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int k = 0; k < 2; ++k)
+        for (int l = 0; l < 2; ++l)
+          sum += ((i + j + k + l) % 2 ? -1.0 : 1.0) * g(xs[i] - us[k], ys[j] - vs[l]);
+  return sum / (2.0 * M_PI);
+}
+
 Scene perpendicular_squares() {
   Scene s;
   add_polygon(s, "a", lamp(), {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});  // z=0, faces +z

@@ -15,6 +15,12 @@ Scene parallel_squares(double d = 1.0);
 /// Exact F between directly opposed parallel rectangles a x b at distance c (Howell C-11).
 double parallel_rectangles_factor(double a, double b, double c);
 
+/// Exact A_1 F_12 (= G, units²) between axis-aligned parallel rectangles in the planes z = 0
+/// ([x0, x1] x [y0, y1]) and z = h ([u0, u1] x [v0, v1]), in any lateral offset: the
+/// four-fold corner sum of the contour integral (Ehlert & Smith 1993; Howell C-12 general).
+double parallel_rectangles_G(double x0, double x1, double y0, double y1, double u0, double u1,
+                             double v0, double v1, double h);
+
 /// Two unit squares at right angles sharing an edge, both facing into the wedge.
 Scene perpendicular_squares();
 /// Exact F between perpendicular rectangles with a common edge of length l, widths w (from

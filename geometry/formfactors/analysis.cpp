@@ -7,7 +7,10 @@
 #include "core/error.hpp"
 #include "core/parallel.hpp"
 #include "core/sampling.hpp"
+#include "geometry/formfactors/constants.hpp"
 #include "geometry/formfactors/pairwise.hpp"
+#include "geometry/formfactors/replicates.hpp"
+#include "geometry/formfactors/visibility.hpp"
 
 namespace lambert {
 
@@ -82,7 +85,7 @@ PointFactors point_form_factors(const PatchMesh& mesh, const Eigen::Vector3d& po
   const Eigen::Vector3d n = normal.normalized();
   const std::vector<ff::PatchGeom> geom = ff::patch_geometry(mesh);
   const Bvh bvh(mesh);
-  const double offset = 1e-6 * mesh.scale;  // as kRayOffset in formfactors.cpp
+  const double offset = ff::kRayOffset * mesh.scale;
   const std::int32_t np = mesh.size();
   std::vector<double> f(np, 0.0), var(np, 0.0);
   std::vector<std::int64_t> rays(np, 0);
@@ -91,31 +94,22 @@ PointFactors point_form_factors(const PatchMesh& mesh, const Eigen::Vector3d& po
       const auto j = static_cast<std::int32_t>(jj);
       const double unocc = ff::point_to_patch(point, n, geom[j]);
       if (unocc <= 0.0) continue;
-      const Kronecker4 seq(hash_keys(options.seed, 0xFFFFFFFFull, static_cast<std::uint64_t>(j)));
-      // Kernel-weighted visible fraction (see hybrid.cpp): Σ K V / Σ K with y uniform on j.
-      double num = 0.0, den = 0.0, num2 = 0.0, den2 = 0.0;
-      int used = 0;
-      for (int s = 0; s < options.samples; ++s) {
-        double jac;
-        const Eigen::Vector3d y = ff::sample_patch(geom[j], seq.get(s, 0), seq.get(s, 1), jac);
-        const Eigen::Vector3d d = y - point;
-        const double r2 = d.squaredNorm();
-        const double k = r2 > 0.0 ? n.dot(d) * -geom[j].normal.dot(d) / (r2 * r2) : 0.0;
-        if (!(k > 0.0)) continue;  // behind the sensor's horizon
-        ++used;
-        const double v = ff::visible(bvh, point, n, y, geom[j].normal, offset) ? 1.0 : 0.0;
-        num += k * v;
-        den += k;
-        num2 += k * k * v;
-        den2 += k * k;
+      // The shared visible-fraction kernel (visibility.hpp), in replicates for the error.
+      const int R = ff::replicate_count(options.samples);
+      double replicate[ff::kReplicates];
+      int seen = 0, exhausted = 0;
+      for (int rep = 0; rep < R; ++rep) {
+        const int k = ff::replicate_size(options.samples, rep);
+        const int v = ff::count_visible(
+            bvh, point, n, geom[j], k,
+            hash_keys(options.seed, 0xFFFFFFFFull, hash_keys(j, static_cast<std::uint64_t>(rep))),
+            offset, exhausted);
+        seen += v;
+        replicate[rep] = unocc * v / k;
       }
-      rays[j] = used;
-      if (den <= 0.0) continue;
-      const double frac = num / den;
-      f[j] = unocc * frac;
-      // Delta-method variance of the ratio: Σ k² (v - frac)² / (Σ k)², with v² = v.
-      const double s2 = num2 * (1 - 2 * frac) + frac * frac * den2;
-      var[j] = used > 1 ? unocc * unocc * std::max(0.0, s2) / (den * den) : 0.0;
+      rays[j] = options.samples;
+      f[j] = unocc * seen / options.samples;
+      var[j] = ff::replicate_variance(replicate, R);
     }
   });
   PointFactors out;

@@ -7,6 +7,7 @@
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "core/timer.hpp"
+#include "geometry/formfactors/constants.hpp"
 #include "geometry/formfactors/hemicube.hpp"
 #include "geometry/formfactors/pairwise.hpp"
 
@@ -14,15 +15,6 @@ namespace lambert {
 
 namespace ff {
 
-// Ray ends are lifted off their patches by this fraction of the scene's bounding-box
-// diagonal. Embree intersects in single precision (relative error ~6e-8 of the coordinate
-// magnitude); 1e-6 of the diagonal is > 10x that for any point inside the box, yet far
-// below any feature size a radiosity mesh resolves (the form-factor bias it introduces is
-// of the order of offset / patch size, < 1e-4 for 1e4 patches).
-constexpr double kRayOffset = 1e-6;
-// Corners closer than this fraction of the diagonal to a patch's plane count as in the
-// plane for culling (float-rounded coordinates of coplanar patches differ by ~1e-16 rel.).
-constexpr double kPlaneEps = 1e-12;
 
 namespace {
 struct UpperEntry {
@@ -43,7 +35,7 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
   // Row i holds the pairs (i, j > i); rows are filled in parallel, one row per task.
   std::vector<std::vector<UpperEntry>> upper(n);
   std::vector<std::vector<double>> upper_var(options.with_stderr ? n : 0);
-  std::vector<std::int64_t> tested(n, 0), rays(n, 0);
+  std::vector<std::int64_t> tested(n, 0), rays(n, 0), unverified(n, 0);
   const std::int64_t total_pairs = static_cast<std::int64_t>(n) * (n - 1) / 2;
   Progress progress("form factors", options.progress ? total_pairs : 0, "rays");
   parallel_for(n, 1, options.threads, [&](std::int64_t begin, std::int64_t end) {
@@ -55,6 +47,7 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
         ++tested[i];
         const PairEstimate e = estimator(ctx, i, j);
         row_rays += e.rays;
+        unverified[i] += e.unverified;
         if (e.G <= 0.0) continue;
         upper[i].push_back({j, e.G});
         if (options.with_stderr) upper_var[i].push_back(e.var);
@@ -70,6 +63,7 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
   for (std::int32_t i = 0; i < n; ++i) {
     out.stats.pairs_tested += tested[i];
     out.stats.rays += rays[i];
+    out.stats.pairs_unverified += unverified[i];
   }
   out.stats.pairs_culled = total_pairs - out.stats.pairs_tested;
 
@@ -182,6 +176,11 @@ std::vector<std::string> form_factor_estimators() {
 
 FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions& options) {
   if (options.samples < 1) throw UsageError("--samples must be at least 1");
+  // Standard errors come from the spread of independent replicates (replicates.hpp), which
+  // needs at least two of them, and Student's t with so few is wide: ask for four.
+  if (options.with_stderr && options.samples < 4 && options.estimator != "hemicube")
+    throw UsageError("--stderr needs --samples of at least 4 (standard errors come from "
+                     "independent replicates of the samples)");
   if (mesh.patches.empty()) throw UsageError("the scene has no patches");
   for (const auto& e : registry()) {
     if (options.estimator != e.name) continue;

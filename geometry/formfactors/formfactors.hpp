@@ -35,6 +35,10 @@ struct FormFactorStats {
   std::int64_t pairs_tested = 0;  ///< unordered pairs that can exchange energy
   std::int64_t pairs_culled = 0;  ///< unordered pairs facing away from each other
   std::int64_t rays = 0;          ///< occlusion rays traced
+  /// Pairs whose visibility could not be sampled as designed (hybrid: no ray could be
+  /// traced, so the unoccluded value was kept; or a kernel-sampling rejection gave up):
+  /// reported and warned about, expected 0.
+  std::int64_t pairs_unverified = 0;
   double seconds = 0.0;           ///< wall time of the computation
 };
 

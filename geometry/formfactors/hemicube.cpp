@@ -29,27 +29,25 @@
 #include "core/progress.hpp"
 #include "core/sampling.hpp"
 #include "core/timer.hpp"
+#include "geometry/formfactors/constants.hpp"
 #include "geometry/formfactors/kernels.hpp"
 
 namespace lambert::ff {
 namespace {
 
-// The hemicube origin is lifted off patch i by this fraction of the scene's bounding-box
-// diagonal: as kRayOffset in formfactors.cpp, > 10x the float rounding of coordinates and
-// far below any patch size. It puts patches coplanar with i (its own surface) strictly
-// behind the tangent plane, so they are excluded without a special case; the factor's
-// bias is O(offset / patch size) < 1e-4 for 1e4 patches.
-constexpr double kOffset = 1e-6;
+// The hemicube origin is lifted off patch i by kRayOffset of the scene's diagonal
+// (constants.hpp). It puts patches coplanar with i (its own surface) strictly behind the
+// tangent plane, so they are excluded without a special case.
+constexpr double kOffset = kRayOffset;
 // Near-plane distance as a fraction of the offset. A face's frustum (|a|, |b| <= w) cut at
 // w < near is a box of half-size near around c: only geometry within ~1e-9 of the diagonal
 // from c is lost, and no other patch can come that close to c (it is 1e-6 off patch i).
 // Keeping w >= near > 0 bounds the projected coordinates (<= diagonal / near ~ 1e9, exact
 // enough in double precision).
 constexpr double kNearFraction = 1e-3;
-// A patch whose plane passes within this fraction of the diagonal of c is edge-on: its
+// A patch whose plane passes within kPlaneEps of the diagonal of c is edge-on: its
 // projection is a segment covering no pixel centre, and its depth plane is singular.
-// (Matches kPlaneEps of the ray-traced estimators: ~1e4 x double rounding.)
-constexpr double kEdgeOnEps = 1e-12;
+constexpr double kEdgeOnEps = kPlaneEps;
 
 // One hemicube face: view axis d and image axes a, b in the local frame (x=u, y=v, z=n).
 struct Face {

@@ -32,12 +32,11 @@ bool can_exchange(const PatchGeom& a, const PatchGeom& b, double eps) {
   return front(b, a) && front(a, b);
 }
 
-double point_to_patch(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& g) {
-  if (g.normal.dot(x - g.p[0]) <= 0.0) return 0.0;  // x behind the receiving patch
+int clip_to_horizon(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& g,
+                    Eigen::Vector3d* out) {
   // Sutherland-Hodgman clip of the polygon (relative to x) against n_x · r >= 0.
-  Eigen::Vector3d in[4], out[5];
+  Eigen::Vector3d in[4];
   double d[4];
-  int m = 0;
   bool all_front = true;
   for (int k = 0; k < g.n; ++k) {
     in[k] = g.p[k] - x;
@@ -46,18 +45,25 @@ double point_to_patch(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const
   }
   if (all_front) {
     for (int k = 0; k < g.n; ++k) out[k] = in[k];
-    m = g.n;
-  } else {
-    for (int k = 0; k < g.n; ++k) {
-      const int l = (k + 1) % g.n;
-      if (d[k] > 0.0) out[m++] = in[k];
-      if ((d[k] > 0.0) != (d[l] > 0.0)) {
-        const double t = d[k] / (d[k] - d[l]);
-        out[m++] = in[k] + t * (in[l] - in[k]);
-      }
-    }
-    if (m < 3) return 0.0;
+    return g.n;
   }
+  int m = 0;
+  for (int k = 0; k < g.n; ++k) {
+    const int l = (k + 1) % g.n;
+    if (d[k] > 0.0) out[m++] = in[k];
+    if ((d[k] > 0.0) != (d[l] > 0.0)) {
+      const double t = d[k] / (d[k] - d[l]);
+      out[m++] = in[k] + t * (in[l] - in[k]);
+    }
+  }
+  return m;
+}
+
+double point_to_patch(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& g) {
+  if (g.normal.dot(x - g.p[0]) <= 0.0) return 0.0;  // x behind the receiving patch
+  Eigen::Vector3d out[5];
+  const int m = clip_to_horizon(x, nx, g, out);
+  if (m < 3) return 0.0;
   double sum = 0.0;
   for (int k = 0; k < m; ++k) {
     const Eigen::Vector3d& a = out[k];

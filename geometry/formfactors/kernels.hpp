@@ -57,6 +57,11 @@ inline Eigen::Vector3d quadrature_point(const PatchGeom& g, double u, double v,
   return sample_patch(g, u, v, jacobian);
 }
 
+/// The corners of patch g relative to x, clipped to the half-space in front of x
+/// (n_x · r >= 0); writes up to 5 corners to `out` and returns their count (< 3: nothing).
+int clip_to_horizon(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& g,
+                    Eigen::Vector3d* out);
+
 /// Point-to-polygon form factor (Lambert's contour formula, exact):
 ///   F_{dx->P} = -(1/2π) Σ_k θ_k  n_x · (r_k × r_{k+1}) / |r_k × r_{k+1}|
 /// with r_k = p_k - x and θ_k the angle between r_k and r_{k+1}. The polygon is first

@@ -3,39 +3,46 @@
 //   G_ij ≈ (1/k) Σ_s K(x_s, y_s) V(x_s, y_s) J_i(x_s) J_j(y_s),
 //   K = cosθ_i cosθ_j / (π r²)  (front sides only: both cosines clamped at 0),
 // with (x_s, y_s) the points of a randomly shifted 4-D Kronecker lattice mapped onto the
-// two patches. Unbiased; the reported variance is the sample variance / k (conservative
-// for low-discrepancy points). Variance is large for patches sharing an edge (the 1/r²
+// two patches, in R independently shifted replicates. Unbiased; the variance comes from the
+// spread of the replicates (replicates.hpp). Variance is large for patches sharing an edge (the 1/r²
 // singularity): use "hybrid" there. Cost: k kernel evaluations and ≤ k rays per pair.
 
 #include "core/sampling.hpp"
 #include "geometry/formfactors/pairwise.hpp"
+#include "geometry/formfactors/replicates.hpp"
 
 namespace lambert::ff {
 
 PairEstimate estimate_mc(const PairContext& ctx, std::int32_t i, std::int32_t j) {
   const PatchGeom& a = ctx.geom[i];
   const PatchGeom& b = ctx.geom[j];
-  const Kronecker4 seq(hash_keys(ctx.seed, static_cast<std::uint64_t>(i),
-                                 static_cast<std::uint64_t>(j)));
+  const std::uint64_t key =
+      hash_keys(ctx.seed, static_cast<std::uint64_t>(i), static_cast<std::uint64_t>(j));
   PairEstimate est;
-  double sum = 0.0, sum2 = 0.0;
-  const int k = ctx.samples;
-  for (int s = 0; s < k; ++s) {
-    double ja, jb;
-    const Eigen::Vector3d x = sample_patch(a, seq.get(s, 0), seq.get(s, 1), ja);
-    const Eigen::Vector3d y = sample_patch(b, seq.get(s, 2), seq.get(s, 3), jb);
-    const Eigen::Vector3d d = y - x;
-    const double r2 = d.squaredNorm();
-    const double ci = a.normal.dot(d), cj = -b.normal.dot(d);
-    if (ci <= 0.0 || cj <= 0.0 || r2 <= 0.0) continue;
-    ++est.rays;
-    if (!visible(ctx.bvh, x, a.normal, y, b.normal, ctx.offset)) continue;
-    const double f = ci * cj / (M_PI * r2 * r2) * ja * jb;
-    sum += f;
-    sum2 += f * f;
+  const int R = replicate_count(ctx.samples);
+  double replicate[kReplicates];
+  double total = 0.0;
+  for (int rep = 0; rep < R; ++rep) {
+    const Kronecker4 seq(hash_keys(key, static_cast<std::uint64_t>(rep)));
+    const int k = replicate_size(ctx.samples, rep);
+    double sum = 0.0;
+    for (int s = 0; s < k; ++s) {
+      double ja, jb;
+      const Eigen::Vector3d x = sample_patch(a, seq.get(s, 0), seq.get(s, 1), ja);
+      const Eigen::Vector3d y = sample_patch(b, seq.get(s, 2), seq.get(s, 3), jb);
+      const Eigen::Vector3d d = y - x;
+      const double r2 = d.squaredNorm();
+      const double ci = a.normal.dot(d), cj = -b.normal.dot(d);
+      if (ci <= 0.0 || cj <= 0.0 || r2 <= 0.0) continue;
+      ++est.rays;
+      if (!visible(ctx.bvh, x, a.normal, y, b.normal, ctx.offset)) continue;
+      sum += ci * cj / (M_PI * r2 * r2) * ja * jb;
+    }
+    total += sum;
+    replicate[rep] = sum / k;
   }
-  est.G = sum / k;
-  est.var = k > 1 ? std::max(0.0, (sum2 / k - est.G * est.G) / (k - 1)) : 0.0;
+  est.G = total / ctx.samples;
+  est.var = replicate_variance(replicate, R);
   return est;
 }
 

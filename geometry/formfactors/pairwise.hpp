@@ -30,18 +30,19 @@ struct PairEstimate {
   double G = 0.0;    ///< estimate of G_ij
   double var = 0.0;  ///< estimated variance of G (0 when unknown)
   std::int64_t rays = 0;
+  bool unverified = false;  ///< visibility could not be sampled as designed (see stats)
 };
 
 /// Signature of a pair estimator.
 using PairEstimator = PairEstimate (*)(const PairContext&, std::int32_t i, std::int32_t j);
 
 /// Estimator "mc": 4-D randomly shifted Kronecker points (x on i, y on j), one occlusion
-/// ray per sample with positive kernel. Unbiased; variance from the sample variance / k.
+/// ray per sample with positive kernel. Unbiased; variance from replicates.
 PairEstimate estimate_mc(const PairContext& ctx, std::int32_t i, std::int32_t j);
 
-/// Estimator "hybrid": exact point-to-patch factors at Gauss-Legendre nodes on one patch
-/// times the visible fraction from rays to sample points on the other, done from both
-/// sides and averaged. Exact (to quadrature) for unoccluded pairs.
+/// Estimator "hybrid": the exact unoccluded G (adaptive quadrature of the contour formula
+/// over the smaller patch) times an unbiased visible fraction from rays drawn with the
+/// kernel's density. Exact (to quadrature, < 1e-6) for unoccluded pairs.
 PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_t j);
 
 /// Runs `estimator` over all pairs in parallel and assembles F (and stderr if asked).

@@ -4,35 +4,22 @@
 
 #include "core/parallel.hpp"
 #include "core/timer.hpp"
+#include "geometry/formfactors/constants.hpp"
 #include "geometry/formfactors/kernels.hpp"
+#include "geometry/formfactors/quadrature.hpp"
 
 namespace lambert {
 namespace {
 
 using namespace ff;
 
-// (1/A_a) ∫_{A_a} F(x -> b) dA_x by composite Gauss-Legendre: s x s cells of order m in
-// patch a's parameter square. The integrand is smooth for distant pairs: the relative error
-// falls like (size/2d)^(2m) (see hybrid.cpp), so order 4 past 6 diameters ((1/12)^8 ~ 2e-9)
-// and order 8 past 3 ((1/6)^16 ~ 3e-13) suffice. It has a
-// log-singular derivative along an edge shared with b, which 6 x 6 cells of order 16
-// (9216 nodes) resolve to ~1e-8 (checked against Howell C-14 for the shared-edge case).
+// F_ab = G0 / A_a by the adaptive quadrature at reference accuracy (quadrature.hpp),
+// integrated over the smaller patch (where the integrand is smoothest).
 double quadrature_factor(const PatchGeom& a, const PatchGeom& b) {
-  const double q = (a.centroid - b.centroid).norm() / std::max(a.diameter, b.diameter);
-  const int cells = q > 3.0 ? 1 : q > 1.2 ? 2 : 6;
-  const int order = q > 6.0 ? 4 : q > 3.0 ? 8 : 16;
-  const GaussRule rule = gauss_legendre(order);
-  double sum = 0.0;
-  for (int cu = 0; cu < cells; ++cu)
-    for (int cv = 0; cv < cells; ++cv)
-      for (int u = 0; u < order; ++u)
-        for (int v = 0; v < order; ++v) {
-          double jac;
-          const Eigen::Vector3d x = quadrature_point(a, (cu + rule.x[u]) / cells,
-                                                         (cv + rule.x[v]) / cells, jac);
-          sum += rule.w[u] * rule.w[v] * jac * point_to_patch(x, a.normal, b);
-        }
-  return sum / (cells * cells * a.area);
+  thread_local std::vector<QuadCell> cells;
+  const double G = a.area <= b.area ? integrate_unoccluded(a, b, kReferenceAccuracy, cells)
+                                    : integrate_unoccluded(b, a, kReferenceAccuracy, cells);
+  return G / a.area;
 }
 
 }  // namespace
@@ -42,7 +29,7 @@ FormFactors unoccluded_quadrature(const PatchMesh& mesh, int threads) {
   Timer timer;
   const std::vector<PatchGeom> geom = patch_geometry(mesh);
   const std::int32_t n = mesh.size();
-  const double eps = 1e-12 * mesh.scale;  // as kPlaneEps in formfactors.cpp
+  const double eps = kPlaneEps * mesh.scale;
   std::vector<std::vector<std::pair<std::int32_t, double>>> rows(n);
   parallel_for(n, 1, threads, [&](std::int64_t b, std::int64_t e) {
     for (std::int64_t i = b; i < e; ++i)

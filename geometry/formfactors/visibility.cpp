@@ -1,0 +1,150 @@
+#include "geometry/formfactors/visibility.hpp"
+
+#include <algorithm>
+
+#include "geometry/formfactors/pairwise.hpp"
+#include "geometry/formfactors/quadrature.hpp"
+
+namespace lambert::ff {
+namespace {
+
+// Solid angle of the spherical triangle of unit vectors a, b, c (Van Oosterom & Strackee
+// 1983, stable for small triangles).
+double solid_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const double num = std::abs(a.dot(b.cross(c)));
+  const double den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
+  return 2.0 * std::atan2(num, den);
+}
+
+// Largest n · w over the spherical polygon of unit vectors w[0..m): at a vertex, at the
+// top of an edge's great arc, or 1 when n points inside the polygon.
+double max_cosine(const Eigen::Vector3d& n, const Eigen::Vector3d* w, int m) {
+  double best = -1.0;
+  bool inside = true;
+  for (int k = 0; k < m; ++k) {
+    const Eigen::Vector3d& a = w[k];
+    const Eigen::Vector3d& b = w[(k + 1) % m];
+    best = std::max(best, n.dot(a));
+    const Eigen::Vector3d c = a.cross(b);
+    const double cn = c.norm();
+    if (cn <= 0.0) continue;
+    const Eigen::Vector3d g = c / cn;  // pole of the edge's great circle
+    inside = inside && n.dot(g) <= 0.0;
+    const Eigen::Vector3d p = n - n.dot(g) * g;  // n projected onto the great circle's plane
+    if (a.cross(p).dot(g) >= 0.0 && p.cross(b).dot(g) >= 0.0) best = std::max(best, p.norm());
+  }
+  // b's front faces x, so its corners run clockwise as seen from x and the inside of every
+  // edge is where n · (w_k x w_k+1) < 0 (the sign convention of the contour formula).
+  return inside ? 1.0 : std::min(1.0, best);
+}
+
+// A direction uniform in the solid angle of the spherical triangle (a, b, c) (Arvo 1995).
+Eigen::Vector3d arvo(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                     double area, double u1, double u2) {
+  const Eigen::Vector3d nab = a.cross(b), nac = a.cross(c);
+  const double cos_alpha =
+      std::clamp(nab.dot(nac) / std::max(nab.norm() * nac.norm(), 1e-300), -1.0, 1.0);
+  const double alpha = std::acos(cos_alpha), sin_alpha = std::sin(alpha);
+  const double s = std::sin(u1 * area - alpha), t = std::cos(u1 * area - alpha);
+  const double u = t - cos_alpha, v = s + sin_alpha * a.dot(b);
+  const double den = (v * s + u * t) * sin_alpha;
+  const double q = den != 0.0 ? std::clamp(((v * t - u * s) * cos_alpha - v) / den, -1.0, 1.0) : 1.0;
+  const Eigen::Vector3d c_perp = c - c.dot(a) * a;
+  const double cpn = c_perp.norm();
+  const Eigen::Vector3d c_hat = cpn > 0.0 ? (q * a + std::sqrt(1.0 - q * q) * c_perp / cpn).eval() : a;
+  const double z = std::clamp(1.0 - u2 * (1.0 - c_hat.dot(b)), -1.0, 1.0);
+  const Eigen::Vector3d h_perp = c_hat - c_hat.dot(b) * b;
+  const double hpn = h_perp.norm();
+  return hpn > 0.0 ? (z * b + std::sqrt(1.0 - z * z) * h_perp / hpn).eval() : b;
+}
+
+}  // namespace
+
+KernelSampler::KernelSampler(const Eigen::Vector3d& x, const Eigen::Vector3d& nx,
+                             const PatchGeom& b)
+    : x_(x), nx_(nx), nb_(b.normal), plane_(b.normal.dot(b.p[0])) {
+  const double height = nb_.dot(x) - plane_;  // x's height above b's plane
+  if (!(height > 0.0)) return;               // b's back faces x: nothing to receive
+  Eigen::Vector3d r[5];
+  const int m = clip_to_horizon(x, nx, b, r);
+  if (m < 3) return;
+  Eigen::Vector3d w[5];
+  for (int k = 0; k < m; ++k) w[k] = r[k].normalized();
+  double omega[3] = {0, 0, 0}, total = 0.0;
+  for (int k = 0; k + 2 < m; ++k) total += omega[k] = solid_angle(w[0], w[k + 1], w[k + 2]);
+  if (!(total > 0.0)) return;
+  const double cos_max = max_cosine(nx, w, m);
+  area_mode_ = total < kSmallSolidAngle;
+  double measure[3] = {0, 0, 0};
+  for (int k = 0; k + 2 < m; ++k)
+    measure[k] = area_mode_ ? 0.5 * (r[k + 1] - r[0]).cross(r[k + 2] - r[0]).norm() : omega[k];
+  for (int k = 0; k < m; ++k) w_[k] = area_mode_ ? (x + r[k]).eval() : w[k];
+  triangles_ = m - 2;
+  for (int k = 0; k < triangles_; ++k) cdf_[k] = (k ? cdf_[k - 1] : 0.0) + measure[k];
+  if (area_mode_) {
+    // K = cosθ_x cosθ_y / r² with cosθ_y = height / r and r >= distance to b.
+    const double rmin = std::max(distance_to_patch(x, b), height);
+    bound_ = cos_max * height / (rmin * rmin * rmin);
+  } else {
+    bound_ = cos_max;
+  }
+}
+
+Eigen::Vector3d KernelSampler::try_once(double u0, double u1, double u2, double& accept) const {
+  const double pick = u0 * cdf_[triangles_ - 1];
+  int t = 0;
+  while (t + 1 < triangles_ && pick >= cdf_[t]) ++t;
+  const Eigen::Vector3d &a = w_[0], &b = w_[t + 1], &c = w_[t + 2];
+  if (area_mode_) {
+    const double s = std::sqrt(u1);
+    const Eigen::Vector3d y = (1.0 - s) * a + s * (1.0 - u2) * b + s * u2 * c;
+    const Eigen::Vector3d d = y - x_;
+    const double r2 = d.squaredNorm();
+    accept = r2 > 0.0 ? nx_.dot(d) * -nb_.dot(d) / (r2 * r2) / bound_ : 0.0;
+    return y;
+  }
+  const double area = cdf_[t] - (t ? cdf_[t - 1] : 0.0);
+  const Eigen::Vector3d w = arvo(a, b, c, area, u1, u2);
+  const double toward = -nb_.dot(w);
+  accept = nx_.dot(w) / bound_;
+  if (!(toward > 0.0)) {  // rounding at b's silhouette: step onto the plane from above
+    accept = 0.0;
+    return x_;
+  }
+  return x_ + (nb_.dot(x_) - plane_) / toward * w;
+}
+
+Eigen::Vector3d KernelSampler::sample(double u0, double u1, double u2, Rng& rng,
+                                      bool& exhausted) const {
+  exhausted = false;
+  Eigen::Vector3d y = x_;
+  for (int k = 0; k < kMaxTries; ++k) {
+    double accept;
+    y = try_once(u0, u1, u2, accept);
+    if (rng.uniform() < accept) return y;
+    u0 = rng.uniform();
+    u1 = rng.uniform();
+    u2 = rng.uniform();
+  }
+  exhausted = true;
+  return y;
+}
+
+int count_visible(const Bvh& bvh, const Eigen::Vector3d& x, const Eigen::Vector3d& nx,
+                  const PatchGeom& b, int rays, std::uint64_t stream, double offset,
+                  int& exhausted) {
+  const KernelSampler sampler(x, nx, b);
+  if (sampler.empty()) return 0;
+  const Kronecker4 seq(stream);
+  Rng rng(mix64(stream));
+  int seen = 0;
+  for (int r = 0; r < rays; ++r) {
+    bool gave_up;
+    const Eigen::Vector3d y = sampler.sample(seq.get(r, 0), seq.get(r, 1), seq.get(r, 2), rng, gave_up);
+    exhausted += gave_up;
+    seen += visible(bvh, x, nx, y, b.normal, offset);
+  }
+  return seen;
+}
+
+}  // namespace lambert::ff

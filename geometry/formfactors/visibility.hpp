@@ -1,0 +1,57 @@
+#pragma once
+// The visible fraction of a patch seen from a point, the one kernel shared by `hybrid`
+// and the sensor-point factors (internal).
+//
+// From a point x with normal n_x, the unoccluded factor to patch b is
+//   F(x -> b) = (1/π) ∫_b K dA_y,  K = cosθ_x cosθ_y / r²  (Lambert's contour formula),
+// and the occluded one is F(x -> b) · vis with vis = ∫_b K V dA_y / ∫_b K dA_y. Drawing y
+// with density ∝ K on b (the projected solid angle of b from x) makes every ray an
+// unbiased Bernoulli sample of vis: no ratio of weights, no Jacobian, no bias for any
+// patch shape, size or distance.
+
+#include "core/sampling.hpp"
+#include "geometry/bvh.hpp"
+#include "geometry/formfactors/kernels.hpp"
+
+namespace lambert::ff {
+
+/// Draws points of a patch with density ∝ K(x, y) from a fixed point x. Two exact methods:
+/// directions uniform in the solid angle of b's part in front of x (Arvo 1995, per triangle
+/// of its fan), kept with probability cosθ_x / (bound of cosθ_x over b); or, when b subtends
+/// under kSmallSolidAngle (where Arvo's formulas lose digits), points uniform in area, kept
+/// with probability K / (bound of K over b). Both are rejection samplers of the same density.
+class KernelSampler {
+ public:
+  KernelSampler(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& b);
+  /// True when no part of b is in front of x (nothing to sample).
+  bool empty() const { return triangles_ == 0; }
+  /// A point of b. (u0, u1, u2) uniform in [0,1)^3 drive the first try (stratification);
+  /// further tries draw from rng. After kMaxTries rejections the last try is returned and
+  /// `exhausted` is set (never seen in practice: acceptance is >= ~cos of b's elevation).
+  Eigen::Vector3d sample(double u0, double u1, double u2, Rng& rng, bool& exhausted) const;
+
+  /// Solid angles below this (sr) use area sampling: ~1e-16 / 1e-4 relative precision of
+  /// Arvo's spherical-excess arithmetic, and a patch that small is nearly uniform in K.
+  static constexpr double kSmallSolidAngle = 1e-4;
+  /// Tries before giving up on the rejection.
+  static constexpr int kMaxTries = 4096;
+
+ private:
+  Eigen::Vector3d try_once(double u0, double u1, double u2, double& accept) const;
+  Eigen::Vector3d x_, nx_, nb_;
+  double plane_ = 0.0;            // n_b · p_b
+  Eigen::Vector3d w_[5];          // clipped corners (unit directions, or points in area mode)
+  double cdf_[3] = {0, 0, 0};     // fan triangles (0, k+1, k+2), cumulative measure
+  int triangles_ = 0;
+  bool area_mode_ = false;
+  double bound_ = 1.0;            // upper bound of the acceptance numerator
+};
+
+/// Number of `rays` visibility rays from x (normal nx, on a patch) to points of b drawn by
+/// KernelSampler that reach b unblocked. `stream` seeds the lattice; `exhausted` counts
+/// rejection give-ups. Ray ends are lifted by `offset` along their normals.
+int count_visible(const Bvh& bvh, const Eigen::Vector3d& x, const Eigen::Vector3d& nx,
+                  const PatchGeom& b, int rays, std::uint64_t stream, double offset,
+                  int& exhausted);
+
+}  // namespace lambert::ff
