@@ -2,6 +2,7 @@
 
 #include "core/log.hpp"
 #include "core/progress.hpp"
+#include "geometry/formfactors/analysis.hpp"
 #include "io/ff_file.hpp"
 
 namespace lambert {
@@ -54,6 +55,12 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
            format_si(static_cast<double>(ff.stats.rays)) + " rays in " +
            format_duration(ff.stats.seconds));
   return ff;
+}
+
+void warn_about_lighting(const PatchMesh& mesh, const SparseF& F, bool solving) {
+  LightingProblems p = find_lighting_problems(mesh, F);
+  p.no_emitter = p.no_emitter && solving;
+  for (const std::string& line : lighting_warnings(mesh, p)) log_warn(line);
 }
 
 }  // namespace lambert

@@ -31,4 +31,9 @@ FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run
 FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& args,
                                 const RunArgs& run, bool with_stderr = false);
 
+/// Warns once per cause (analysis.hpp's find_lighting_problems) when F makes the result
+/// silently B = E: nothing sees anything, or an emitter sees nothing. `solving` adds the
+/// no-emitter warning (F by itself needs no emitter).
+void warn_about_lighting(const PatchMesh& mesh, const SparseF& F, bool solving);
+
 }  // namespace lambert

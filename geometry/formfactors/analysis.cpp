@@ -51,6 +51,56 @@ FormFactorDiagnostics diagnose(const PatchMesh& mesh, const SparseF& F, int wors
   return d;
 }
 
+LightingProblems find_lighting_problems(const PatchMesh& mesh, const SparseF& F) {
+  const std::int32_t n = mesh.size();
+  LAMBERT_CHECK(F.rows() == n && F.cols() == n, "F does not match the mesh");
+  LightingProblems p;
+  p.pairs = static_cast<std::int64_t>(n) * (n - 1) / 2;
+  const auto surfaces = mesh.surface_names.size();
+  std::vector<char> emits(surfaces, 0), sees(surfaces, 0);
+  bool any_visible = false;
+  for (std::int32_t i = 0; i < n; ++i) {
+    const Patch& patch = mesh.patches[i];
+    bool row_sees = false;
+    for (SparseF::InnerIterator it(F, i); it && !row_sees; ++it) row_sees = it.value() > 0.0;
+    any_visible = any_visible || row_sees;
+    if (patch.emission.maxCoeff() > 0.0) {
+      emits.at(patch.surface) = 1;
+      sees.at(patch.surface) = sees.at(patch.surface) || row_sees;
+    }
+  }
+  p.no_emitter = std::find(emits.begin(), emits.end(), 1) == emits.end();
+  p.nothing_visible = n >= 2 && !any_visible;
+  if (!p.nothing_visible)
+    for (size_t s = 0; s < surfaces; ++s)
+      if (emits[s] && !sees[s]) p.blind_emitters.push_back(static_cast<std::int32_t>(s));
+  return p;
+}
+
+std::vector<std::string> lighting_warnings(const PatchMesh& mesh, const LightingProblems& p) {
+  std::vector<std::string> lines;
+  if (p.no_emitter)
+    lines.push_back("no surface emits: every radiosity is 0; give a material Ke in the MTL");
+  if (p.nothing_visible)
+    lines.push_back("no patch faces any other (F is zero for all " + std::to_string(p.pairs) +
+                    " patch pairs): the scene may be inside out or its winding inverted — "
+                    "lambert lights the front (counter-clockwise) side");
+  if (!p.blind_emitters.empty()) {
+    constexpr size_t kNamed = 5;  // enough to recognise the surfaces, short enough for one line
+    std::string names;
+    for (size_t k = 0; k < std::min(kNamed, p.blind_emitters.size()); ++k)
+      names += (k ? ", '" : "'") + mesh.surface_names.at(p.blind_emitters[k]) + "'";
+    if (p.blind_emitters.size() > kNamed)
+      names += " and " + std::to_string(p.blind_emitters.size() - kNamed) + " more";
+    const bool one = p.blind_emitters.size() == 1;
+    lines.push_back(std::string(one ? "emitter " : "emitters ") + names + (one ? " sees" : " see") +
+                    " nothing from " + (one ? "its" : "their") +
+                    " front side: " + (one ? "its normal" : "their normals") +
+                    " may point away from the scene (inverted winding)");
+  }
+  return lines;
+}
+
 SurfaceFactors surface_factors(const PatchMesh& mesh, const FormFactors& ff) {
   SurfaceFactors out;
   const auto s = static_cast<Eigen::Index>(mesh.surface_names.size());

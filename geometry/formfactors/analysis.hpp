@@ -29,6 +29,26 @@ struct FormFactorDiagnostics {
 /// Computes the diagnostics; `worst` rows are reported. O(nnz log) time.
 FormFactorDiagnostics diagnose(const PatchMesh& mesh, const SparseF& F, int worst = 5);
 
+/// Why a scene would silently come out as B = E (or all zero), found from the mesh's
+/// emission and F alone, so it holds for any estimator and for an F loaded from a file.
+struct LightingProblems {
+  bool no_emitter = false;       ///< no patch has E > 0 in any channel
+  bool nothing_visible = false;  ///< at least 2 patches and no positive entry in F
+  std::int64_t pairs = 0;        ///< unordered patch pairs, N (N - 1) / 2
+  /// Emitting surfaces none of whose patches has a positive entry in its row of F (a tiny
+  /// but nonzero row sum is not listed); empty when nothing_visible, which explains them.
+  std::vector<std::int32_t> blind_emitters;
+  /// True when any problem was found.
+  bool any() const { return no_emitter || nothing_visible || !blind_emitters.empty(); }
+};
+
+/// Finds the problems above. O(N + nnz) time; F must be N x N for the mesh's N patches.
+LightingProblems find_lighting_problems(const PatchMesh& mesh, const SparseF& F);
+
+/// One line per problem found (without a "warning: " prefix), naming the surfaces involved
+/// and the likely cause.
+std::vector<std::string> lighting_warnings(const PatchMesh& mesh, const LightingProblems& p);
+
 /// Surface-to-surface factors F_GH = Σ_{i∈G} A_i Σ_{j∈H} F_ij / A_G and standard errors.
 struct SurfaceFactors {
   std::vector<std::string> surfaces;
