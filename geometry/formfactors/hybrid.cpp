@@ -14,8 +14,7 @@
 // Unoccluded pairs get G0 exactly (V = 1) and fully blocked ones exactly 0. The ratio of
 // weights is consistent with a bias O(Var(w) / k), far below the statistical error (w
 // varies by ~10 % within a cell). The standard error comes from R independent replicates
-// (replicates.hpp) and covers sampling only; the quadrature error (< 1e-6 relative) is not
-// included. Cost per pair: the quadrature nodes (9 .. ~500 contour evaluations) + k rays.
+// (replicates.hpp) plus the quadrature's error bound, 1e-6 G0 (kQuadratureTolerance). Cost per pair: the quadrature nodes (9 .. ~500 contour evaluations) + k rays.
 
 #include <algorithm>
 
@@ -96,7 +95,11 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
     return est;
   }
   est.G = G0 * num / den;
-  est.var = replicate_variance(replicate, R);
+  // Sampling variance plus the quadrature's error bound (kQuadratureTolerance of G0, the
+  // worst case measured by the sweep in tests/geometry/quadrature_test.cpp), so that the
+  // error bar of an unoccluded pair (no sampling error) is not zero.
+  const double quad = kQuadratureTolerance * G0;
+  est.var = replicate_variance(replicate, R) + quad * quad;
   est.unverified = unverified;
   return est;
 }

@@ -1,0 +1,155 @@
+// Error bars that mean what they say: over many occluded and unoccluded configurations,
+// near and far, equal and unequal sizes, and seeds, the exact factor lies within ± 2
+// stderr of the estimate in at least 95 % of cases, and the reported stderr matches the
+// spread of the estimates over seeds within a factor of 1.5 (issue: mc's was 3-11 x).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "geometry/analytic.hpp"
+#include "geometry/formfactors/formfactors.hpp"
+
+namespace lambert {
+namespace {
+
+const Material kGrey{"m", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
+
+// Emitter a = [0, wa] x [0, wa] at z = 0 (up), receiver b = [ox, ox + wb] x [0, wb] at
+// z = h (down). A plate 1e-3 off one of them (just in front of b, or just above a; 100 x
+// the ray offset, 1e-6 of the scene's diagonal) hides its part x > cut; the exact G is
+// then the closed form of the unhidden rectangle (the plate's penumbra on the hidden
+// patch is < 1e-3 / h wide: ~1e-3 relative, < 1/20 of the smallest stderr tested).
+struct Config {
+  double wa, wb, h, ox, cut;
+  bool near_receiver;  // plate in front of b (else just above a); cut < 0: no plate
+};
+
+Scene scene_of(const Config& c) {
+  Scene s;
+  add_polygon(s, "a", kGrey, {{0, 0, 0}, {c.wa, 0, 0}, {c.wa, c.wa, 0}, {0, c.wa, 0}});
+  add_polygon(s, "b", kGrey,
+              {{c.ox, 0, c.h}, {c.ox, c.wb, c.h}, {c.ox + c.wb, c.wb, c.h}, {c.ox + c.wb, 0, c.h}});
+  if (c.cut >= 0.0) {
+    const double z = c.near_receiver ? c.h - 1e-3 : 1e-3, far = 3.0;
+    add_polygon(s, "plate", kGrey, {{c.cut, -far, z}, {far, -far, z}, {far, far, z}, {c.cut, far, z}});
+  }
+  return s;
+}
+
+double exact_G(const Config& c) {
+  double ax1 = c.wa, bx0 = c.ox, bx1 = c.ox + c.wb;
+  if (c.cut >= 0.0 && c.near_receiver) bx1 = std::min(bx1, c.cut);
+  if (c.cut >= 0.0 && !c.near_receiver) ax1 = std::min(ax1, c.cut);
+  if (bx1 <= bx0 || ax1 <= 0.0) return 0.0;
+  return parallel_rectangles_G(0, ax1, 0, c.wa, bx0, bx1, 0, c.wb, c.h);
+}
+
+std::vector<Config> configs() {
+  std::vector<Config> out;
+  for (double h : {0.3, 1.0, 3.0})                                      // near .. far
+    for (auto [wa, wb] : {std::pair{1.0, 1.0}, {0.2, 1.0}, {1.0, 0.2}})  // sizes 1:1, 1:5, 5:1
+      for (bool near_receiver : {true, false}) {
+        const double w = near_receiver ? wb : wa, x0 = near_receiver ? 0.1 : 0.0;
+        out.push_back({wa, wb, h, x0, x0 + 0.5 * w, near_receiver});   // half hidden
+        out.push_back({wa, wb, h, x0, x0 + 0.2 * w, near_receiver});   // mostly hidden
+      }
+  out.push_back({1.0, 1.0, 1.0, 0.0, -1.0, true});  // unoccluded
+  out.push_back({0.2, 1.0, 0.3, 0.4, -1.0, true});
+  return out;
+}
+
+void calibrate(const std::string& estimator, int samples) {
+  constexpr int kSeeds = 12;
+  int inside = 0, total = 0;
+  std::uint64_t stream = 0;
+  double rel_reported2 = 0.0, rel_spread2 = 0.0;
+  for (const Config& c : configs()) {
+    const PatchMesh mesh = mesh_scene(scene_of(c), {});
+    const double exact = exact_G(c);
+    std::vector<double> est;
+    double var_sum = 0.0;
+    for (int seed = 1; seed <= kSeeds; ++seed) {
+      FormFactorOptions o;
+      o.estimator = estimator;
+      o.samples = samples;
+      // A fresh seed per case: the same seed in every configuration would reuse the same
+      // random shifts (streams hash the seed with the patch indices, 0 and 1 in every
+      // scene), making the cases' misses correlated.
+      o.seed = 1000 * ++stream + seed;
+      o.with_stderr = true;
+      o.progress = false;
+      const FormFactors ff = compute_form_factors(mesh, o);
+      const double G = ff.F.coeff(0, 1) * mesh.patches[0].area;
+      const double se = ff.stderr_F.coeff(0, 1) * mesh.patches[0].area;
+      inside += std::abs(G - exact) <= 2.0 * se;
+      ++total;
+      est.push_back(G);
+      var_sum += se * se;
+    }
+    double mean = 0.0, s2 = 0.0;
+    for (double g : est) mean += g / kSeeds;
+    for (double g : est) s2 += (g - mean) * (g - mean) / (kSeeds - 1);
+    const double spread = std::sqrt(s2), reported = std::sqrt(var_sum / kSeeds);
+    // Unoccluded hybrid pairs have no sampling error (spread 0): skipped.
+    if (spread > 1e-6 * exact) {
+      // One configuration: the spread over 12 seeds of a few-ray estimate is itself
+      // uncertain by ~1/sqrt(2 * 11) = 21 % for normal errors and more for the skewed
+      // ones (measured over 200 seeds, every configuration here has a ratio of 1.15-1.3):
+      // a gross check only, [1/4, 4].
+      EXPECT_GT(reported / spread, 0.25) << estimator << " h " << c.h << " cut " << c.cut;
+      EXPECT_LT(reported / spread, 4.0) << estimator << " h " << c.h << " cut " << c.cut;
+      rel_reported2 += reported * reported / (exact * exact);
+      rel_spread2 += s2 / (exact * exact);
+    }
+  }
+  // Pooled over the ~36 occluded configurations (each a relative spread), the ratio is
+  // known to ~1/sqrt(2 * 36 * 11) = 3.6 %: within a factor of 1.5 as the issue asks.
+  const double pooled = std::sqrt(rel_reported2 / rel_spread2);
+  EXPECT_GT(pooled, 1.0 / 1.5) << estimator;
+  EXPECT_LT(pooled, 1.5) << estimator;
+  // >= 95 % within 2 stderr; the stderr is scaled for 97 % (replicates.hpp), and with
+  // 456 cases the binomial spread of the observed coverage is 0.8 %: 95 % is 2.5σ below.
+  EXPECT_GE(inside, 0.95 * total) << estimator << ": " << inside << " of " << total;
+  std::printf("%s: %d of %d (%.1f %%) within 2 stderr; reported / spread %.2f\n",
+              estimator.c_str(), inside, total, 100.0 * inside / total, pooled);
+}
+
+}  // namespace
+
+TEST(ErrorBars, HybridCoverageAndSpreadAreCalibrated) { calibrate("hybrid", 64); }
+TEST(ErrorBars, McCoverageAndSpreadAreCalibrated) { calibrate("mc", 256); }
+
+// A tapered receiver (width 2 -> 0.1) with its narrow half hidden: sampling a bilinear
+// quad uniformly in (u, v) without its Jacobian weighted the visible fraction by the
+// parametrisation (10-15 % low). The exact G is the unoccluded G to the wide half, which
+// hybrid's quadrature gives to 1e-6 (quadrature_test.cpp).
+TEST(ErrorBars, TaperedHalfShadedReceiverIsWithinThreeSigma) {
+  Scene open, shaded;
+  add_polygon(open, "a", kGrey, {{-1, 0, 0}, {1, 0, 0}, {1, 2, 0}, {-1, 2, 0}});
+  add_polygon(open, "wide", kGrey, {{-1, 0, 1}, {-0.525, 1, 1}, {0.525, 1, 1}, {1, 0, 1}});
+  add_polygon(shaded, "a", kGrey, {{-1, 0, 0}, {1, 0, 0}, {1, 2, 0}, {-1, 2, 0}});
+  add_polygon(shaded, "b", kGrey, {{-1, 0, 1}, {-0.05, 2, 1}, {0.05, 2, 1}, {1, 0, 1}});
+  add_polygon(shaded, "plate", kGrey, {{-3, 1, 1 - 1e-3}, {3, 1, 1 - 1e-3}, {3, 4, 1 - 1e-3}, {-3, 4, 1 - 1e-3}});
+  FormFactorOptions o;
+  o.samples = 4;
+  o.progress = false;
+  const PatchMesh open_mesh = mesh_scene(open, {});
+  const double exact = compute_form_factors(open_mesh, o).F.coeff(0, 1) * open_mesh.patches[0].area;
+  const PatchMesh mesh = mesh_scene(shaded, {});
+  ASSERT_EQ(mesh.patches[1].vertex_count, 4);  // one non-parallelogram quad
+  for (const std::string est : {"hybrid", "mc"}) {
+    o.estimator = est;
+    o.samples = 1 << 14;
+    o.with_stderr = true;
+    const FormFactors ff = compute_form_factors(mesh, o);
+    const double G = ff.F.coeff(0, 1) * mesh.patches[0].area;
+    const double se = ff.stderr_F.coeff(0, 1) * mesh.patches[0].area;
+    // 3 stderr (two-sided false alarm < 0.3 %) plus the plate's penumbra: it is 1e-3 in
+    // front of b, so its shadow edge on b moves by <= 1e-3 x (Δy / Δz <= 2): a band of
+    // 2e-3 x 1.05 of b's 2.1 area, 1e-3 of G (2e-3 allowed).
+    EXPECT_NEAR(G, exact, 3 * se + 2e-3 * exact) << est << " se " << se;
+  }
+}
+
+}  // namespace lambert
