@@ -48,13 +48,11 @@ std::string csv_number(double v) {
   return buf;
 }
 
-void write_energy_json(JsonWriter& j, const EnergyBalance& e) {
-  j.begin_object();
-  j.field("emitted", e.emitted);
-  j.field("absorbed", e.absorbed);
-  j.field("escaped", e.escaped);
-  j.field("relative_imbalance", e.relative_imbalance);
-  j.end_object();
+Json energy_json(const EnergyBalance& e) {
+  return {{"emitted", e.emitted},
+          {"absorbed", e.absorbed},
+          {"escaped", e.escaped},
+          {"relative_imbalance", e.relative_imbalance}};
 }
 
 }  // namespace lambert

@@ -16,8 +16,8 @@ void add_solve_options(CLI::App* cmd, SolveOptions& options, bool with_solver);
 /// "R", "G" or "B".
 const char* channel_name(int channel);
 
-/// Writes an energy balance as a JSON object {emitted, absorbed, escaped, relative_imbalance}.
-void write_energy_json(JsonWriter& j, const EnergyBalance& e);
+/// An energy balance as a JSON object {emitted, absorbed, escaped, relative_imbalance}.
+Json energy_json(const EnergyBalance& e);
 
 /// Quotes a CSV field when it holds a comma, quote or newline (RFC 4180).
 std::string csv_field(const std::string& s);
