@@ -15,11 +15,10 @@
 namespace lambert {
 namespace {
 
+// The settings stored with a saved F (recovered by `--ff`) and written to its report.
 std::string settings_string(const FormFactorOptions& o, const LoadedScene& s) {
   std::ostringstream ss;
-  ss << "estimator=" << o.estimator << " samples=" << o.samples << " seed=" << o.seed
-     << " threshold=" << o.threshold << " patches=" << s.mesh.size() << " max_edge=" << s.max_edge;
-  if (o.estimator == "hemicube") ss << " hemicube_res=" << o.hemicube_resolution << " symmetrize=" << o.symmetrize;
+  ss << format_ff_settings(o) << " patches=" << s.mesh.size() << " max_edge=" << s.max_edge;
   return ss.str();
 }
 

@@ -31,14 +31,14 @@ struct StageTimes {
   double total() const { return load + form_factors + solve + vertices + render + write; }
 };
 
-std::string run_settings(const RunOptions& o, const LoadedScene& s, const Camera& cam) {
+std::string run_settings(const RunOptions& o, const LoadedScene& s, const RadiosityResult& r,
+                         const Camera& cam) {
   std::ostringstream ss;
-  ss << "patches=" << s.mesh.size() << " max_edge=" << s.max_edge;
-  if (!o.ff.ff_file.empty()) ss << " ff=" << o.ff.ff_file;
-  ss << " estimator=" << o.ff.estimator << " samples=" << o.ff.samples << " seed=" << o.run.seed
-     << " solver=" << o.solver.solver << " tol=" << o.solver.tol
-     << " interp=" << o.shade.vertex_interp << " shading=" << (o.shade.flat ? "flat" : "gouraud")
-     << " antialias=" << o.shade.antialias << " size=" << cam.width << "x" << cam.height;
+  ss << "patches=" << s.mesh.size() << " max_edge=" << s.max_edge << ' '
+     << ff_settings_text(r.ff_options, o.ff.ff_file) << " solver=" << o.solver.solver
+     << " tol=" << o.solver.tol << " interp=" << o.shade.vertex_interp
+     << " shading=" << (o.shade.flat ? "flat" : "gouraud") << " antialias=" << o.shade.antialias
+     << " render_seed=" << o.run.seed << " size=" << cam.width << "x" << cam.height;
   return ss.str();
 }
 
@@ -64,13 +64,10 @@ Json report_json(const Report& rp) {
             {"patches", rp.loaded.mesh.size()},
             {"shading_vertices", rp.shaded.field.size()},
             {"surfaces", rp.loaded.mesh.surface_names.size()}};
-  j["form_factors"] = {{"estimator", rp.opts.ff.estimator},
-                       {"samples", rp.opts.ff.samples},
-                       {"seed", rp.opts.run.seed},
-                       {"loaded_from", rp.opts.ff.ff_file},
-                       {"entries", r.ff_entries},
-                       {"pairs_tested", r.ff_stats.pairs_tested},
-                       {"rays", r.ff_stats.rays}};
+  Json& ff = j["form_factors"] = ff_settings_json(r.ff_options, rp.opts.ff.ff_file);
+  ff["entries"] = r.ff_entries;
+  ff["pairs_tested"] = r.ff_stats.pairs_tested;
+  ff["rays"] = r.ff_stats.rays;
 
   Json channels = Json::array();
   for (const auto& c : r.solution.channels)
@@ -240,7 +237,7 @@ int run_run(const RunOptions& opts) {
   paths.png = (dir / (name + ".png")).string();
   paths.vertex_exr = (dir / (name + "_vertices.exr")).string();
   paths.ply = (dir / (name + ".ply")).string();
-  const std::string settings = run_settings(opts, loaded, camera);
+  const std::string settings = run_settings(opts, loaded, r, camera);
   std::vector<std::string> files = write_outputs(paths, loaded.mesh, shaded, image, ev, settings);
   const std::string report_path = (dir / "report.json").string();
   files.push_back(report_path);

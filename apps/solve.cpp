@@ -106,6 +106,7 @@ int run_solve(const SolveCommandOptions& opts) {
               {"form_factors_seconds", ff_seconds},
               {"form_factors_source", opts.ff.ff_file.empty() ? "computed" : opts.ff.ff_file},
               {"solve_seconds", sol.seconds}}},
+            {"form_factors", ff_settings_json(ff.options, opts.ff.ff_file)},
             {"form_factor_nonzeros", ff.F.nonZeros()}};
   Json& channels = j["channels"] = Json::array();
   for (int c = 0; c < 3; ++c) channels.push_back(channel_json(sol.channels[c], sol.energy[c], c));

@@ -6,18 +6,19 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "apps/cli.hpp"
-#include "common/run_cli.hpp"
 #include "apps/common.hpp"
 #include "apps/problem.hpp"
+#include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
 #include "geometry/formfactors/formfactors.hpp"
+#include "io/exr.hpp"
+#include "io/ff_file.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
@@ -123,6 +124,100 @@ TEST(SolveCommand, BadSolverOptionsAreUsageErrors) {
   EXPECT_EQ(run(with_fast({"solve", "--solver", "cg", "--preconditioner", "ilut", "-o", csv})),
             kExitUsage);
   EXPECT_FALSE(std::filesystem::exists(csv));
+}
+
+// The settings a report or image states for its F.
+void expect_mc_64_5(const nlohmann::json& ff, const std::string& file) {
+  EXPECT_EQ(ff.at("estimator"), "mc") << file;
+  EXPECT_EQ(ff.at("samples").get<int>(), 64) << file;
+  EXPECT_EQ(ff.at("seed").get<std::uint64_t>(), 5u) << file;
+  EXPECT_EQ(ff.at("threshold").get<double>(), 1e-4) << file;  // %.17g reads back exactly
+  EXPECT_EQ(ff.at("loaded_from"), file);
+}
+void expect_mc_64_5(const std::string& exr_settings) {
+  FormFactorOptions o;
+  ASSERT_TRUE(parse_ff_settings(exr_settings, o)) << exr_settings;
+  EXPECT_EQ(o.estimator, "mc") << exr_settings;
+  EXPECT_EQ(o.samples, 64) << exr_settings;
+  EXPECT_EQ(o.seed, 5u) << exr_settings;
+}
+
+TEST(SolveCommand, LoadedFormFactorsReportTheSettingsThatMadeThem) {
+  testing::TempDir dir;
+  const std::vector<std::string> mesh = {"-q", "--patches", "150"};
+  const auto cmd = [&](std::vector<std::string> args) {
+    args.insert(args.end(), mesh.begin(), mesh.end());
+    return args;
+  };
+  for (const std::string& f : {std::string("F.bin"), std::string("F.mtx")}) {
+    const std::string file = dir.file(f);
+    ASSERT_EQ(run(cmd({"formfactors", "--estimator", "mc", "--samples", "64", "--seed", "5",
+                       "--threshold", "1e-4", "-o", file})),
+              kExitOk);
+    ASSERT_EQ(run(cmd({"solve", "--ff", file, "-o", dir.file("B.csv")})), kExitOk) << f;
+    expect_mc_64_5(read_json(dir.file("B.json")).at("form_factors"), file);
+  }
+  const std::string file = dir.file("F.bin");
+  ::testing::internal::CaptureStdout();
+  const int code = run(cmd({"run", "--ff", file, "-o", dir.file("out"), "--size", "8x8"}));
+  ::testing::internal::GetCapturedStdout();
+  ASSERT_EQ(code, kExitOk);
+  const nlohmann::json report = read_json(dir.file("out/report.json"));
+  expect_mc_64_5(report.at("form_factors"), file);
+  expect_mc_64_5(report.at("settings").get<std::string>());
+  ExrInfo info;
+  read_image_exr(dir.file("out/cornell.exr"), &info);
+  expect_mc_64_5(info.settings);
+  ::testing::internal::CaptureStdout();
+  ASSERT_EQ(run(cmd({"render", "--ff", file, "-o", dir.file("r.exr"), "--size", "8x8"})), kExitOk);
+  ::testing::internal::GetCapturedStdout();
+  read_image_exr(dir.file("r.exr"), &info);
+  expect_mc_64_5(info.settings);
+
+  // A foreign Matrix Market file (the mesh hash but no settings line): unknown, not defaults.
+  std::string foreign;
+  for (const auto& line : read_lines(dir.file("F.mtx")))
+    if (line.rfind("% lambert-settings:", 0) != 0) foreign += line + "\n";
+  const std::string foreign_file = dir.write("foreign.mtx", foreign);
+  ::testing::internal::CaptureStderr();
+  ::testing::internal::CaptureStdout();
+  const int foreign_code =  // without -q, which silences warnings too
+      run({"solve", "--patches", "150", "--ff", foreign_file, "-o", dir.file("B.csv")});
+  ::testing::internal::GetCapturedStdout();
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  ASSERT_EQ(foreign_code, kExitOk) << err;
+  EXPECT_NE(err.find("records no form-factor settings"), std::string::npos) << err;
+  const nlohmann::json ff = read_json(dir.file("B.json")).at("form_factors");
+  for (const char* key :
+       {"estimator", "samples", "seed", "threshold", "hemicube_resolution", "symmetrize"})
+    EXPECT_TRUE(ff.at(key).is_null()) << key;
+}
+
+TEST(SolveCommand, OptionsThatOnlySteerAComputationAreRefusedWithFf) {
+  testing::TempDir dir;
+  const std::string file = dir.file("F.bin");
+  ASSERT_EQ(run({"formfactors", "-q", "--patches", "60", "--samples", "2", "-o", file}), kExitOk);
+  for (const std::vector<std::string>& extra : {std::vector<std::string>{"--estimator", "mc"},
+                                                {"--samples", "8"},
+                                                {"--threshold", "0.1"},
+                                                {"--hemicube-res", "64"},
+                                                {"--symmetrize"}}) {
+    // Outputs that would be accepted, so that only the option clash can refuse the command.
+    for (const auto& [command, output] :
+         std::vector<std::pair<std::string, std::string>>{{"solve", dir.file("B.csv")},
+                                                          {"run", dir.file("out")},
+                                                          {"render", dir.file("r.exr")},
+                                                          {"compare", dir.file("c/")}}) {
+      std::vector<std::string> args = {command, "-q", "--patches", "60",
+                                       "--ff",  file, "-o",        output};
+      args.insert(args.end(), extra.begin(), extra.end());
+      ::testing::internal::CaptureStderr();
+      EXPECT_EQ(run(args), kExitUsage) << command << ' ' << extra[0];
+      const std::string err = ::testing::internal::GetCapturedStderr();
+      EXPECT_NE(err.find(extra[0] + " excludes --ff"), std::string::npos) << err;
+      EXPECT_FALSE(std::filesystem::exists(output)) << command << ' ' << extra[0];
+    }
+  }
 }
 
 TEST(CompareCommand, WritesTableHistoriesAndPlots) {
