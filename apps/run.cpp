@@ -107,9 +107,9 @@ Json report_json(const Report& rp) {
                  {"shading", rp.opts.shade.flat ? "flat" : "gouraud"},
                  {"rays", rp.render.rays},
                  {"exposure_ev", rp.ev}};
-  j["seconds"] = {{"load_and_mesh", rp.t.load},     {"form_factors", rp.t.form_factors},
-                  {"solve", rp.t.solve},            {"vertices", rp.t.vertices},
-                  {"render", rp.t.render},          {"write", rp.t.write},
+  j["seconds"] = {{"load_and_mesh", rp.t.load}, {"form_factors", rp.t.form_factors},
+                  {"solve", rp.t.solve},        {"vertices", rp.t.vertices},
+                  {"render", rp.t.render},      {"write", rp.t.write},
                   {"total", rp.t.total()}};
   j["rays_total"] = r.ff_stats.rays + rp.render.rays;
   j["files"] = rp.files;

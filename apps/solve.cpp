@@ -35,12 +35,9 @@ void write_radiosity_csv(const std::string& path, const PatchMesh& mesh,
 }
 
 Json channel_json(const ChannelReport& r, const EnergyBalance& e, int c) {
-  Json j = {{"channel", channel_name(c)},
-            {"status", to_string(r.status)},
-            {"iterations", r.iterations},
-            {"matvecs", r.matvecs},
-            {"residual", r.residual},
-            {"seconds", r.seconds}};
+  Json j = {{"channel", channel_name(c)}, {"status", to_string(r.status)},
+            {"iterations", r.iterations}, {"matvecs", r.matvecs},
+            {"residual", r.residual},     {"seconds", r.seconds}};
   if (!r.note.empty()) j["note"] = r.note;
   j["energy"] = energy_json(e);
   j["history"] = {{"iteration", r.history_iteration},

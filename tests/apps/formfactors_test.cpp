@@ -1,9 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "apps/cli.hpp"
 #include "common/run_cli.hpp"
@@ -15,9 +14,9 @@ using testing::run;
 using testing::slurp;
 namespace {
 
-
-
-nlohmann::json parse_json_file(const std::string& path) { return nlohmann::json::parse(slurp(path)); }
+nlohmann::json parse_json_file(const std::string& path) {
+  return nlohmann::json::parse(slurp(path));
+}
 
 // The inside of a unit cube as an OBJ file (faces wound to point inwards).
 const char* kCubeObj =
@@ -97,7 +96,8 @@ TEST(FormFactorsCommand, SavedMatrixIsRefusedForAnotherMeshing) {
   // ulp of 1).
   EXPECT_LE(report.at("reciprocity_max").get<double>(), 1e-14);
   EXPECT_EQ(report.at("patches").get<int>(), 24);  // six unit faces at --max-edge 0.5: 2 x 2 each
-  EXPECT_EQ(report.at("nnz").get<std::int64_t>(), 24 * 20);  // every patch sees all but its face's 4
+  EXPECT_EQ(report.at("nnz").get<std::int64_t>(),
+            24 * 20);  // every patch sees all but its face's 4
   EXPECT_EQ(report.at("entries_negative").get<int>(), 0);
   EXPECT_EQ(run({"formfactors", "-q", "-o", dir.file("x.bin"), "--estimator", "nope"}), kExitUsage);
 }
