@@ -131,11 +131,11 @@ void print_summary(const Report& rp) {
     std::printf(" %s %d it (res %.2g)", channel[c], r.solution.channels[c].iterations,
                 r.solution.channels[c].residual);
   std::printf("\n");
-  std::printf("energy     emitted / absorbed / escaped (W), relative imbalance:\n");
+  std::printf("energy     emitted / absorbed / escaped (W), relative imbalance (its parts):\n");
   for (int c = 0; c < 3; ++c) {
     const auto& e = r.solution.energy[c];
-    std::printf("           %s %.6g / %.6g / %.6g, %.2e\n", channel[c], e.emitted, e.absorbed,
-                e.escaped, e.relative_imbalance);
+    std::printf("           %s %.6g / %.6g / %.6g, %.2e (%s)\n", channel[c], e.emitted, e.absorbed,
+                e.escaped, e.relative_imbalance, energy_split_text(e).c_str());
   }
   const auto [after, before] = worst_power_error(rp.shaded.power);
   std::printf(

@@ -35,9 +35,10 @@ void write_radiosity_csv(const std::string& path, const PatchMesh& mesh,
 }
 
 Json channel_json(const ChannelReport& r, const EnergyBalance& e, int c) {
-  Json j = {{"channel", channel_name(c)}, {"status", to_string(r.status)},
-            {"iterations", r.iterations}, {"matvecs", r.matvecs},
-            {"residual", r.residual},     {"seconds", r.seconds}};
+  Json j = {{"channel", channel_name(c)},  {"status", to_string(r.status)},
+            {"iterations", r.iterations},  {"matvecs", r.matvecs},
+            {"residual", r.residual},      {"seconds", r.seconds},
+            {"refinements", r.refinements}};
   if (!r.note.empty()) j["note"] = r.note;
   j["energy"] = energy_json(e);
   j["history"] = {{"iteration", r.history_iteration},
@@ -120,10 +121,10 @@ int run_solve(const SolveCommandOptions& opts) {
     const ChannelReport& r = sol.channels[c];
     std::printf(
         "  %s: %-15s %6d iterations %8lld matvecs  residual %.3e  %.4fs  energy "
-        "emitted %.6g absorbed %.6g escaped %.6g (imbalance %.2e)\n",
+        "emitted %.6g absorbed %.6g escaped %.6g (imbalance %.2e: %s)\n",
         channel_name(c), to_string(r.status), r.iterations, static_cast<long long>(r.matvecs),
         r.residual, r.seconds, sol.energy[c].emitted, sol.energy[c].absorbed, sol.energy[c].escaped,
-        sol.energy[c].relative_imbalance);
+        sol.energy[c].relative_imbalance, energy_split_text(sol.energy[c]).c_str());
   }
   std::printf("wrote %s and %s\n", opts.output.c_str(), json_path.c_str());
   if (sol.status != SolveStatus::Converged) {
