@@ -61,7 +61,8 @@ TEST(FormFactorsCommand, BySurfaceTableIsReciprocalAndRowsOfTheClosedCubeSumToOn
             kExitOk);
   const nlohmann::json json = parse_json_file(out);
   ASSERT_EQ(json.at("surfaces").size(), 6u);
-  // Six unit faces.
+  // Six unit faces, each the sum of four 0.5 x 0.5 patches (exact in binary): 1e-15 is a
+  // few ulp of 1.
   for (const auto& area : json.at("areas")) EXPECT_NEAR(area.get<double>(), 1.0, 1e-15);
   const auto F = json.at("F").get<std::vector<std::vector<double>>>();
   const auto err = json.at("stderr").get<std::vector<std::vector<double>>>();
