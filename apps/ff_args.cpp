@@ -8,22 +8,32 @@
 namespace lambert {
 
 void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load) {
-  cmd->add_option("--estimator", args.estimator, "Form-factor estimator")
-      ->check(CLI::IsMember(form_factor_estimators()))
-      ->capture_default_str();
-  cmd->add_option("--samples", args.samples, "Sample pairs (rays) per patch pair")
-      ->check(CLI::Range(1, 1 << 20))
-      ->capture_default_str();
-  cmd->add_option("--threshold", args.threshold, "Drop form factors below this value")
-      ->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--hemicube-res", args.hemicube_resolution,
-                  "Hemicube top-face resolution (estimator hemicube)")
-      ->check(CLI::Range(4, 8192))
-      ->capture_default_str();
-  cmd->add_flag("--symmetrize", args.symmetrize,
-                "Average A_i F_ij and A_j F_ji (for non-reciprocal estimators)");
-  if (with_load)
-    cmd->add_option("--ff", args.ff_file, "Use a saved form-factor file (from `formfactors -o`)");
+  std::vector<CLI::Option*> compute_only;
+  compute_only.push_back(cmd->add_option("--estimator", args.estimator, "Form-factor estimator")
+                             ->check(CLI::IsMember(form_factor_estimators()))
+                             ->capture_default_str());
+  compute_only.push_back(
+      cmd->add_option("--samples", args.samples, "Sample pairs (rays) per patch pair")
+          ->check(CLI::Range(1, 1 << 20))
+          ->capture_default_str());
+  compute_only.push_back(
+      cmd->add_option("--threshold", args.threshold, "Drop form factors below this value")
+          ->check(CLI::Range(0.0, 1.0)));
+  compute_only.push_back(cmd->add_option("--hemicube-res", args.hemicube_resolution,
+                                         "Hemicube top-face resolution (estimator hemicube)")
+                             ->check(CLI::Range(4, 8192))
+                             ->capture_default_str());
+  compute_only.push_back(
+      cmd->add_flag("--symmetrize", args.symmetrize,
+                    "Average A_i F_ij and A_j F_ji (for non-reciprocal estimators)"));
+  if (!with_load) return;
+  CLI::Option* ff = cmd->add_option(
+      "--ff", args.ff_file,
+      "Use a saved form-factor file (from `formfactors -o`) and the settings stored in it; "
+      "excludes the options above");
+  // A loaded F keeps the settings that made it: an option that would change them is refused
+  // rather than silently ignored (and then misreported).
+  for (CLI::Option* o : compute_only) ff->excludes(o);
 }
 
 FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run) {
@@ -42,9 +52,18 @@ FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run
 FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& args,
                                 const RunArgs& run, bool with_stderr) {
   if (!args.ff_file.empty()) {
-    FormFactors ff = read_form_factors(args.ff_file, mesh_hash(scene.mesh), scene.mesh.size());
+    FormFactorFileInfo info;
+    FormFactors ff =
+        read_form_factors(args.ff_file, mesh_hash(scene.mesh), scene.mesh.size(), &info);
+    ff.options.threads = run.threads;
+    ff.options.progress = !run.quiet;
+    ff.options.with_stderr = ff.stderr_F.nonZeros() > 0;
+    if (!parse_ff_settings(info.settings, ff.options)) {
+      ff.options.estimator.clear();
+      log_warn(args.ff_file + ": records no form-factor settings; reports show them as unknown");
+    }
     log_info("form factors: loaded " + args.ff_file + " (" + std::to_string(ff.F.nonZeros()) +
-             " entries)");
+             " entries, " + ff_settings_text(ff.options, "") + ")");
     return ff;
   }
   FormFactorOptions o = make_ff_options(args, run);
@@ -61,6 +80,22 @@ void warn_about_lighting(const PatchMesh& mesh, const SparseF& F, bool solving) 
   LightingProblems p = find_lighting_problems(mesh, F);
   p.no_emitter = p.no_emitter && solving;
   for (const std::string& line : lighting_warnings(mesh, p)) log_warn(line);
+}
+
+Json ff_settings_json(const FormFactorOptions& o, const std::string& loaded_from) {
+  const auto known = [&](Json v) { return o.estimator.empty() ? Json() : v; };
+  return {{"estimator", known(o.estimator)},
+          {"samples", known(o.samples)},
+          {"seed", known(o.seed)},
+          {"threshold", known(o.threshold)},
+          {"hemicube_resolution", known(o.hemicube_resolution)},
+          {"symmetrize", known(o.symmetrize)},
+          {"loaded_from", loaded_from}};
+}
+
+std::string ff_settings_text(const FormFactorOptions& o, const std::string& loaded_from) {
+  return (loaded_from.empty() ? std::string() : "ff=" + loaded_from + " ") +
+         (o.estimator.empty() ? std::string("settings=unknown") : format_ff_settings(o));
 }
 
 }  // namespace lambert

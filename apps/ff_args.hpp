@@ -7,6 +7,7 @@
 
 #include "apps/common.hpp"
 #include "geometry/formfactors/formfactors.hpp"
+#include "io/json.hpp"
 
 namespace lambert {
 
@@ -20,14 +21,18 @@ struct FormFactorArgs {
   std::string ff_file;  ///< load F from this file instead of computing it
 };
 
-/// Adds the form-factor options to a subcommand. `with_load` adds --ff FILE.
+/// Adds the form-factor options to a subcommand. `with_load` adds --ff FILE, which excludes
+/// the options that only steer a computation (--estimator, --samples, --threshold,
+/// --hemicube-res, --symmetrize): given together, they are a usage error.
 void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load = true);
 
 /// Builds FormFactorOptions from the arguments.
 FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run);
 
 /// Computes F for the scene, or loads --ff (refusing a file made for another mesh), and
-/// logs a one-line summary on stderr.
+/// logs a one-line summary on stderr. A loaded F's `options` are the settings stored in the
+/// file (threads and progress from `run`); when the file records none, `options.estimator`
+/// is empty (reports then show the settings as unknown) and a warning is logged.
 FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& args,
                                 const RunArgs& run, bool with_stderr = false);
 
@@ -35,5 +40,14 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
 /// silently B = E: nothing sees anything, or an emitter sees nothing. `solving` adds the
 /// no-emitter warning (F by itself needs no emitter).
 void warn_about_lighting(const PatchMesh& mesh, const SparseF& F, bool solving);
+
+/// The settings that made F, for reports: {estimator, samples, seed, threshold,
+/// hemicube_resolution, symmetrize, loaded_from} ("" when computed here), every setting null
+/// when unknown (see obtain_form_factors).
+Json ff_settings_json(const FormFactorOptions& options, const std::string& loaded_from);
+
+/// The same as one line of key=value text for image and PLY metadata: "[ff=FILE ]" followed
+/// by format_ff_settings(), or "settings=unknown".
+std::string ff_settings_text(const FormFactorOptions& options, const std::string& loaded_from);
 
 }  // namespace lambert

@@ -5,7 +5,6 @@
 
 #include "apps/commands.hpp"
 #include "apps/ff_args.hpp"
-#include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
@@ -16,55 +15,46 @@
 namespace lambert {
 namespace {
 
+// The settings stored with a saved F (recovered by `--ff`) and written to its report.
 std::string settings_string(const FormFactorOptions& o, const LoadedScene& s) {
   std::ostringstream ss;
-  ss << "estimator=" << o.estimator << " samples=" << o.samples << " seed=" << o.seed
-     << " threshold=" << o.threshold << " patches=" << s.mesh.size() << " max_edge=" << s.max_edge;
-  if (o.estimator == "hemicube") ss << " hemicube_res=" << o.hemicube_resolution << " symmetrize=" << o.symmetrize;
+  ss << format_ff_settings(o) << " patches=" << s.mesh.size() << " max_edge=" << s.max_edge;
   return ss.str();
 }
 
-void write_diagnostics_json(std::ostream& out, const LoadedScene& s, const FormFactors& ff,
-                            const FormFactorDiagnostics& d, const std::string& settings) {
-  JsonWriter j(out);
-  j.begin_object();
-  j.field("scene", s.scene.source);
-  j.field("settings", settings);
-  j.field("patches", d.n);
-  j.field("nnz", d.nnz);
-  j.field("pairs_tested", ff.stats.pairs_tested);
-  j.field("pairs_culled", ff.stats.pairs_culled);
-  j.field("rays", ff.stats.rays);
-  j.field("seconds", ff.stats.seconds);
-  j.field("rays_per_second", ff.stats.seconds > 0 ? ff.stats.rays / ff.stats.seconds : 0.0);
-  j.key("row_sums");
-  j.begin_object();
-  j.field("min", d.row_sum_min);
-  j.field("max", d.row_sum_max);
-  j.field("mean", d.row_sum_mean);
-  j.field("histogram_max", FormFactorDiagnostics::kHistogramMax);
-  j.key("histogram");
-  j.begin_array();
-  for (auto c : d.row_sum_histogram) j.value(c);
-  j.end_array();
-  j.key("worst_rows");
-  j.begin_array();
-  for (auto i : d.worst_rows) {
-    j.begin_object();
-    j.field("patch", i);
-    j.field("surface", s.mesh.surface_names[s.mesh.patches[i].surface]);
-    double sum = 0.0;
-    for (SparseF::InnerIterator it(ff.F, i); it; ++it) sum += it.value();
-    j.field("row_sum", sum);
-    j.end_object();
-  }
-  j.end_array();
-  j.end_object();
-  j.field("reciprocity_max", d.reciprocity_max);
-  j.field("reciprocity_max_relative", d.reciprocity_max_relative);
-  j.field("entries_negative", d.negative);
-  j.field("entries_above_one", d.above_one);
-  j.end_object();
+double row_sum(const SparseF& F, std::int32_t i) {
+  double sum = 0.0;
+  for (SparseF::InnerIterator it(F, i); it; ++it) sum += it.value();
+  return sum;
+}
+
+Json diagnostics_json(const LoadedScene& s, const FormFactors& ff, const FormFactorDiagnostics& d,
+                      const std::string& settings) {
+  Json worst = Json::array();
+  for (auto i : d.worst_rows)
+    worst.push_back({{"patch", i},
+                     {"surface", s.mesh.surface_names[s.mesh.patches[i].surface]},
+                     {"row_sum", row_sum(ff.F, i)}});
+  return {{"scene", s.scene.source},
+          {"settings", settings},
+          {"patches", d.n},
+          {"nnz", d.nnz},
+          {"pairs_tested", ff.stats.pairs_tested},
+          {"pairs_culled", ff.stats.pairs_culled},
+          {"rays", ff.stats.rays},
+          {"seconds", ff.stats.seconds},
+          {"rays_per_second", ff.stats.seconds > 0 ? ff.stats.rays / ff.stats.seconds : 0.0},
+          {"row_sums",
+           {{"min", d.row_sum_min},
+            {"max", d.row_sum_max},
+            {"mean", d.row_sum_mean},
+            {"histogram_max", FormFactorDiagnostics::kHistogramMax},
+            {"histogram", d.row_sum_histogram},
+            {"worst_rows", worst}}},
+          {"reciprocity_max", d.reciprocity_max},
+          {"reciprocity_max_relative", d.reciprocity_max_relative},
+          {"entries_negative", d.negative},
+          {"entries_above_one", d.above_one}};
 }
 
 void print_diagnostics(const LoadedScene& s, const FormFactors& ff, const FormFactorDiagnostics& d) {
@@ -78,51 +68,34 @@ void print_diagnostics(const LoadedScene& s, const FormFactors& ff, const FormFa
   std::printf("row-sum histogram (bins of %.2f from 0):", FormFactorDiagnostics::kHistogramMax / FormFactorDiagnostics::kHistogramBins);
   for (auto c : d.row_sum_histogram) std::printf(" %lld", static_cast<long long>(c));
   std::printf("\nlargest row sums:");
-  for (auto i : d.worst_rows) {
-    double sum = 0.0;
-    for (SparseF::InnerIterator it(ff.F, i); it; ++it) sum += it.value();
-    std::printf(" %d (%s) %.6f;", i, s.mesh.surface_names[s.mesh.patches[i].surface].c_str(), sum);
-  }
+  for (auto i : d.worst_rows)
+    std::printf(" %d (%s) %.6f;", i, s.mesh.surface_names[s.mesh.patches[i].surface].c_str(),
+                row_sum(ff.F, i));
   std::printf("\nreciprocity residual max |A_i F_ij - A_j F_ji| = %.3g (relative %.3g)\n",
               d.reciprocity_max, d.reciprocity_max_relative);
   std::printf("entries < 0: %lld, entries > 1: %lld\n", static_cast<long long>(d.negative),
               static_cast<long long>(d.above_one));
 }
 
-void write_surface_json(const std::string& path, const SurfaceFactors& sf) {
-  write_stream_atomically(path, [&](std::ostream& out) {
-    JsonWriter j(out);
-    j.begin_object();
-    j.key("surfaces");
-    j.begin_array();
-    for (const auto& n : sf.surfaces) j.value(n);
-    j.end_array();
-    j.field("areas", sf.areas);
-    for (const char* key : {"F", "stderr"}) {
-      const Eigen::MatrixXd& m = std::string(key) == "F" ? sf.F : sf.stderr_F;
-      j.key(key);
-      j.begin_array();
-      for (Eigen::Index g = 0; g < m.rows(); ++g) {
-        std::vector<double> row(m.cols());
-        for (Eigen::Index h = 0; h < m.cols(); ++h) row[h] = m(g, h);
-        j.value(row);
-      }
-      j.end_array();
-    }
-    j.end_object();
-  });
+// Rows of a dense matrix as nested JSON arrays.
+Json rows_json(const Eigen::MatrixXd& m) {
+  Json rows = Json::array();
+  for (Eigen::Index g = 0; g < m.rows(); ++g) {
+    Json& row = rows.emplace_back(Json::array());
+    for (Eigen::Index h = 0; h < m.cols(); ++h) row.push_back(m(g, h));
+  }
+  return rows;
 }
 
-void write_point_json(std::ostream& out, const PointFactors& pf) {
-  JsonWriter j(out);
-  j.begin_object();
-  j.key("surfaces");
-  j.begin_array();
-  for (const auto& n : pf.surfaces) j.value(n);
-  j.end_array();
-  j.field("F", pf.F);
-  j.field("stderr", pf.stderr_F);
-  j.end_object();
+Json surface_json(const SurfaceFactors& sf) {
+  return {{"surfaces", sf.surfaces},
+          {"areas", sf.areas},
+          {"F", rows_json(sf.F)},
+          {"stderr", rows_json(sf.stderr_F)}};
+}
+
+Json point_json(const PointFactors& pf) {
+  return {{"surfaces", pf.surfaces}, {"F", pf.F}, {"stderr", pf.stderr_F}};
 }
 
 Eigen::Vector3d parse_vec(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
@@ -160,9 +133,9 @@ int run_formfactors(const FormFactorsOptions& opts) {
     const FormFactorOptions o = make_ff_options(opts.ff, opts.run);
     const PointFactors pf = point_form_factors(scene.mesh, parse_vec(opts.point), parse_vec(opts.normal), o);
     if (opts.output.empty()) {
-      write_point_json(std::cout, pf);
+      std::cout << json_text(point_json(pf));
     } else {
-      write_stream_atomically(opts.output, [&](std::ostream& out) { write_point_json(out, pf); });
+      write_json_file(opts.output, point_json(pf));
       log_info("wrote " + opts.output);
     }
     return 0;
@@ -176,7 +149,7 @@ int run_formfactors(const FormFactorsOptions& opts) {
   namespace fs = std::filesystem;
   const std::string ext = fs::path(opts.output).extension().string();
   if (opts.by_surface) {
-    write_surface_json(opts.output, surface_factors(scene.mesh, ff));
+    write_json_file(opts.output, surface_json(surface_factors(scene.mesh, ff)));
   } else if (ext == ".mtx") {
     write_matrix_market(opts.output, ff.F, {mesh_hash(scene.mesh), settings});
   } else {
@@ -187,7 +160,7 @@ int run_formfactors(const FormFactorsOptions& opts) {
       !opts.report.empty() ? opts.report : fs::path(opts.output).replace_extension(".report.json").string();
   if (report == opts.output)
     throw UsageError("formfactors: --report and -o name the same file '" + report + "'");
-  write_stream_atomically(report, [&](std::ostream& out) { write_diagnostics_json(out, scene, ff, d, settings); });
+  write_json_file(report, diagnostics_json(scene, ff, d, settings));
   log_info("wrote " + report);
   return 0;
 }

@@ -12,18 +12,19 @@
 namespace lambert {
 namespace {
 
-std::string render_settings(const RenderOptions& o, const LoadedScene& s, const Camera& cam) {
+std::string render_settings(const RenderOptions& o, const LoadedScene& s, const RadiosityResult& r,
+                            const Camera& cam) {
   std::ostringstream ss;
   ss << "patches=" << s.mesh.size() << " max_edge=" << s.max_edge;
   if (!o.radiosity.empty()) {
     ss << " radiosity=" << o.radiosity;
   } else {
-    ss << " estimator=" << o.ff.estimator << " samples=" << o.ff.samples << " seed=" << o.run.seed
-       << " solver=" << o.solver.solver << " tol=" << o.solver.tol;
+    ss << ' ' << ff_settings_text(r.ff_options, o.ff.ff_file) << " solver=" << o.solver.solver
+       << " tol=" << o.solver.tol;
   }
   ss << " interp=" << o.shade.vertex_interp << " shading=" << (o.shade.flat ? "flat" : "gouraud")
-     << " antialias=" << o.shade.antialias << " size=" << cam.width << "x" << cam.height
-     << " eye=" << cam.eye.x() << "," << cam.eye.y() << "," << cam.eye.z()
+     << " antialias=" << o.shade.antialias << " render_seed=" << o.run.seed << " size=" << cam.width
+     << "x" << cam.height << " eye=" << cam.eye.x() << "," << cam.eye.y() << "," << cam.eye.z()
      << " look_at=" << cam.look_at.x() << "," << cam.look_at.y() << "," << cam.look_at.z()
      << " vfov=" << cam.vfov_degrees;
   return ss.str();
@@ -84,8 +85,8 @@ int run_render(const RenderOptions& opts) {
                      opts.output + "'");
   paths.vertex_exr = opts.vertex_exr;
   paths.ply = opts.ply;
-  const auto written =
-      write_outputs(paths, loaded.mesh, shaded, image, ev, render_settings(opts, loaded, camera));
+  const auto written = write_outputs(paths, loaded.mesh, shaded, image, ev,
+                                     render_settings(opts, loaded, r, camera));
   const auto [power_after, power_before] = worst_power_error(shaded.power);
   std::printf("rendered %dx%d, %lld rays in %.2fs, exposure %+.3f EV\n", image.width, image.height,
               static_cast<long long>(stats.rays), stats.seconds, ev);

@@ -84,6 +84,7 @@ void add_shade_options(CLI::App* cmd, ShadeArgs& args) {
 void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOptions& solver,
                  const RunArgs& run, RadiosityResult& r) {
   r.ff_stats = F.stats;
+  r.ff_options = F.options;
   r.ff_entries = F.F.nonZeros();
   const Timer solve_timer;
   const RadiosityProblem problem = make_problem(scene.mesh, F.F);

@@ -45,6 +45,8 @@ struct RadiosityResult {
   bool solved = false;         ///< false when read from a CSV
   RadiositySolution solution;  ///< valid when solved
   FormFactorStats ff_stats;    ///< valid when solved (rays 0 when F was loaded)
+  FormFactorOptions ff_options;  ///< valid when solved: the settings that made F (a loaded
+                                 ///< file's own; see obtain_form_factors)
   std::int64_t ff_entries = 0;
   double ff_seconds = 0.0;
   double solve_seconds = 0.0;

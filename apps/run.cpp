@@ -9,7 +9,6 @@
 #include "apps/cli.hpp"
 #include "apps/commands.hpp"
 #include "apps/solve_args.hpp"
-#include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
@@ -32,14 +31,14 @@ struct StageTimes {
   double total() const { return load + form_factors + solve + vertices + render + write; }
 };
 
-std::string run_settings(const RunOptions& o, const LoadedScene& s, const Camera& cam) {
+std::string run_settings(const RunOptions& o, const LoadedScene& s, const RadiosityResult& r,
+                         const Camera& cam) {
   std::ostringstream ss;
-  ss << "patches=" << s.mesh.size() << " max_edge=" << s.max_edge;
-  if (!o.ff.ff_file.empty()) ss << " ff=" << o.ff.ff_file;
-  ss << " estimator=" << o.ff.estimator << " samples=" << o.ff.samples << " seed=" << o.run.seed
-     << " solver=" << o.solver.solver << " tol=" << o.solver.tol
-     << " interp=" << o.shade.vertex_interp << " shading=" << (o.shade.flat ? "flat" : "gouraud")
-     << " antialias=" << o.shade.antialias << " size=" << cam.width << "x" << cam.height;
+  ss << "patches=" << s.mesh.size() << " max_edge=" << s.max_edge << ' '
+     << ff_settings_text(r.ff_options, o.ff.ff_file) << " solver=" << o.solver.solver
+     << " tol=" << o.solver.tol << " interp=" << o.shade.vertex_interp
+     << " shading=" << (o.shade.flat ? "flat" : "gouraud") << " antialias=" << o.shade.antialias
+     << " render_seed=" << o.run.seed << " size=" << cam.width << "x" << cam.height;
   return ss.str();
 }
 
@@ -58,103 +57,63 @@ struct Report {
   std::string settings;
 };
 
-void write_report(std::ostream& out, const Report& rp) {
+Json report_json(const Report& rp) {
   const auto& r = rp.r;
-  JsonWriter j(out);
-  j.begin_object();
-  j.field("scene", rp.loaded.scene.source);
-  j.field("settings", rp.settings);
-  j.field("patches", static_cast<std::int64_t>(rp.loaded.mesh.size()));
-  j.field("shading_vertices", static_cast<std::int64_t>(rp.shaded.field.size()));
-  j.field("surfaces", static_cast<std::int64_t>(rp.loaded.mesh.surface_names.size()));
+  Json j = {{"scene", rp.loaded.scene.source},
+            {"settings", rp.settings},
+            {"patches", rp.loaded.mesh.size()},
+            {"shading_vertices", rp.shaded.field.size()},
+            {"surfaces", rp.loaded.mesh.surface_names.size()}};
+  Json& ff = j["form_factors"] = ff_settings_json(r.ff_options, rp.opts.ff.ff_file);
+  ff["entries"] = r.ff_entries;
+  ff["pairs_tested"] = r.ff_stats.pairs_tested;
+  ff["rays"] = r.ff_stats.rays;
 
-  j.key("form_factors");
-  j.begin_object();
-  j.field("estimator", rp.opts.ff.estimator);
-  j.field("samples", rp.opts.ff.samples);
-  j.field("seed", static_cast<std::int64_t>(rp.opts.run.seed));
-  j.field("loaded_from", rp.opts.ff.ff_file);
-  j.field("entries", r.ff_entries);
-  j.field("pairs_tested", r.ff_stats.pairs_tested);
-  j.field("rays", r.ff_stats.rays);
-  j.end_object();
+  Json channels = Json::array();
+  for (const auto& c : r.solution.channels)
+    channels.push_back({{"status", to_string(c.status)},
+                        {"iterations", c.iterations},
+                        {"matvecs", c.matvecs},
+                        {"residual", c.residual},
+                        {"seconds", c.seconds}});
+  j["solver"] = {{"name", rp.opts.solver.solver},
+                 {"tol", rp.opts.solver.tol},
+                 {"status", to_string(r.solution.status)},
+                 {"channels", channels}};
 
-  j.key("solver");
-  j.begin_object();
-  j.field("name", rp.opts.solver.solver);
-  j.field("tol", rp.opts.solver.tol);
-  j.field("status", to_string(r.solution.status));
-  j.key("channels");
-  j.begin_array();
-  for (const auto& c : r.solution.channels) {
-    j.begin_object();
-    j.field("status", to_string(c.status));
-    j.field("iterations", c.iterations);
-    j.field("matvecs", c.matvecs);
-    j.field("residual", c.residual);
-    j.field("seconds", c.seconds);
-    j.end_object();
-  }
-  j.end_array();
-  j.end_object();
-
-  j.key("energy_balance");
-  j.begin_array();
-  for (const auto& e : r.solution.energy) {
-    write_energy_json(j, e);
-  }
-  j.end_array();
+  Json& energy = j["energy_balance"] = Json::array();
+  for (const auto& e : r.solution.energy) energy.push_back(energy_json(e));
 
   const auto [after, before] = worst_power_error(rp.shaded.power);
-  j.key("vertex_power");
-  j.begin_object();
-  j.field("interpolation", rp.opts.shade.vertex_interp);
-  j.field("max_relative_error", after);
-  j.field("area_weighted_max_relative_error", before);
-  j.field("tolerance", rp.opts.shade.vertex_interp == "conservative" ? kPowerTolerance : before);
-  j.key("surfaces");
-  j.begin_array();
-  for (const auto& s : rp.shaded.power) {
-    j.begin_object();
-    j.field("name", s.name);
-    j.field("area", s.area);
-    j.field("patch_power", as_vector(s.patch_power));
-    j.field("field_power", as_vector(s.field_power));
-    j.field("area_weighted_power", as_vector(s.area_weighted_power));
-    j.field("relative_error", s.relative_error());
-    j.field("area_weighted_relative_error", s.area_weighted_relative_error());
-    j.end_object();
-  }
-  j.end_array();
-  j.end_object();
+  Json surfaces = Json::array();
+  for (const auto& s : rp.shaded.power)
+    surfaces.push_back({{"name", s.name},
+                        {"area", s.area},
+                        {"patch_power", as_vector(s.patch_power)},
+                        {"field_power", as_vector(s.field_power)},
+                        {"area_weighted_power", as_vector(s.area_weighted_power)},
+                        {"relative_error", s.relative_error()},
+                        {"area_weighted_relative_error", s.area_weighted_relative_error()}});
+  j["vertex_power"] = {
+      {"interpolation", rp.opts.shade.vertex_interp},
+      {"max_relative_error", after},
+      {"area_weighted_max_relative_error", before},
+      {"tolerance", rp.opts.shade.vertex_interp == "conservative" ? kPowerTolerance : before},
+      {"surfaces", surfaces}};
 
-  j.key("render");
-  j.begin_object();
-  j.field("width", rp.camera.width);
-  j.field("height", rp.camera.height);
-  j.field("samples_per_pixel", rp.opts.shade.antialias * rp.opts.shade.antialias);
-  j.field("shading", rp.opts.shade.flat ? "flat" : "gouraud");
-  j.field("rays", rp.render.rays);
-  j.field("exposure_ev", rp.ev);
-  j.end_object();
-
-  j.key("seconds");
-  j.begin_object();
-  j.field("load_and_mesh", rp.t.load);
-  j.field("form_factors", rp.t.form_factors);
-  j.field("solve", rp.t.solve);
-  j.field("vertices", rp.t.vertices);
-  j.field("render", rp.t.render);
-  j.field("write", rp.t.write);
-  j.field("total", rp.t.total());
-  j.end_object();
-  j.field("rays_total", r.ff_stats.rays + rp.render.rays);
-  j.key("files");
-  j.begin_array();
-  for (const auto& f : rp.files) j.value(f);
-  j.end_array();
-  j.end_object();
-  out << '\n';
+  j["render"] = {{"width", rp.camera.width},
+                 {"height", rp.camera.height},
+                 {"samples_per_pixel", rp.opts.shade.antialias * rp.opts.shade.antialias},
+                 {"shading", rp.opts.shade.flat ? "flat" : "gouraud"},
+                 {"rays", rp.render.rays},
+                 {"exposure_ev", rp.ev}};
+  j["seconds"] = {{"load_and_mesh", rp.t.load}, {"form_factors", rp.t.form_factors},
+                  {"solve", rp.t.solve},        {"vertices", rp.t.vertices},
+                  {"render", rp.t.render},      {"write", rp.t.write},
+                  {"total", rp.t.total()}};
+  j["rays_total"] = r.ff_stats.rays + rp.render.rays;
+  j["files"] = rp.files;
+  return j;
 }
 
 void print_summary(const Report& rp) {
@@ -172,11 +131,11 @@ void print_summary(const Report& rp) {
     std::printf(" %s %d it (res %.2g)", channel[c], r.solution.channels[c].iterations,
                 r.solution.channels[c].residual);
   std::printf("\n");
-  std::printf("energy     emitted / absorbed / escaped (W), relative imbalance:\n");
+  std::printf("energy     emitted / absorbed / escaped (W), relative imbalance (its parts):\n");
   for (int c = 0; c < 3; ++c) {
     const auto& e = r.solution.energy[c];
-    std::printf("           %s %.6g / %.6g / %.6g, %.2e\n", channel[c], e.emitted, e.absorbed,
-                e.escaped, e.relative_imbalance);
+    std::printf("           %s %.6g / %.6g / %.6g, %.2e (%s)\n", channel[c], e.emitted, e.absorbed,
+                e.escaped, e.relative_imbalance, energy_split_text(e).c_str());
   }
   const auto [after, before] = worst_power_error(rp.shaded.power);
   std::printf(
@@ -278,13 +237,13 @@ int run_run(const RunOptions& opts) {
   paths.png = (dir / (name + ".png")).string();
   paths.vertex_exr = (dir / (name + "_vertices.exr")).string();
   paths.ply = (dir / (name + ".ply")).string();
-  const std::string settings = run_settings(opts, loaded, camera);
+  const std::string settings = run_settings(opts, loaded, r, camera);
   std::vector<std::string> files = write_outputs(paths, loaded.mesh, shaded, image, ev, settings);
   const std::string report_path = (dir / "report.json").string();
   files.push_back(report_path);
   t.write = timer.seconds();
   const Report report{opts, loaded, r, shaded, rs, camera, ev, t, files, settings};
-  write_stream_atomically(report_path, [&](std::ostream& out) { write_report(out, report); });
+  write_json_file(report_path, report_json(report));
   print_summary(report);
   if (r.solution.status != SolveStatus::Converged) {
     log_warn("solver status " + std::string(to_string(r.solution.status)) +

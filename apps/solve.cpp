@@ -34,25 +34,17 @@ void write_radiosity_csv(const std::string& path, const PatchMesh& mesh,
   });
 }
 
-void write_channel(JsonWriter& j, const ChannelReport& r, const EnergyBalance& e, int c) {
-  j.begin_object();
-  j.field("channel", channel_name(c));
-  j.field("status", to_string(r.status));
-  j.field("iterations", r.iterations);
-  j.field("matvecs", r.matvecs);
-  j.field("residual", r.residual);
-  j.field("seconds", r.seconds);
-  if (!r.note.empty()) j.field("note", r.note);
-  j.key("energy");
-  write_energy_json(j, e);
-  j.key("history");
-  j.begin_object();
-  std::vector<double> its(r.history_iteration.begin(), r.history_iteration.end());
-  j.field("iteration", its);
-  j.field("seconds", r.time_history);
-  j.field("residual", r.residual_history);
-  j.end_object();
-  j.end_object();
+Json channel_json(const ChannelReport& r, const EnergyBalance& e, int c) {
+  Json j = {{"channel", channel_name(c)},  {"status", to_string(r.status)},
+            {"iterations", r.iterations},  {"matvecs", r.matvecs},
+            {"residual", r.residual},      {"seconds", r.seconds},
+            {"refinements", r.refinements}};
+  if (!r.note.empty()) j["note"] = r.note;
+  j["energy"] = energy_json(e);
+  j["history"] = {{"iteration", r.history_iteration},
+                  {"seconds", r.time_history},
+                  {"residual", r.residual_history}};
+  return j;
 }
 
 }  // namespace
@@ -89,66 +81,51 @@ int run_solve(const SolveCommandOptions& opts) {
   const std::string json_path = summary_path(opts.output);
   write_radiosity_csv(opts.output, loaded.mesh, sol.B);
   const auto surfaces = surface_averages(loaded.mesh, sol.B);
-  write_stream_atomically(json_path, [&](std::ostream& out) {
-    JsonWriter j(out);
-    j.begin_object();
-    j.field("scene", loaded.scene.source);
-    j.field("patches", static_cast<std::int64_t>(loaded.mesh.size()));
-    j.field("solver", so.solver);
-    j.field("status", to_string(sol.status));
-    j.key("options");
-    j.begin_object();
-    j.field("tol", so.tol);
-    j.field("max_iterations", so.max_iterations);
-    j.field("omega", so.omega);
-    j.field("preconditioner", so.preconditioner);
-    j.field("restart", so.restart);
-    j.field("ambient", so.ambient);
-    j.end_object();
-    int iterations = 0;
-    double residual = 0.0;
-    for (const auto& r : sol.channels) {
-      iterations = std::max(iterations, r.iterations);
-      residual = std::max(residual, r.residual);
-    }
-    j.field("iterations", iterations);
-    j.field("residual", residual);
-    j.key("timings");
-    j.begin_object();
-    j.field("load_and_mesh_seconds", load_seconds);
-    j.field("form_factors_seconds", ff_seconds);
-    j.field("form_factors_source", opts.ff.ff_file.empty() ? "computed" : opts.ff.ff_file);
-    j.field("solve_seconds", sol.seconds);
-    j.end_object();
-    j.field("form_factor_nonzeros", static_cast<std::int64_t>(ff.F.nonZeros()));
-    j.key("channels");
-    j.begin_array();
-    for (int c = 0; c < 3; ++c) write_channel(j, sol.channels[c], sol.energy[c], c);
-    j.end_array();
-    j.key("surfaces");
-    j.begin_array();
-    for (const auto& s : surfaces) {
-      j.begin_object();
-      j.field("name", s.name);
-      j.field("area", s.area);
-      j.field("patches", s.patches);
-      j.field("average_radiosity", std::vector<double>{s.average[0], s.average[1], s.average[2]});
-      j.end_object();
-    }
-    j.end_array();
-    j.end_object();
-    out << '\n';
-  });
+  int iterations = 0;
+  double residual = 0.0;
+  for (const auto& r : sol.channels) {
+    iterations = std::max(iterations, r.iterations);
+    residual = std::max(residual, r.residual);
+  }
+  Json j = {{"scene", loaded.scene.source},
+            {"patches", loaded.mesh.size()},
+            {"solver", so.solver},
+            {"status", to_string(sol.status)},
+            {"options",
+             {{"tol", so.tol},
+              {"max_iterations", so.max_iterations},
+              {"omega", so.omega},
+              {"preconditioner", so.preconditioner},
+              {"restart", so.restart},
+              {"ambient", so.ambient}}},
+            {"iterations", iterations},
+            {"residual", residual},
+            {"timings",
+             {{"load_and_mesh_seconds", load_seconds},
+              {"form_factors_seconds", ff_seconds},
+              {"form_factors_source", opts.ff.ff_file.empty() ? "computed" : opts.ff.ff_file},
+              {"solve_seconds", sol.seconds}}},
+            {"form_factors", ff_settings_json(ff.options, opts.ff.ff_file)},
+            {"form_factor_nonzeros", ff.F.nonZeros()}};
+  Json& channels = j["channels"] = Json::array();
+  for (int c = 0; c < 3; ++c) channels.push_back(channel_json(sol.channels[c], sol.energy[c], c));
+  Json& surface_list = j["surfaces"] = Json::array();
+  for (const auto& s : surfaces)
+    surface_list.push_back({{"name", s.name},
+                            {"area", s.area},
+                            {"patches", s.patches},
+                            {"average_radiosity", {s.average[0], s.average[1], s.average[2]}}});
+  write_json_file(json_path, j);
 
   std::printf("solver %s: %s\n", so.solver.c_str(), to_string(sol.status));
   for (int c = 0; c < 3; ++c) {
     const ChannelReport& r = sol.channels[c];
     std::printf(
         "  %s: %-15s %6d iterations %8lld matvecs  residual %.3e  %.4fs  energy "
-        "emitted %.6g absorbed %.6g escaped %.6g (imbalance %.2e)\n",
+        "emitted %.6g absorbed %.6g escaped %.6g (imbalance %.2e: %s)\n",
         channel_name(c), to_string(r.status), r.iterations, static_cast<long long>(r.matvecs),
         r.residual, r.seconds, sol.energy[c].emitted, sol.energy[c].absorbed, sol.energy[c].escaped,
-        sol.energy[c].relative_imbalance);
+        sol.energy[c].relative_imbalance, energy_split_text(sol.energy[c]).c_str());
   }
   std::printf("wrote %s and %s\n", opts.output.c_str(), json_path.c_str());
   if (sol.status != SolveStatus::Converged) {

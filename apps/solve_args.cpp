@@ -48,13 +48,30 @@ std::string csv_number(double v) {
   return buf;
 }
 
-void write_energy_json(JsonWriter& j, const EnergyBalance& e) {
-  j.begin_object();
-  j.field("emitted", e.emitted);
-  j.field("absorbed", e.absorbed);
-  j.field("escaped", e.escaped);
-  j.field("relative_imbalance", e.relative_imbalance);
-  j.end_object();
+namespace {
+// A part of the imbalance relative to the emitted power (absolute when nothing is emitted,
+// as relative_imbalance is).
+double relative(const EnergyBalance& e, double part) {
+  return e.emitted > 0.0 ? part / e.emitted : part;
+}
+}  // namespace
+
+Json energy_json(const EnergyBalance& e) {
+  return {{"emitted", e.emitted},
+          {"absorbed", e.absorbed},
+          {"escaped", e.escaped},
+          {"relative_imbalance", e.relative_imbalance},
+          {"residual_part", e.residual_part},
+          {"non_reciprocity_part", e.non_reciprocity_part},
+          {"relative_residual_part", relative(e, e.residual_part)},
+          {"relative_non_reciprocity_part", relative(e, e.non_reciprocity_part)}};
+}
+
+std::string energy_split_text(const EnergyBalance& e) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "residual part %.2e, non-reciprocity part %.2e",
+                relative(e, e.residual_part), relative(e, e.non_reciprocity_part));
+  return buf;
 }
 
 }  // namespace lambert

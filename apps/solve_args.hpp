@@ -16,8 +16,13 @@ void add_solve_options(CLI::App* cmd, SolveOptions& options, bool with_solver);
 /// "R", "G" or "B".
 const char* channel_name(int channel);
 
-/// Writes an energy balance as a JSON object {emitted, absorbed, escaped, relative_imbalance}.
-void write_energy_json(JsonWriter& j, const EnergyBalance& e);
+/// An energy balance as a JSON object {emitted, absorbed, escaped, relative_imbalance,
+/// residual_part, non_reciprocity_part (W, signed), relative_residual_part,
+/// relative_non_reciprocity_part (the parts over emitted)}.
+Json energy_json(const EnergyBalance& e);
+
+/// "residual part R, non-reciprocity part N": the imbalance's two parts relative to emitted.
+std::string energy_split_text(const EnergyBalance& e);
 
 /// Quotes a CSV field when it holds a comma, quote or newline (RFC 4180).
 std::string csv_field(const std::string& s);

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cinttypes>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -194,7 +195,67 @@ FormFactors read_matrix_market(std::istream& in, const std::string& path,
   return ff;
 }
 
+// strtoll/strtoull/strtod over the whole of `s`.
+bool parse_int(const std::string& s, long long& v) {
+  char* end = nullptr;
+  errno = 0;
+  v = std::strtoll(s.c_str(), &end, 10);
+  return !s.empty() && *end == '\0' && errno == 0;
+}
+bool parse_uint(const std::string& s, std::uint64_t& v) {
+  char* end = nullptr;
+  errno = 0;
+  v = std::strtoull(s.c_str(), &end, 10);
+  return !s.empty() && s[0] != '-' && *end == '\0' && errno == 0;
+}
+bool parse_double(const std::string& s, double& v) {
+  char* end = nullptr;
+  v = std::strtod(s.c_str(), &end);
+  return !s.empty() && *end == '\0' && std::isfinite(v);
+}
+
 }  // namespace
+
+std::string format_ff_settings(const FormFactorOptions& o) {
+  char threshold[32];
+  std::snprintf(threshold, sizeof threshold, "%.17g", o.threshold);
+  return "estimator=" + o.estimator + " samples=" + std::to_string(o.samples) +
+         " seed=" + std::to_string(o.seed) + " threshold=" + threshold +
+         " hemicube_res=" + std::to_string(o.hemicube_resolution) +
+         " symmetrize=" + (o.symmetrize ? "1" : "0");
+}
+
+bool parse_ff_settings(const std::string& text, FormFactorOptions& options) {
+  FormFactorOptions o = options;
+  bool estimator = false, samples = false, seed = false, threshold = false;
+  std::istringstream in(text);
+  for (std::string pair; in >> pair;) {
+    const size_t eq = pair.find('=');
+    if (eq == std::string::npos) continue;
+    const std::string key = pair.substr(0, eq), value = pair.substr(eq + 1);
+    long long k = 0;
+    if (key == "estimator") {
+      o.estimator = value;
+      estimator = !value.empty();
+    } else if (key == "samples") {
+      samples = parse_int(value, k) && k >= 1 && k <= INT32_MAX;
+      o.samples = static_cast<int>(k);
+    } else if (key == "seed") {
+      seed = parse_uint(value, o.seed);
+    } else if (key == "threshold") {
+      threshold = parse_double(value, o.threshold);
+    } else if (key == "hemicube_res") {
+      if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
+      o.hemicube_resolution = static_cast<int>(k);
+    } else if (key == "symmetrize") {
+      if (value != "0" && value != "1") return false;
+      o.symmetrize = value == "1";
+    }
+  }
+  if (!(estimator && samples && seed && threshold)) return false;
+  options = o;
+  return true;
+}
 
 void write_matrix_market(const std::string& path, const SparseF& F, const FormFactorFileInfo& info) {
   write_stream_atomically(path, [&](std::ostream& out) {

@@ -12,8 +12,21 @@ namespace lambert {
 /// Identity of the meshed scene and settings stored with a saved F.
 struct FormFactorFileInfo {
   std::uint64_t mesh_hash = 0;  ///< mesh_hash() of the PatchMesh F was computed on
-  std::string settings;         ///< human-readable settings (estimator, samples, seed, ...)
+  std::string settings;         ///< settings text: format_ff_settings() plus mesh notes
 };
+
+/// The settings of a computation as stored in a saved F: space-separated key=value pairs
+/// "estimator=E samples=K seed=S threshold=T hemicube_res=N symmetrize=0|1" (threshold with
+/// %.17g, so it reads back exactly). Writers may append more pairs (patches, max_edge).
+std::string format_ff_settings(const FormFactorOptions& options);
+
+/// Recovers estimator, samples, seed, threshold, hemicube_res and symmetrize from a stored
+/// settings text into `options` (other members untouched; unknown keys ignored). Returns
+/// false, leaving `options` unchanged, when any of estimator, samples, seed, threshold is
+/// missing or malformed (a file written by another tool). hemicube_res and symmetrize keep
+/// their values when absent (files before these were always stored wrote them for the
+/// hemicube only; the other estimators ignore them).
+bool parse_ff_settings(const std::string& text, FormFactorOptions& options);
 
 /// Writes F in Matrix Market coordinate real general format (1-based), atomically. The
 /// header comments carry the mesh hash and the settings.

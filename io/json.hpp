@@ -1,50 +1,21 @@
 #pragma once
-// A minimal streaming JSON writer (output only) for reports and summaries.
+// JSON reports and summaries through nlohmann-json: the document type every report is built
+// as, its text form and the atomic file writer.
 
-#include <cstdint>
-#include <ostream>
+#include <nlohmann/json.hpp>
 #include <string>
-#include <vector>
 
 namespace lambert {
 
-/// Writes JSON to a stream with correct commas and escaping. Usage:
-///   JsonWriter j(out); j.begin_object(); j.key("n"); j.value(3); j.end_object();
-/// Non-finite doubles are written as null (JSON has no NaN/Inf).
-class JsonWriter {
- public:
-  explicit JsonWriter(std::ostream& out) : out_(out) {}
-  void begin_object();
-  void end_object();
-  void begin_array();
-  void end_array();
-  /// Writes an object key; the next call writes its value.
-  void key(const std::string& k);
-  void value(double v);
-  void value(std::int64_t v);
-  void value(int v) { value(static_cast<std::int64_t>(v)); }
-  void value(bool v);
-  void value(const std::string& v);
-  void value(const char* v) { value(std::string(v)); }
-  void null();
-  /// Writes an array of numbers.
-  void value(const std::vector<double>& v);
-  /// Shorthand for key(k) followed by value(v).
-  template <typename T>
-  void field(const std::string& k, const T& v) {
-    key(k);
-    value(v);
-  }
+/// A JSON document whose object keys keep their insertion order (reports read top-down).
+using Json = nlohmann::ordered_json;
 
- private:
-  void separator();
-  std::ostream& out_;
-  std::vector<bool> first_;  // per open container: no element written yet
-  bool after_key_ = false;
-  int depth_ = 0;
-};
+/// The text of `j`: indented by 2, with a final newline. Non-finite numbers become null (JSON
+/// has no NaN/Inf); invalid UTF-8 in strings (e.g. a Latin-1 file name) is replaced by U+FFFD
+/// instead of throwing.
+std::string json_text(const Json& j);
 
-/// Escapes a string for JSON (quotes included).
-std::string json_quote(const std::string& s);
+/// Writes json_text(j) to `path` atomically (temp name in the same folder, then rename).
+void write_json_file(const std::string& path, const Json& j);
 
 }  // namespace lambert

@@ -112,12 +112,16 @@ double relative_residual(const RadiosityProblem& problem, const Eigen::MatrixX3d
   return s.relative_residual_uncounted(B.col(channel));
 }
 
-// Energy bookkeeping (power, W in scene units). H = F B is the irradiance: the power that
-// reaches patch i is sum_j A_j B_j F_ji = A_i sum_j F_ij B_j = A_i H_i by reciprocity.
+// Energy bookkeeping (power, W in scene units). H = F B is the irradiance: for a reciprocal
+// F the power that reaches patch i is sum_j A_j B_j F_ji = A_i sum_j F_ij B_j = A_i H_i.
 // Absorbed: a fraction (1 - rho_i) of it. Escaped: patch i's exitance times the fraction of
-// its hemisphere that sees no patch, A_i B_i (1 - sum_j F_ij). With sum_i A_i H_i =
-// sum_j A_j B_j sum_i F_ji (reciprocity), emitted - absorbed - escaped = sum A (E + rho H - B)
-// = sum A r: zero for an exact solution. Cost: one product with F.
+// its hemisphere that sees no patch, A_i B_i (1 - sum_j F_ij). Expanding,
+//   emitted - absorbed - escaped = sum A (E + rho H - B) + (sum A B rowsum(F) - sum A H)
+//                                = sum A r            + sum_ij A_i F_ij (B_i - B_j),
+// the residual part (zero for an exact solution) and the non-reciprocity part: the second
+// sum is sum_ij (A_j F_ji - A_i F_ij) B_j after relabelling its first half, zero when
+// A_i F_ij = A_j F_ji. Both parts are computed from their definitions (not as differences),
+// so each carries only the rounding of its own sums. Cost: one product with F.
 EnergyBalance energy_balance(const RadiosityProblem& problem, const Eigen::MatrixX3d& B,
                              int channel) {
   const SparseRowMatrix& F = *problem.F;
@@ -126,12 +130,16 @@ EnergyBalance energy_balance(const RadiosityProblem& problem, const Eigen::Matri
   multiply_f(F, b, h, 1);
   const Eigen::VectorXd row_sum = F * Eigen::VectorXd::Ones(F.cols());
   const Eigen::VectorXd& a = problem.area;
+  const Eigen::VectorXd rho = problem.rho.col(channel);
+  const Eigen::VectorXd e_col = problem.emission.col(channel);
   EnergyBalance e;
-  e.emitted = a.dot(problem.emission.col(channel));
-  e.absorbed = a.dot((1.0 - problem.rho.col(channel).array()).matrix().cwiseProduct(h));
+  e.emitted = a.dot(e_col);
+  e.absorbed = a.dot((1.0 - rho.array()).matrix().cwiseProduct(h));
   e.escaped = a.dot(b.cwiseProduct((1.0 - row_sum.array()).matrix()));
   const double imbalance = std::abs(e.emitted - e.absorbed - e.escaped);
   e.relative_imbalance = e.emitted > 0.0 ? imbalance / e.emitted : imbalance;
+  e.residual_part = a.dot(e_col + rho.cwiseProduct(h) - b);
+  e.non_reciprocity_part = a.dot(b.cwiseProduct(row_sum) - h);
   return e;
 }
 

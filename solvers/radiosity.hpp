@@ -51,6 +51,7 @@ struct ChannelReport {
   std::vector<int> history_iteration;    ///< iteration count at history point k (0 = guess)
   double seconds = 0.0;
   std::string note;  ///< solver remark (refinements, ambient, fallback)
+  int refinements = 0;  ///< southwell: restarts from the true residual (F not reciprocal)
 };
 
 /// Power bookkeeping of a solution, per channel (W in scene units).
@@ -59,6 +60,11 @@ struct EnergyBalance {
   double absorbed = 0.0;  ///< sum_i A_i (1 - rho_i) H_i, H = F B the irradiance (see below)
   double escaped = 0.0;   ///< power leaving through open boundaries: sum_i A_i B_i (1 - sum_j F_ij)
   double relative_imbalance = 0.0;  ///< |emitted - absorbed - escaped| / emitted
+  /// The imbalance emitted - absorbed - escaped split into its two causes (W, signed; they
+  /// add up to it to rounding):
+  double residual_part = 0.0;         ///< sum_i A_i r_i, r = E + rho H - B: the solver's share
+  double non_reciprocity_part = 0.0;  ///< sum_ij (A_i F_ij B_i - A_i F_ij B_j): F's share,
+                                      ///< 0 when A_i F_ij = A_j F_ji
 };
 
 /// The solution of all three channels.
@@ -86,9 +92,10 @@ double relative_residual(const RadiosityProblem& problem, const Eigen::MatrixX3d
 
 /// Power bookkeeping of channel c of B. With H = F B (irradiance, by reciprocity
 /// A_i H_i = sum_j A_j F_ji B_j is the power arriving at i): emitted sum A_i E_i,
-/// absorbed sum A_i (1 - rho_i) H_i, escaped sum A_i B_i (1 - sum_j F_ij). For a reciprocal
-/// F (A_i F_ij = A_j F_ji), emitted - absorbed - escaped = sum_i A_i r_i exactly, with
-/// r = E - K B the residual, so an exact solution (B = E + rho H) balances exactly.
+/// absorbed sum A_i (1 - rho_i) H_i, escaped sum A_i B_i (1 - sum_j F_ij). Always
+/// emitted - absorbed - escaped = residual_part + non_reciprocity_part: sum_i A_i r_i with
+/// r = E - K B the residual (0 for an exact solution), plus
+/// sum_i A_i B_i sum_j F_ij - sum_i A_i H_i (0 for a reciprocal F, A_i F_ij = A_j F_ji).
 EnergyBalance energy_balance(const RadiosityProblem& problem, const Eigen::MatrixX3d& B,
                              int channel);
 

@@ -106,6 +106,7 @@ ChannelReport solve_southwell(const ChannelSystem& system, const SolveOptions& o
   report.residual = system.relative_residual_uncounted(B);
   if (report.history_iteration.back() != report.iterations || shot % n != 0)
     record(report, report.iterations, report.residual, report.seconds);
+  report.refinements = refinements;
   if (refinements > 0)
     report.note = std::to_string(refinements) + " refinement(s): F is not exactly reciprocal";
   if (options.ambient) {

@@ -1,7 +1,6 @@
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -15,19 +14,8 @@ using testing::run;
 using testing::slurp;
 namespace {
 
-
-
-// Numbers of the JSON array that follows `"key": [` (flat arrays only).
-std::vector<double> json_numbers(const std::string& json, const std::string& key) {
-  std::vector<double> out;
-  size_t at = json.find("\"" + key + "\": [");
-  if (at == std::string::npos) return out;
-  at = json.find('[', at) + 1;
-  const size_t end = json.find(']', at);
-  std::stringstream ss(json.substr(at, end - at));
-  std::string tok;
-  while (std::getline(ss, tok, ',')) out.push_back(std::stod(tok));
-  return out;
+nlohmann::json parse_json_file(const std::string& path) {
+  return nlohmann::json::parse(slurp(path));
 }
 
 // The inside of a unit cube as an OBJ file (faces wound to point inwards).
@@ -47,9 +35,12 @@ TEST(FormFactorsCommand, SensorPointAtTheCubeCentreSeesEachFaceAnalytically) {
   ASSERT_EQ(run({"formfactors", obj, "-q", "--point", "0.5,0.5,0.5", "--normal", "0,0,1",
                  "--max-edge", "0.5", "-o", out}),
             kExitOk);
-  const std::string json = slurp(out);
-  const auto F = json_numbers(json, "F");
+  const nlohmann::json json = parse_json_file(out);
+  const auto F = json.at("F").get<std::vector<double>>();
   ASSERT_EQ(F.size(), 6u);
+  ASSERT_EQ(json.at("surfaces").get<std::vector<std::string>>(),
+            (std::vector<std::string>{"bottom", "top", "left", "right", "front", "back"}));
+  ASSERT_EQ(json.at("stderr").size(), 6u);
   // Surfaces in file order: bottom, top, left, right, front, back. Facing +z from the
   // centre: the top face is a centred parallel square (side 1 at distance 0.5), four times
   // the corner formula with A = B = 1: (2/π)(1/√2) atan(1/√2) x 2 = 0.55397...; the sides
@@ -68,23 +59,21 @@ TEST(FormFactorsCommand, BySurfaceTableIsReciprocalAndRowsOfTheClosedCubeSumToOn
   ASSERT_EQ(run({"formfactors", obj, "-q", "--by-surface", "--max-edge", "0.5", "--samples", "4",
                  "-o", out}),
             kExitOk);
-  const std::string json = slurp(out);
-  EXPECT_NE(json.find("\"surfaces\""), std::string::npos);
-  EXPECT_NE(json.find("\"stderr\""), std::string::npos);
-  // Rows: F[g] arrays appear in order after "F": [[ ... ]]; parse the whole nested block.
-  const size_t at = json.find("\"F\": [");
-  std::string block = json.substr(at, json.find("\"stderr\"") - at);
+  const nlohmann::json json = parse_json_file(out);
+  ASSERT_EQ(json.at("surfaces").size(), 6u);
+  // Six unit faces, each the sum of four 0.5 x 0.5 patches (exact in binary): 1e-15 is a
+  // few ulp of 1.
+  for (const auto& area : json.at("areas")) EXPECT_NEAR(area.get<double>(), 1.0, 1e-15);
+  const auto F = json.at("F").get<std::vector<std::vector<double>>>();
+  const auto err = json.at("stderr").get<std::vector<std::vector<double>>>();
+  ASSERT_EQ(F.size(), 6u);
+  ASSERT_EQ(err.size(), 6u);
   std::vector<double> all;
-  std::string num;
-  for (char c : block.substr(5)) {
-    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == 'e' || c == '-') {
-      num += c;
-    } else if (!num.empty()) {
-      all.push_back(std::stod(num));
-      num.clear();
-    }
+  for (int g = 0; g < 6; ++g) {
+    ASSERT_EQ(F[g].size(), 6u);
+    ASSERT_EQ(err[g].size(), 6u);
+    all.insert(all.end(), F[g].begin(), F[g].end());
   }
-  ASSERT_EQ(all.size(), 36u);
   for (int g = 0; g < 6; ++g) {
     double sum = 0;
     for (int h = 0; h < 6; ++h) {
@@ -103,7 +92,14 @@ TEST(FormFactorsCommand, SavedMatrixIsRefusedForAnotherMeshing) {
   const std::string obj = dir.write("c.obj", kCubeObj);
   ASSERT_EQ(run({"formfactors", obj, "-q", "--max-edge", "0.5", "--samples", "2", "-o", dir.file("F.mtx")}), kExitOk);
   ASSERT_EQ(run({"formfactors", obj, "-q", "--max-edge", "0.5", "--samples", "2", "-o", dir.file("F.bin")}), kExitOk);
-  EXPECT_NE(slurp(dir.file("F.report.json")).find("\"reciprocity_max\""), std::string::npos);
+  const nlohmann::json report = parse_json_file(dir.file("F.report.json"));
+  // hybrid computes A_i F_ij once per pair: reciprocal to rounding (|A_i F_ij| <= 1, so a few
+  // ulp of 1).
+  EXPECT_LE(report.at("reciprocity_max").get<double>(), 1e-14);
+  EXPECT_EQ(report.at("patches").get<int>(), 24);  // six unit faces at --max-edge 0.5: 2 x 2 each
+  EXPECT_EQ(report.at("nnz").get<std::int64_t>(),
+            24 * 20);  // every patch sees all but its face's 4
+  EXPECT_EQ(report.at("entries_negative").get<int>(), 0);
   EXPECT_EQ(run({"formfactors", "-q", "-o", dir.file("x.bin"), "--estimator", "nope"}), kExitUsage);
 }
 

@@ -104,7 +104,9 @@ TEST(LightingWarnings, InsideOutCubeWarnsOnceForComputedAndLoadedF) {
   for (const auto& args :
        {small({"solve", obj, "-o", dir.file("B.csv")}),
         small({"formfactors", obj, "-o", dir.file("F.bin")}),
-        small({"solve", obj, "--ff", dir.file("F.bin"), "-o", dir.file("B2.csv")})}) {
+        // --samples would be refused with --ff (the file's own settings are used).
+        std::vector<std::string>{"solve", obj, "--ff", dir.file("F.bin"), "--max-edge", "0.5",
+                                 "-o", dir.file("B2.csv")}}) {
     const auto [code, err] = run_captured(args);
     EXPECT_EQ(code, kExitOk) << args[0] << '\n' << err;
     EXPECT_EQ(count(err, warning), 1) << args[0] << '\n' << err;

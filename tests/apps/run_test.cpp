@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -62,9 +63,38 @@ TEST(RunCommand, TinySceneProducesEveryFile) {
             5);
   EXPECT_EQ(slurp(out + "/tiny.png").substr(1, 3), "PNG");
   EXPECT_EQ(slurp(out + "/tiny.ply").substr(0, 4), "ply\n");
-  const std::string report = slurp(out + "/report.json");
-  for (const char* key : {"\"energy_balance\"", "\"vertex_power\"", "\"seconds\"", "\"files\""})
-    EXPECT_NE(report.find(key), std::string::npos) << key;
+  const nlohmann::json report = nlohmann::json::parse(slurp(out + "/report.json"));
+  EXPECT_EQ(report.at("surfaces").get<int>(), 6);
+  const auto& ff = report.at("form_factors");
+  EXPECT_EQ(ff.at("estimator"), "hybrid");
+  EXPECT_EQ(ff.at("samples").get<int>(), 4);
+  EXPECT_EQ(ff.at("seed").get<int>(), 1);
+  EXPECT_EQ(ff.at("loaded_from"), "");
+  EXPECT_GT(ff.at("rays").get<std::int64_t>(), 0);
+  EXPECT_EQ(report.at("solver").at("status"), "converged");
+  ASSERT_EQ(report.at("energy_balance").size(), 3u);
+  for (const auto& e : report.at("energy_balance")) {
+    // Light Ke 10 9 8 on a 0.2 x 0.2 patch: emitted = 0.04 Ke per channel.
+    EXPECT_GT(e.at("emitted").get<double>(), 0.0);
+    // Converged to tol 1e-8 on hybrid's reciprocal F: the imbalance is the residual part,
+    // |sum A r| / emitted <= ||A||_2 ||r||_2 / emitted ~ 1e-8; 1e-6 leaves a margin.
+    EXPECT_LE(e.at("relative_imbalance").get<double>(), 1e-6);
+  }
+  const auto& emitted = report.at("energy_balance");
+  // The light is 0.2 x 0.2 (area exact to rounding of its corners, ~1e-16): emitted = 0.04 Ke,
+  // a sum of a few patch terms, so 1e-12 is rounding with a wide margin.
+  EXPECT_NEAR(emitted[0].at("emitted").get<double>(), 0.4, 1e-12);
+  EXPECT_NEAR(emitted[2].at("emitted").get<double>(), 0.32, 1e-12);
+  const auto& power = report.at("vertex_power");
+  EXPECT_EQ(power.at("interpolation"), "conservative");
+  EXPECT_LE(power.at("max_relative_error").get<double>(), power.at("tolerance").get<double>());
+  EXPECT_EQ(power.at("surfaces").size(), 6u);
+  EXPECT_EQ(report.at("render").at("width").get<int>(), 40);
+  EXPECT_EQ(report.at("render").at("height").get<int>(), 30);
+  EXPECT_GE(report.at("seconds").at("total").get<double>(), 0.0);
+  EXPECT_EQ(report.at("rays_total").get<std::int64_t>(),
+            ff.at("rays").get<std::int64_t>() + report.at("render").at("rays").get<std::int64_t>());
+  EXPECT_EQ(report.at("files").size(), 5u);
   const Image img = read_image_exr(out + "/tiny.exr");
   EXPECT_EQ(img.width, 40);
   EXPECT_EQ(img.height, 30);

@@ -90,3 +90,66 @@ TEST(FormFactorFile, TruncatedOrCorruptBinaryIsRefused) {
 }
 
 }  // namespace lambert
+
+namespace lambert {
+
+TEST(FormFactorFile, SettingsTextRecoversEverySettingExactly) {
+  FormFactorOptions o;
+  o.estimator = "hemicube";
+  o.samples = 77;
+  o.seed = 18446744073709551615ull;  // the largest seed: all 64 bits survive
+  o.threshold = 1.0 / 3.0;           // %.17g reads back to the same double
+  o.hemicube_resolution = 96;
+  o.symmetrize = true;
+  FormFactorOptions back;
+  ASSERT_TRUE(parse_ff_settings(format_ff_settings(o) + " patches=24 max_edge=0.5", back));
+  EXPECT_EQ(back.estimator, "hemicube");
+  EXPECT_EQ(back.samples, 77);
+  EXPECT_EQ(back.seed, o.seed);
+  EXPECT_EQ(back.threshold, o.threshold);
+  EXPECT_EQ(back.hemicube_resolution, 96);
+  EXPECT_TRUE(back.symmetrize);
+}
+
+TEST(FormFactorFile, SettingsOfOlderFilesAreRecoveredAndForeignTextIsRefused) {
+  // What `formfactors` wrote before every key was stored: no hemicube_res/symmetrize.
+  FormFactorOptions o;
+  ASSERT_TRUE(
+      parse_ff_settings("estimator=mc samples=64 seed=5 threshold=0 patches=9 max_edge=1", o));
+  EXPECT_EQ(o.estimator, "mc");
+  EXPECT_EQ(o.samples, 64);
+  EXPECT_EQ(o.seed, 5u);
+  EXPECT_FALSE(o.symmetrize);
+  for (const char* foreign :
+       {"", "made by hand", "estimator=mc samples=64", "estimator=mc samples=x seed=1 threshold=0",
+        "estimator=mc samples=4 seed=-1 threshold=0"}) {
+    FormFactorOptions untouched;
+    untouched.estimator = "keep";
+    EXPECT_FALSE(parse_ff_settings(foreign, untouched)) << foreign;
+    EXPECT_EQ(untouched.estimator, "keep") << foreign;
+  }
+}
+
+TEST(FormFactorFile, MatrixMarketKeepsTheSettingsInItsHeaderComments) {
+  Fixture f;
+  testing::TempDir dir;
+  FormFactorOptions o;
+  o.estimator = "mc";
+  o.samples = 64;
+  o.seed = 5;
+  write_matrix_market(dir.file("F.mtx"), f.ff.F, {f.info.mesh_hash, format_ff_settings(o)});
+  std::ifstream in(dir.file("F.mtx"));
+  bool found = false;
+  for (std::string line; std::getline(in, line) && line[0] == '%';)
+    found = found || line == "% lambert-settings: " + format_ff_settings(o);
+  EXPECT_TRUE(found);
+  FormFactorFileInfo info;
+  read_form_factors(dir.file("F.mtx"), f.info.mesh_hash, f.mesh.size(), &info);
+  FormFactorOptions back;
+  ASSERT_TRUE(parse_ff_settings(info.settings, back));
+  EXPECT_EQ(back.estimator, "mc");
+  EXPECT_EQ(back.samples, 64);
+  EXPECT_EQ(back.seed, 5u);
+}
+
+}  // namespace lambert
