@@ -75,4 +75,9 @@ LoadedScene load_scene(const SceneArgs& args) {
   return out;
 }
 
+const Bvh& scene_bvh(const LoadedScene& scene, int threads) {
+  if (!scene.bvh) scene.bvh = std::make_shared<const Bvh>(scene.mesh, threads);
+  return *scene.bvh;
+}
+
 }  // namespace lambert

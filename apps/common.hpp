@@ -3,8 +3,10 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <memory>
 #include <string>
 
+#include "geometry/bvh.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/scene.hpp"
 
@@ -38,7 +40,12 @@ struct LoadedScene {
   Scene scene;
   PatchMesh mesh;
   double max_edge = 0.0;  ///< the --max-edge actually used (0 = one element per face)
+  /// The mesh's BVH, built on first use by scene_bvh and shared by every stage of a run.
+  mutable std::shared_ptr<const Bvh> bvh;
 };
+
+/// The BVH of the scene's mesh (built once, with `threads` Embree threads; 0 = all cores).
+const Bvh& scene_bvh(const LoadedScene& scene, int threads);
 
 /// CLI11 check for an output file option: its directory must exist (checked before any
 /// work, so a long computation never ends in a failed write).

@@ -68,11 +68,16 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
   }
   FormFactorOptions o = make_ff_options(args, run);
   o.with_stderr = with_stderr;
-  FormFactors ff = compute_form_factors(scene.mesh, o);
+  FormFactors ff = compute_form_factors(scene.mesh, o, &scene_bvh(scene, run.threads));
   log_info("form factors: " + std::to_string(scene.mesh.size()) + " patches, " +
            format_si(static_cast<double>(ff.F.nonZeros())) + " entries, " +
            format_si(static_cast<double>(ff.stats.rays)) + " rays in " +
            format_duration(ff.stats.seconds));
+  if (ff.stats.pairs_unverified > 0)
+    log_warn(std::to_string(ff.stats.pairs_unverified) +
+             " patch pairs could not have their visibility sampled as designed (no ray could be "
+             "traced, or the kernel sampler gave up): their factors are unoccluded values or "
+             "approximate; a degenerate (sliver or grazing) patch is the likely cause");
   return ff;
 }
 

@@ -73,7 +73,7 @@ int run_render(const RenderOptions& opts) {
   const ShadedField shaded = shade_vertices(loaded.mesh, r.B, opts.shade);
   RenderStats stats;
   const Image image =
-      render_scene(loaded.mesh, r.B, shaded.field, camera, opts.shade, opts.run, &stats);
+      render_scene(loaded, r.B, shaded.field, camera, opts.shade, opts.run, &stats);
   const double ev = choose_exposure(opts.shade, image);
   OutputPaths paths;
   paths.image_exr = opts.output;

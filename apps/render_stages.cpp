@@ -124,11 +124,12 @@ ShadedField shade_vertices(const PatchMesh& mesh, const Eigen::MatrixX3d& B,
   return s;
 }
 
-Image render_scene(const PatchMesh& mesh, const Eigen::MatrixX3d& B, const VertexField& field,
+Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const VertexField& field,
                    const Camera& camera, const ShadeArgs& args, const RunArgs& run,
                    RenderStats* stats) {
   const Timer timer;
-  const Bvh bvh(mesh);
+  const PatchMesh& mesh = scene.mesh;
+  const Bvh& bvh = scene_bvh(scene, run.threads);
   RenderSettings settings;
   settings.flat = args.flat;
   settings.antialias = args.antialias;
@@ -136,7 +137,7 @@ Image render_scene(const PatchMesh& mesh, const Eigen::MatrixX3d& B, const Verte
   settings.threads = run.threads;
   settings.progress = !run.quiet;
   Image img = render(mesh, bvh, camera, B, field, settings, stats);
-  if (stats) stats->seconds = timer.seconds();  // including the BVH build
+  if (stats) stats->seconds = timer.seconds();  // including the BVH build when not yet built
   log_info("render: " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + ", " +
            std::to_string(args.antialias * args.antialias) + " samples/pixel, " +
            (args.flat ? "flat" : "Gouraud") + " shading in " + format_duration(timer.seconds()));

@@ -70,8 +70,8 @@ struct ShadedField {
 /// Interpolates B to the shading vertices with --vertex-interp.
 ShadedField shade_vertices(const PatchMesh& mesh, const Eigen::MatrixX3d& B, const ShadeArgs& args);
 
-/// Builds the BVH and renders the scene through `camera`.
-Image render_scene(const PatchMesh& mesh, const Eigen::MatrixX3d& B, const VertexField& field,
+/// Renders the scene through `camera` (with the run's shared BVH, scene_bvh).
+Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const VertexField& field,
                    const Camera& camera, const ShadeArgs& args, const RunArgs& run,
                    RenderStats* stats);
 

@@ -225,7 +225,7 @@ int run_run(const RunOptions& opts) {
   stage(5, "rendering " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
   RenderStats rs;
   const Image image =
-      render_scene(loaded.mesh, r.B, shaded.field, camera, opts.shade, opts.run, &rs);
+      render_scene(loaded, r.B, shaded.field, camera, opts.shade, opts.run, &rs);
   t.render = rs.seconds;
   const double ev = choose_exposure(opts.shade, image);
 

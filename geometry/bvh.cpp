@@ -2,7 +2,11 @@
 
 #include <embree3/rtcore.h>
 
+#include <atomic>
 #include <limits>
+#include <map>
+#include <mutex>
+#include <string>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -35,18 +39,55 @@ struct SceneDeleter {
   void operator()(RTCSceneTy* s) const { rtcReleaseScene(s); }
 };
 
+std::atomic<std::int64_t> g_builds{0};
+
+// The process's Embree devices, one per thread count, created on first use and released at
+// exit (after every Bvh: a Bvh keeps its device alive through the shared pointer).
+struct DeviceRegistry {
+  std::mutex mutex;
+  std::map<int, std::shared_ptr<RTCDeviceTy>> devices;
+};
+DeviceRegistry& device_registry() {
+  static DeviceRegistry registry;
+  return registry;
+}
+
+std::shared_ptr<RTCDeviceTy> process_device(int threads) {
+  DeviceRegistry& r = device_registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  auto& devices = r.devices;
+  std::shared_ptr<RTCDeviceTy>& d = devices[threads];
+  if (d) return d;
+  const std::string config =
+      "verbose=0" + (threads > 0 ? ",threads=" + std::to_string(threads) : std::string());
+  d.reset(rtcNewDevice(config.c_str()), DeviceDeleter());
+  if (!d) {
+    devices.erase(threads);
+    throw Error("embree: cannot create device");
+  }
+  rtcSetDeviceErrorFunction(d.get(), embree_error, nullptr);
+  return d;
+}
+
 }  // namespace
 
 struct Bvh::Impl {
-  std::unique_ptr<RTCDeviceTy, DeviceDeleter> device;
-  std::unique_ptr<RTCSceneTy, SceneDeleter> scene;
+  std::shared_ptr<RTCDeviceTy> device;
+  std::unique_ptr<RTCSceneTy, SceneDeleter> scene;  // released before the device
 };
 
-Bvh::Bvh(const PatchMesh& mesh) : impl_(std::make_unique<Impl>()) {
-  impl_->device.reset(rtcNewDevice("verbose=0"));
-  if (!impl_->device) throw Error("embree: cannot create device");
+std::int64_t Bvh::builds() { return g_builds.load(); }
+
+std::int64_t Bvh::devices() {
+  DeviceRegistry& r = device_registry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  return static_cast<std::int64_t>(r.devices.size());
+}
+
+Bvh::Bvh(const PatchMesh& mesh, int threads) : impl_(std::make_unique<Impl>()) {
+  ++g_builds;
+  impl_->device = process_device(threads);
   RTCDevice device = impl_->device.get();
-  rtcSetDeviceErrorFunction(device, embree_error, nullptr);
   impl_->scene.reset(rtcNewScene(device));
   check_device(device, "rtcNewScene");
   RTCScene scene = impl_->scene.get();

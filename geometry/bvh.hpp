@@ -17,11 +17,14 @@ struct RayHit {
 };
 
 /// An acceleration structure over a PatchMesh. Every patch blocks rays from both sides.
-/// Queries are const and thread-safe; construction is not.
+/// Queries are const and thread-safe; construction is not. All BVHs of a process share one
+/// Embree device per thread count (in practice one: the command's -j), created on first use
+/// and kept for the life of the process.
 class Bvh {
  public:
-  /// Builds the BVH (robust mode, high quality). Throws Error if Embree fails.
-  explicit Bvh(const PatchMesh& mesh);
+  /// Builds the BVH (robust mode, high quality) on the process's device for `threads`
+  /// worker threads (0 = all cores). Throws Error if Embree fails.
+  explicit Bvh(const PatchMesh& mesh, int threads = 0);
   ~Bvh();
   Bvh(const Bvh&) = delete;
   Bvh& operator=(const Bvh&) = delete;
@@ -35,6 +38,10 @@ class Bvh {
   RayHit intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
                    float tnear = 0.0f,
                    float tfar = std::numeric_limits<float>::infinity()) const;
+
+  /// BVHs built and Embree devices created so far by this process (for tests and logs).
+  static std::int64_t builds();
+  static std::int64_t devices();
 
  private:
   struct Impl;

@@ -134,7 +134,7 @@ PointFactors point_form_factors(const PatchMesh& mesh, const Eigen::Vector3d& po
     throw UsageError("--point and --normal must be finite and the normal non-zero");
   const Eigen::Vector3d n = normal.normalized();
   const std::vector<ff::PatchGeom> geom = ff::patch_geometry(mesh);
-  const Bvh bvh(mesh);
+  const Bvh bvh(mesh, options.threads);
   const double offset = ff::kRayOffset * mesh.scale;
   const std::int32_t np = mesh.size();
   std::vector<double> f(np, 0.0), var(np, 0.0);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
@@ -24,11 +25,10 @@ struct UpperEntry {
 }  // namespace
 
 FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& options,
-                             PairEstimator estimator) {
+                             const Bvh& bvh, PairEstimator estimator) {
   Timer timer;
   const std::int32_t n = mesh.size();
   const std::vector<PatchGeom> geom = patch_geometry(mesh);
-  const Bvh bvh(mesh);
   const PairContext ctx{geom, bvh, options.samples, options.seed, kRayOffset * mesh.scale};
   const double plane_eps = kPlaneEps * mesh.scale;
 
@@ -123,21 +123,24 @@ namespace {
 
 struct EstimatorEntry {
   const char* name;
-  FormFactors (*compute)(const PatchMesh&, const FormFactorOptions&);
+  bool traces_rays;  ///< needs a BVH and reports replicate standard errors (needs samples >= 4)
+  FormFactors (*compute)(const PatchMesh&, const FormFactorOptions&, const Bvh*);
 };
 
 const std::vector<EstimatorEntry>& registry() {
   static const std::vector<EstimatorEntry> table = {
-      {"hybrid",
-       [](const PatchMesh& m, const FormFactorOptions& o) {
-         return ff::compute_pairwise(m, o, ff::estimate_hybrid);
+      {"hybrid", true,
+       [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
+         return ff::compute_pairwise(m, o, *b, ff::estimate_hybrid);
        }},
-      {"mc",
-       [](const PatchMesh& m, const FormFactorOptions& o) {
-         return ff::compute_pairwise(m, o, ff::estimate_mc);
+      {"mc", true,
+       [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
+         return ff::compute_pairwise(m, o, *b, ff::estimate_mc);
        }},
-      {"hemicube",
-       [](const PatchMesh& m, const FormFactorOptions& o) { return ff::compute_hemicube(m, o); }},
+      {"hemicube", false,
+       [](const PatchMesh& m, const FormFactorOptions& o, const Bvh*) {
+         return ff::compute_hemicube(m, o);  // rasterises: no rays
+       }},
   };
   return table;
 }
@@ -174,17 +177,23 @@ std::vector<std::string> form_factor_estimators() {
   return names;
 }
 
-FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions& options) {
+FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions& options,
+                                 const Bvh* bvh) {
   if (options.samples < 1) throw UsageError("--samples must be at least 1");
-  // Standard errors come from the spread of independent replicates (replicates.hpp), which
-  // needs at least two of them, and Student's t with so few is wide: ask for four.
-  if (options.with_stderr && options.samples < 4 && options.estimator != "hemicube")
-    throw UsageError("--stderr needs --samples of at least 4 (standard errors come from "
-                     "independent replicates of the samples)");
   if (mesh.patches.empty()) throw UsageError("the scene has no patches");
   for (const auto& e : registry()) {
     if (options.estimator != e.name) continue;
-    FormFactors out = e.compute(mesh, options);
+    // Standard errors come from the spread of independent replicates (replicates.hpp),
+    // which needs at least two of them, and Student's t with so few is wide: ask for four.
+    if (e.traces_rays && options.with_stderr && options.samples < 4)
+      throw UsageError("--stderr needs --samples of at least 4 (standard errors come from "
+                       "independent replicates of the samples)");
+    std::unique_ptr<Bvh> own;
+    if (!bvh && e.traces_rays) {
+      own = std::make_unique<Bvh>(mesh, options.threads);
+      bvh = own.get();
+    }
+    FormFactors out = e.compute(mesh, options, bvh);
     apply_threshold(out, options.threshold);
     return out;
   }

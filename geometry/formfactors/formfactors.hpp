@@ -53,9 +53,13 @@ struct FormFactors {
 /// Names of the available estimators ("mc", "hybrid", ...).
 std::vector<std::string> form_factor_estimators();
 
+class Bvh;
+
 /// Computes F for every patch pair of `mesh` with the chosen estimator. Multi-threaded;
-/// for a given seed the result is bitwise identical for any thread count. Throws UsageError
-/// for an unknown estimator or invalid settings.
-FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions& options);
+/// for a given seed the result is bitwise identical for any thread count. `bvh` (built over
+/// `mesh`) is used for the visibility rays when given, so that one BVH serves a whole run;
+/// otherwise one is built. Throws UsageError for an unknown estimator or invalid settings.
+FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions& options,
+                                 const Bvh* bvh = nullptr);
 
 }  // namespace lambert

@@ -45,9 +45,9 @@ PairEstimate estimate_mc(const PairContext& ctx, std::int32_t i, std::int32_t j)
 /// kernel's density. Exact (to quadrature, < 1e-6) for unoccluded pairs.
 PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_t j);
 
-/// Runs `estimator` over all pairs in parallel and assembles F (and stderr if asked).
+/// Runs `estimator` over all pairs in parallel, tracing against `bvh` (built over `mesh`), and assembles F (and stderr if asked).
 FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& options,
-                             PairEstimator estimator);
+                             const Bvh& bvh, PairEstimator estimator);
 
 /// True when the segment between x (on a patch with normal nx) and y (normal ny) is free,
 /// with both ends lifted by `offset` along their normals so the end patches never occlude.

@@ -10,6 +10,7 @@
 #include "apps/cli.hpp"
 #include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
+#include "geometry/bvh.hpp"
 #include "io/exr.hpp"
 
 namespace lambert {
@@ -104,6 +105,19 @@ TEST(RunCommand, TinySceneProducesEveryFile) {
   // The summary reports the stages.
   for (const char* word : {"patches", "rays", "solver", "energy", "time", "files"})
     EXPECT_NE(stdout_text.find(word), std::string::npos) << word;
+}
+
+// One Embree device per process, one BVH per run, shared by form factors and rendering
+// (each test runs in a process of its own, so the process counters start at 0).
+TEST(RunCommand, BuildsOneBvhOnOneDeviceForFormFactorsAndRendering) {
+  lambert::testing::TempDir dir;
+  write_tiny_scene(dir);
+  ASSERT_EQ(Bvh::builds(), 0);
+  const int code = run({"run", dir.file("tiny.obj"), "-o", dir.file("out/"), "--patches", "80",
+                        "--samples", "4", "--size", "40x30", "-q", "-j", "2"});
+  ASSERT_EQ(code, kExitOk);
+  EXPECT_EQ(Bvh::builds(), 1);
+  EXPECT_EQ(Bvh::devices(), 1);
 }
 
 TEST(RunCommand, NamePrefixAndBuiltInCornellBox) {
