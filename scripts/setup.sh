@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 preset="${1:-release}"
 
 packages=(build-essential cmake pkg-config libembree-dev libeigen3-dev libopenexr-dev
-          libtinyobjloader-dev libgtest-dev libcli11-dev zlib1g-dev)
+          libgtest-dev libcli11-dev zlib1g-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
