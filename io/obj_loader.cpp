@@ -48,11 +48,14 @@ std::string where(const std::string& file, int line) {
   return line > 0 ? file + ":" + std::to_string(line) : file;
 }
 
-std::string rgb(const Eigen::Vector3d& c) {
+// Shortest readable form of a number (6 significant digits, no trailing zeros).
+std::string num(double x) {
   std::ostringstream s;
-  s << c[0] << " " << c[1] << " " << c[2];
+  s << x;
   return s.str();
 }
+
+std::string rgb(const Eigen::Vector3d& c) { return num(c[0]) + " " + num(c[1]) + " " + num(c[2]); }
 
 std::string list_names(const std::set<std::string>& names) {
   std::string out;
@@ -181,7 +184,7 @@ Materials build_materials(const ObjData& obj, const std::vector<MtlMaterial>& de
     scene.materials.push_back(mat);
   }
   if (!clamped.empty())
-    diag.warn(name + ": Kd clamped to --max-reflectance " + std::to_string(options.max_reflectance) +
+    diag.warn(name + ": Kd clamped to --max-reflectance " + num(options.max_reflectance) +
               " in material(s) " + list_names(clamped));
   auto add_default = [&](const std::string& mat_name) {
     scene.materials.push_back({mat_name, options.default_reflectance, Eigen::Vector3d::Zero()});
@@ -273,7 +276,7 @@ std::map<std::int32_t, std::set<std::int32_t>> build_faces(const ObjData& obj,
                        std::to_string(kMaxSplitCorners) + " cannot be split into triangles)");
     ++report.nonplanar_faces_split;
     diag.warn(where(name, of.line) + ": non-planar polygon (off its plane by " +
-              std::to_string(off) + ") split into triangles");
+              num(off) + ") split into triangles");
     for (const auto& t : triangulate(poly)) {
       Face tri = face;
       tri.vertices = {face.vertices[t[0]], face.vertices[t[1]], face.vertices[t[2]]};
@@ -493,7 +496,7 @@ Scene load_obj_stream(std::istream& in, const std::string& name, const MtlOpener
   if (scene.faces.empty()) throw SceneError(name + ": empty scene: no faces with positive area");
   const auto [lo, hi] = scene.bounds();
   if ((hi - lo).norm() < kMinSceneExtent)
-    throw SceneError(name + ": scene extent " + std::to_string((hi - lo).norm()) +
+    throw SceneError(name + ": scene extent " + num((hi - lo).norm()) +
                      " is below 1e-50, where form factors underflow: rescale the scene");
   report_coincident(scene, name, diag, report);
   apply_emit(options.emit, name, scene);
