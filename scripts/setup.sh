@@ -7,6 +7,8 @@ preset="${1:-release}"
 
 packages=(build-essential cmake pkg-config libembree-dev libeigen3-dev libopenexr-dev
           libgtest-dev libcli11-dev zlib1g-dev)
+# The fuzz preset builds with clang and links libFuzzer (from libclang-rt).
+[[ "$preset" == fuzz ]] && packages+=(clang libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
