@@ -367,16 +367,36 @@ std::vector<std::array<double, 3>> corner_key(const Scene& scene, const Face& f)
   return key;
 }
 
+std::uint64_t hash_key(const std::vector<std::array<double, 3>>& key) {
+  std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the coordinates' bits
+  for (const auto& p : key) {
+    for (double x : p) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &x, sizeof bits);
+      h = (h ^ bits) * 1099511628211ull;
+    }
+  }
+  return h;
+}
+
 // Faces with exactly the corners of an earlier face (a second copy of the floor) count
 // their area twice and push row sums of F above 1: one warning per pair of surfaces.
+// Faces are bucketed by a hash of their sorted corners and compared exactly.
 void report_coincident(const Scene& scene, const std::string& name, Diagnostics& diag,
                        LoadReport& report) {
-  std::map<std::vector<std::array<double, 3>>, size_t> first;
+  std::unordered_multimap<std::uint64_t, size_t> seen;
+  seen.reserve(scene.faces.size());
   std::map<std::pair<std::int32_t, std::int32_t>, std::pair<size_t, int>> pairs;  // -> (f, count)
   std::vector<std::pair<size_t, size_t>> examples;
   for (size_t f = 0; f < scene.faces.size(); ++f) {
-    auto [it, added] = first.emplace(corner_key(scene, scene.faces[f]), f);
-    if (added) continue;
+    const auto key = corner_key(scene, scene.faces[f]);
+    const std::uint64_t h = hash_key(key);
+    auto [lo, hi] = seen.equal_range(h);
+    auto it = std::find_if(lo, hi, [&](const auto& e) { return corner_key(scene, scene.faces[e.second]) == key; });
+    if (it == hi) {
+      seen.emplace(h, f);
+      continue;
+    }
     ++report.coincident_faces;
     const Face& a = scene.faces[it->second];
     const Face& b = scene.faces[f];
@@ -415,13 +435,13 @@ void apply_emit(const std::vector<EmitRule>& rules, const std::string& name, Sce
     if (!any)
       throw UsageError("--emit '" + rule.pattern + "': no surface or material of " + name +
                        " matches (lambert info lists the names)");
+    std::vector<bool> shared(scene.materials.size());  // also used by an unmatched surface
+    for (size_t s = 0; s < scene.surfaces.size(); ++s)
+      if (!hit[s]) shared[scene.surfaces[s].material] = true;
     for (size_t s = 0; s < scene.surfaces.size(); ++s) {
       if (!hit[s]) continue;
       Surface& surf = scene.surfaces[s];
-      bool shared = false;
-      for (size_t t = 0; t < scene.surfaces.size(); ++t)
-        shared = shared || (!hit[t] && scene.surfaces[t].material == surf.material);
-      if (shared) {
+      if (shared[surf.material]) {
         Material copy = scene.materials[surf.material];
         copy.name += "@" + surf.name;
         surf.material = static_cast<std::int32_t>(scene.materials.size());
