@@ -58,9 +58,11 @@ TEST(ObjParser, PolygonsOfAnyCornerCountKeepEveryCornerAndTheirArea) {
     const Scene s = load_text(ngon(n));
     ASSERT_EQ(s.faces.size(), 2u) << n;
     EXPECT_EQ(s.faces[0].vertices.size(), static_cast<size_t>(n)) << n;
-    // Area n/2 sin(2 pi/n); the cosines were printed to 17 digits, so the area is exact to
-    // a few ulps times n (summation): 1e-12 relative covers n = 1e5 (1e5 * 1e-16 = 1e-11... of
-    // the terms, which are ~1/n of the total each, so ~1e-16 * sqrt(n) relative typically).
+    // Area n/2 sin(2 pi/n) <= pi. The corners are printed to 17 digits (exact round trip);
+    // each of the n - 2 fan cross products is ~2 pi/n and rounded to 1e-16 of itself, so
+    // the sum errs by at most ~n * 1e-16 * 2 pi / n = 6e-16 (worst case, no cancellation of
+    // errors): a tolerance of 1e-12 pi is 5000 times that. (The corner count is checked
+    // exactly above; the area catches corners taken from the wrong vertices.)
     EXPECT_NEAR(face_area(s, 0), 0.5 * n * std::sin(2 * M_PI / n), 1e-12 * M_PI) << n;
     // The face after the polygon is built from its own vertices.
     EXPECT_EQ(s.faces[1].vertices, (std::vector<std::int32_t>{n, n + 1, n + 2})) << n;
