@@ -14,6 +14,7 @@ namespace lambert {
 struct InfoOptions {
   SceneArgs scene;
   RunArgs run;
+  bool list_surfaces = false;  ///< --list-surfaces: names only, no meshing
 };
 /// Registers `info` on the app.
 CLI::App* add_info_command(CLI::App& app, InfoOptions& opts);

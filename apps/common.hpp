@@ -9,12 +9,15 @@
 #include "geometry/bvh.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/scene.hpp"
+#include "io/obj_loader.hpp"
 
 namespace lambert {
 
-/// Scene file and meshing target.
+/// Scene file, how to load it and meshing target.
 struct SceneArgs {
   std::string scene;                 ///< OBJ path; empty = built-in Cornell box
+  LoadOptions load;                  ///< --strict, --default-reflectance, --max-reflectance
+  std::vector<std::string> emit;     ///< --emit NAME_OR_GLOB=R,G,B, parsed by load_scene
   double max_edge = 0.0;             ///< --max-edge
   std::int64_t patches = 0;          ///< --patches
   std::int64_t default_patches = 0;  ///< used when neither is given
@@ -28,7 +31,8 @@ struct RunArgs {
   bool verbose = false;     ///< -v
 };
 
-/// Adds the positional SCENE and --max-edge / --patches to a subcommand.
+/// Adds the positional SCENE, the loading options (--strict, --default-reflectance,
+/// --max-reflectance, --emit) and --max-edge / --patches to a subcommand.
 void add_scene_options(CLI::App* cmd, SceneArgs& args);
 /// Adds -j/--threads, --seed, -q/--quiet and -v/--verbose to a subcommand.
 void add_run_options(CLI::App* cmd, RunArgs& args);
@@ -59,6 +63,8 @@ CLI::Validator output_prefix_check();
 /// a name ending in '/', created if needed) the prefix DIR/<name>; otherwise -o is the prefix.
 std::string output_prefix(const std::string& output, const std::string& name);
 
+/// Loads the scene (or the built-in Cornell box) with the loading options.
+Scene load_scene_file(const SceneArgs& args);
 /// Loads the scene (or the built-in Cornell box) and meshes it.
 LoadedScene load_scene(const SceneArgs& args);
 

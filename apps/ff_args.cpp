@@ -81,9 +81,9 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
   return ff;
 }
 
-void warn_about_lighting(const PatchMesh& mesh, const SparseF& F, bool solving) {
+void warn_about_lighting(const PatchMesh& mesh, const SparseF& F) {
   LightingProblems p = find_lighting_problems(mesh, F);
-  p.no_emitter = p.no_emitter && solving;
+  p.no_emitter = false;  // the scene loader has warned already, naming the file and --emit
   for (const std::string& line : lighting_warnings(mesh, p)) log_warn(line);
 }
 

@@ -37,9 +37,9 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
                                 const RunArgs& run, bool with_stderr = false);
 
 /// Warns once per cause (analysis.hpp's find_lighting_problems) when F makes the result
-/// silently B = E: nothing sees anything, or an emitter sees nothing. `solving` adds the
-/// no-emitter warning (F by itself needs no emitter).
-void warn_about_lighting(const PatchMesh& mesh, const SparseF& F, bool solving);
+/// silently B = E: nothing sees anything, or an emitter sees nothing. (A scene without an
+/// emitter is warned about by the loader.)
+void warn_about_lighting(const PatchMesh& mesh, const SparseF& F);
 
 /// The settings that made F, for reports: {estimator, samples, seed, threshold,
 /// hemicube_resolution, symmetrize, loaded_from} ("" when computed here), every setting null

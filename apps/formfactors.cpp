@@ -143,7 +143,7 @@ int run_formfactors(const FormFactorsOptions& opts) {
   }
   if (opts.output.empty()) throw UsageError("formfactors: -o/--output is required");
   const FormFactors ff = obtain_form_factors(scene, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
-  warn_about_lighting(scene.mesh, ff.F, false);
+  warn_about_lighting(scene.mesh, ff.F);
   const FormFactorDiagnostics d = diagnose(scene.mesh, ff.F);
   print_diagnostics(scene, ff, d);
   const std::string settings = settings_string(ff.options, scene);

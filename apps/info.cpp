@@ -11,11 +11,23 @@ CLI::App* add_info_command(CLI::App& app, InfoOptions& opts) {
   opts.scene.default_patches = 2000;
   add_scene_options(cmd, opts.scene);
   add_run_options(cmd, opts.run);
+  cmd->add_flag("--list-surfaces", opts.list_surfaces,
+                "Print one line per surface (name, tab, material, tab, emits yes/no) and stop "
+                "(the names --emit matches)");
   return cmd;
 }
 
 int run_info(const InfoOptions& opts) {
   apply_run_options(opts.run);
+  if (opts.list_surfaces) {
+    const Scene scene = load_scene_file(opts.scene);
+    for (size_t s = 0; s < scene.surfaces.size(); ++s) {
+      const Material& m = scene.material_of(static_cast<std::int32_t>(s));
+      std::printf("%s\t%s\t%s\n", scene.surfaces[s].name.c_str(), m.name.c_str(),
+                  m.emits() ? "yes" : "no");
+    }
+    return 0;
+  }
   const LoadedScene loaded = load_scene(opts.scene);
   const Scene& scene = loaded.scene;
   const PatchMesh& mesh = loaded.mesh;

@@ -88,7 +88,7 @@ void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOpti
   r.ff_entries = F.F.nonZeros();
   const Timer solve_timer;
   const RadiosityProblem problem = make_problem(scene.mesh, F.F);
-  warn_about_lighting(scene.mesh, F.F, true);
+  warn_about_lighting(scene.mesh, F.F);
   SolveOptions so = solver;
   so.threads = run.threads;
   r.solution = solve_radiosity(problem, so);

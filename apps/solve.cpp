@@ -73,7 +73,7 @@ int run_solve(const SolveCommandOptions& opts) {
   const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);
   const double ff_seconds = ff_timer.seconds();
   const RadiosityProblem problem = make_problem(loaded.mesh, ff.F);
-  warn_about_lighting(loaded.mesh, ff.F, true);
+  warn_about_lighting(loaded.mesh, ff.F);
   SolveOptions so = opts.solve;
   so.threads = opts.run.threads;
   const RadiositySolution sol = solve_radiosity(problem, so);

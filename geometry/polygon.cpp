@@ -2,26 +2,49 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 
 namespace lambert {
-
-Eigen::Vector3d newell_normal(const std::vector<Eigen::Vector3d>& poly) {
+namespace {
+// Newell's normal of the polygon scaled by 2^-e, where 2^e bounds its corners' offsets
+// from the first corner: the cross products stay near 1 whatever the coordinates'
+// magnitude (1e150 would square to infinity), and scaling by a power of two is exact, so
+// for ordinary coordinates the result is bitwise the unscaled one times 2^-2e.
+Eigen::Vector3d scaled_newell(const std::vector<Eigen::Vector3d>& poly, int& e) {
   Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  e = 0;
   const size_t m = poly.size();
   if (m < 3) return n;
+  double big = 0.0;
+  for (const auto& p : poly) big = std::max(big, (p - poly[0]).cwiseAbs().maxCoeff());
+  if (!(big > 0.0) || !std::isfinite(big)) return n;
+  std::frexp(big, &e);
   // Sum of (p_k - p_0) x (p_{k+1} - p_0): exact for planar polygons, relative to a vertex
   // to avoid cancellation far from the origin.
-  for (size_t k = 1; k + 1 < m; ++k) n += (poly[k] - poly[0]).cross(poly[k + 1] - poly[0]);
+  auto at = [&](size_t k) -> Eigen::Vector3d {
+    return (poly[k] - poly[0]).unaryExpr([e](double x) { return std::ldexp(x, -e); });
+  };
+  for (size_t k = 1; k + 1 < m; ++k) n += at(k).cross(at(k + 1));
   return n;
+}
+}  // namespace
+
+Eigen::Vector3d newell_normal(const std::vector<Eigen::Vector3d>& poly) {
+  int e = 0;
+  const Eigen::Vector3d n = scaled_newell(poly, e);
+  return n.unaryExpr([e](double x) { return std::ldexp(x, 2 * e); });
 }
 
 double polygon_area(const std::vector<Eigen::Vector3d>& poly) {
-  return 0.5 * newell_normal(poly).norm();
+  int e = 0;
+  const double half = 0.5 * scaled_newell(poly, e).norm();
+  return std::ldexp(half, 2 * e);
 }
 
 double planarity_deviation(const std::vector<Eigen::Vector3d>& poly) {
   if (poly.size() <= 3) return 0.0;
-  const Eigen::Vector3d n = newell_normal(poly);
+  int e = 0;
+  const Eigen::Vector3d n = scaled_newell(poly, e);
   if (n.norm() == 0.0) return 0.0;
   const Eigen::Vector3d u = n.normalized();
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -39,11 +62,22 @@ double polygon_diameter(const std::vector<Eigen::Vector3d>& poly) {
   return d;
 }
 
+double polygon_extent(const std::vector<Eigen::Vector3d>& poly) {
+  if (poly.empty()) return 0.0;
+  Eigen::Vector3d lo = poly[0], hi = poly[0];
+  for (const auto& p : poly) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  return (hi - lo).stableNorm();
+}
+
 namespace {
 // 2D projection of the polygon onto the plane orthogonal to its normal's dominant axis,
 // oriented so that the polygon is counter-clockwise in 2D.
 std::vector<Eigen::Vector2d> project(const std::vector<Eigen::Vector3d>& poly) {
-  const Eigen::Vector3d n = newell_normal(poly);
+  int e = 0;
+  const Eigen::Vector3d n = scaled_newell(poly, e);
   int axis = 0;
   n.cwiseAbs().maxCoeff(&axis);
   const int a = (axis + 1) % 3, b = (axis + 2) % 3;
@@ -70,6 +104,14 @@ bool is_convex(const std::vector<Eigen::Vector3d>& poly) {
 
 std::vector<std::array<int, 3>> triangulate(const std::vector<Eigen::Vector3d>& poly) {
   std::vector<std::array<int, 3>> tris;
+  const int m = static_cast<int>(poly.size());
+  if (m > 3 && is_convex(poly)) {
+    // Ear clipping of a strictly convex polygon clips corner 0, 1, 2, ... in turn (each is
+    // an ear with nothing inside): the fan from the last corner, in that order, in O(n).
+    for (int k = 0; k + 4 <= m; ++k) tris.push_back({m - 1, k, k + 1});
+    tris.push_back({m - 3, m - 2, m - 1});
+    return tris;
+  }
   const auto p = project(poly);
   std::vector<int> idx(poly.size());
   for (size_t k = 0; k < idx.size(); ++k) idx[k] = static_cast<int>(k);

@@ -9,21 +9,28 @@
 namespace lambert {
 
 /// Newell's normal of a polygon: a vector of length 2*area along the front normal
-/// (counter-clockwise winding), robust for any simple planar polygon.
+/// (counter-clockwise winding), robust for any simple planar polygon. Its length
+/// overflows for coordinates beyond ~1e154; polygon_area does not.
 Eigen::Vector3d newell_normal(const std::vector<Eigen::Vector3d>& poly);
 
-/// Area of a planar polygon (half the Newell normal's length).
+/// Area of a planar polygon (half the Newell normal's length), computed on the polygon
+/// scaled by a power of two so that squares cannot overflow (exact otherwise).
 double polygon_area(const std::vector<Eigen::Vector3d>& poly);
 
 /// Largest distance of a vertex from the polygon's mean plane (Newell normal through the
 /// vertex mean); 0 for triangles.
 double planarity_deviation(const std::vector<Eigen::Vector3d>& poly);
 
-/// Largest distance between two vertices.
+/// Largest distance between two vertices (O(n^2)).
 double polygon_diameter(const std::vector<Eigen::Vector3d>& poly);
 
+/// Diagonal of the bounding box, between the diameter and sqrt(3) times it (O(n)).
+double polygon_extent(const std::vector<Eigen::Vector3d>& poly);
+
+
 /// Triangulates a simple polygon by ear clipping in its Newell plane; returns index
-/// triples into `poly`, wound like the polygon. Works for convex and concave polygons.
+/// triples into `poly`, wound like the polygon. Works for convex and concave polygons;
+/// O(n) for strictly convex ones (the fan ear clipping would produce), O(n^2) or more else.
 std::vector<std::array<int, 3>> triangulate(const std::vector<Eigen::Vector3d>& poly);
 
 /// True when the planar polygon is strictly convex in its Newell plane.

@@ -1,7 +1,8 @@
 #include "io/obj_loader.hpp"
 
-#include <tiny_obj_loader.h>
+#include <fnmatch.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -11,204 +12,465 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <unordered_map>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "geometry/polygon.hpp"
+#include "io/line_reader.hpp"
+#include "io/mtl_parser.hpp"
+#include "io/obj_parser.hpp"
 
 namespace lambert {
 namespace {
 
 namespace fs = std::filesystem;
 
-// A face whose area is below this fraction of its squared diameter is degenerate: its
-// normal is not defined to better than ~1e-5 relative in double precision (the cross
-// product of near-parallel edges loses that many digits), so it cannot be a patch.
+// A face whose area is below this fraction of its squared extent (bounding-box diagonal)
+// is degenerate: its normal is not defined to better than ~1e-5 relative in double
+// precision (the cross product of near-parallel edges loses that many digits), so it
+// cannot be a patch.
 constexpr double kDegenerateRelArea = 1e-10;
-// Vertices farther than this fraction of the polygon diameter from its mean plane make it
+// Vertices farther than this fraction of the polygon extent from its mean plane make it
 // non-planar. Measured geometry is rarely better than 1e-4 relative (the Cornell box's red
 // wall is off by 0.8 mm in 559 mm = 1.4e-3); below it, form factors change by < 1e-4.
 constexpr double kPlanarityRelTol = 1e-4;
+// Non-planar polygons are split by ear clipping, O(n^2) to O(n^3) in their corner count:
+// beyond this many corners (~1e9 operations in the worst case) they are refused instead.
+constexpr size_t kMaxSplitCorners = 1000;
+// Smallest accepted scene extent: distances^4 (see kMaxObjCoordinate) must stay normal
+// doubles, (1e-50)^4 = 1e-200 > 2.2e-308.
+constexpr double kMinSceneExtent = 1e-50;
+// Names listed in one warning before "and N more".
+constexpr size_t kMaxListed = 6;
 
 std::string where(const std::string& file, int line) {
   return line > 0 ? file + ":" + std::to_string(line) : file;
 }
 
+// Shortest readable form of a number (6 significant digits, no trailing zeros).
+std::string num(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
+std::string rgb(const Eigen::Vector3d& c) { return num(c[0]) + " " + num(c[1]) + " " + num(c[2]); }
+
+std::string list_names(const std::set<std::string>& names) {
+  std::string out;
+  size_t k = 0;
+  for (const auto& n : names) {
+    if (k == kMaxListed) return out + " and " + std::to_string(names.size() - k) + " more";
+    out += (k++ ? ", '" : "'") + n + "'";
+  }
+  return out;
+}
+
+// Warnings go to the log and to the report; in --strict mode a refusal instead.
+class Diagnostics {
+ public:
+  Diagnostics(bool strict, LoadReport& report) : strict_(strict), report_(report) {}
+  void warn(const std::string& msg) {
+    log_warn(msg);
+    report_.warnings.push_back(msg);
+  }
+  // A default that --strict refuses: `refusal` is the error, `msg` the warning.
+  void defaulted(const std::string& refusal, const std::string& msg) {
+    if (strict_) throw SceneError(refusal);
+    warn(msg);
+  }
+  bool strict() const { return strict_; }
+
+ private:
+  bool strict_;
+  LoadReport& report_;
+};
+
 std::ifstream open_or_throw(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw IoError(path + ": cannot open: file not found");
   if (fs::is_directory(path, ec)) throw IoError(path + ": cannot open: is a directory");
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open: " + std::strerror(errno));
   return in;
 }
 
-bool parse_double(const std::string& tok, double& out) {
-  if (tok.empty()) return false;
-  const char* begin = tok.c_str();
-  char* end = nullptr;
-  errno = 0;
-  out = std::strtod(begin, &end);
-  return end == begin + tok.size();
-}
-
-// Line-level facts the loader needs for messages (tinyobjloader keeps no line numbers).
-struct ObjLines {
-  std::vector<int> face_lines;                             // line of the k-th face
-  std::vector<std::pair<int, std::string>> usemtl;         // (line, name)
-  std::vector<std::pair<int, std::string>> mtllib;         // (line, file)
-  int first_face_without_material = 0;
-};
-
-// Scans the OBJ for syntax errors that tinyobjloader would silently accept.
-ObjLines scan_obj(const std::string& path) {
-  std::ifstream in = open_or_throw(path);
-  ObjLines out;
-  static const std::set<std::string> kIgnored = {"vt", "vn", "vp", "s", "l", "p", "cstype",
-                                                 "deg", "curv", "curv2", "surf", "parm",
-                                                 "trim", "hole", "end", "bmat", "step",
-                                                 "mg", "lod", "shadow_obj", "trace_obj",
-                                                 "ctech", "stech", "o", "g"};
-  std::string line;
-  int lineno = 0;
-  std::int64_t nverts = 0;
-  bool have_material = false;
-  while (std::getline(in, line)) {
-    ++lineno;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    std::istringstream ls(line);
-    std::string key;
-    if (!(ls >> key) || key[0] == '#') continue;
-    const std::string at = where(path, lineno);
-    if (key == "v") {
-      double c[3];
-      std::string tok;
-      for (double& x : c) {
-        if (!(ls >> tok) || !parse_double(tok, x))
-          throw SceneError(at + ": malformed vertex: expected 3 numbers");
-        if (!std::isfinite(x)) throw SceneError(at + ": vertex coordinate '" + tok + "' is not finite");
+// The material libraries of all mtllib statements, parsed once each; a later definition
+// of a name replaces an earlier one. A statement naming no library that opens is a
+// default (warning), unless its whole rest or each of its tokens opens.
+std::vector<MtlMaterial> read_libraries(const ObjData& obj, const std::string& name,
+                                        const MtlOpener& open_mtl, Diagnostics& diag) {
+  std::vector<MtlMaterial> defs;
+  std::map<std::string, size_t> index;
+  std::set<std::string> opened;
+  auto read = [&](MtlFile f) {
+    if (!opened.insert(f.name).second) return;
+    for (auto& m : parse_mtl(*f.stream, f.name)) {
+      auto [it, added] = index.emplace(m.name, defs.size());
+      if (added) {
+        defs.push_back(std::move(m));
+        continue;
       }
-      ++nverts;
-    } else if (key == "f") {
-      std::string tok;
-      int count = 0;
-      while (ls >> tok) {
-        const std::string idx = tok.substr(0, tok.find('/'));
-        char* end = nullptr;
-        const long v = std::strtol(idx.c_str(), &end, 10);
-        if (idx.empty() || *end != '\0')
-          throw SceneError(at + ": malformed face index '" + tok + "'");
-        const std::int64_t resolved = v > 0 ? v : nverts + v + 1;
-        if (v == 0 || resolved < 1 || resolved > nverts)
-          throw SceneError(at + ": face index " + std::to_string(v) + " out of range (" +
-                           std::to_string(nverts) + " vertices defined so far)");
-        ++count;
-      }
-      if (count < 3) throw SceneError(at + ": face has " + std::to_string(count) + " vertices, needs at least 3");
-      if (!have_material && out.first_face_without_material == 0) out.first_face_without_material = lineno;
-      out.face_lines.push_back(lineno);
-    } else if (key == "usemtl") {
-      std::string name;
-      if (!(ls >> name)) throw SceneError(at + ": usemtl without a material name");
-      out.usemtl.emplace_back(lineno, name);
-      have_material = true;
-    } else if (key == "mtllib") {
-      std::string name;
-      if (!(ls >> name)) throw SceneError(at + ": mtllib without a file name");
-      out.mtllib.emplace_back(lineno, name);
-    } else if (!kIgnored.count(key)) {
-      throw SceneError(at + ": malformed OBJ: unknown statement '" + key + "'");
+      diag.warn(where(m.file, m.line) + ": material '" + m.name + "' defined again (first at " +
+                where(defs[it->second].file, defs[it->second].line) + "): this one is used");
+      defs[it->second] = std::move(m);
     }
-  }
-  if (in.bad()) throw IoError(path + ": read error");
-  return out;
-}
-
-// Lines of each material's Kd / Ke statements in the MTL files.
-struct MtlLines {
-  std::map<std::string, std::pair<std::string, int>> kd, ke, def;  // name -> (file, line)
-};
-
-MtlLines scan_mtl(const std::string& path) {
-  MtlLines out;
-  std::ifstream in = open_or_throw(path);
-  std::string line, current;
-  int lineno = 0;
-  while (std::getline(in, line)) {
-    ++lineno;
-    std::istringstream ls(line);
-    std::string key;
-    if (!(ls >> key) || key[0] == '#') continue;
-    if (key == "newmtl") {
-      ls >> current;
-      out.def[current] = {path, lineno};
-    } else if (key == "Kd" || key == "Ke") {
-      std::string tok;
-      double x;
-      for (int c = 0; c < 3; ++c) {
-        if (!(ls >> tok) || !parse_double(tok, x))
-          throw SceneError(where(path, lineno) + ": malformed " + key + ": expected 3 numbers");
-        if (!std::isfinite(x))
-          throw SceneError(where(path, lineno) + ": material '" + current + "': " + key +
-                           " value '" + tok + "' must be finite");
-      }
-      (key == "Kd" ? out.kd : out.ke)[current] = {path, lineno};
-    }
-  }
-  return out;
-}
-
-Material convert_material(const tinyobj::material_t& m, const MtlLines& lines,
-                          const std::string& obj_path) {
-  Material mat;
-  mat.name = m.name;
-  for (int c = 0; c < 3; ++c) {
-    mat.rho[c] = m.diffuse[c];
-    mat.emission[c] = m.emission[c];
-  }
-  auto at = [&](const std::map<std::string, std::pair<std::string, int>>& table) {
-    auto it = table.find(m.name);
-    if (it != table.end()) return where(it->second.first, it->second.second);
-    auto def = lines.def.find(m.name);
-    return def != lines.def.end() ? where(def->second.first, def->second.second) : obj_path;
   };
-  for (int c = 0; c < 3; ++c) {
-    if (!std::isfinite(mat.rho[c]) || mat.rho[c] < 0.0 || mat.rho[c] >= 1.0) {
-      std::ostringstream msg;
-      msg << at(lines.kd) << ": material '" << m.name << "': reflectance Kd " << mat.rho.transpose()
-          << " must lie in [0, 1) in every channel (rho >= 1 makes I - rho F singular: the "
-             "radiosity system has no solution)";
-      throw SceneError(msg.str());
+  for (const auto& lib : obj.mtllibs) {
+    MtlFile whole = open_mtl(lib.rest);
+    if (whole.stream) {
+      read(std::move(whole));
+      continue;
     }
-    if (!std::isfinite(mat.emission[c]) || mat.emission[c] < 0.0) {
-      std::ostringstream msg;
-      msg << at(lines.ke) << ": material '" << m.name << "': emission Ke "
-          << mat.emission.transpose() << " must be finite and >= 0";
-      throw SceneError(msg.str());
+    for (const auto& tok : lib.tokens) {
+      MtlFile f = tok == lib.rest ? MtlFile{} : open_mtl(tok);
+      if (f.stream) {
+        read(std::move(f));
+        continue;
+      }
+      const std::string at = where(name, lib.line) + ": material library '" + tok + "' not found";
+      diag.defaulted(at, at + ": the materials it would define get the default");
     }
   }
-  return mat;
+  return defs;
 }
 
+// MTL material -> scene material: --max-reflectance clamps, then Kd must lie in [0, 1] and
+// Ke be >= 0. Returns whether some channel of Kd is 1 (lossless).
+bool convert_material(const MtlMaterial& m, const LoadOptions& options, Material& mat,
+                      std::set<std::string>& clamped) {
+  mat.name = m.name;
+  mat.rho = m.kd;
+  mat.emission = m.ke;
+  const std::string at_kd = where(m.file, m.kd_line ? m.kd_line : m.line);
+  if (options.max_reflectance > 0 && mat.rho.maxCoeff() > options.max_reflectance) {
+    mat.rho = mat.rho.cwiseMin(options.max_reflectance);
+    clamped.insert(m.name);
+  }
+  if (mat.rho.minCoeff() < 0.0 || mat.rho.maxCoeff() > 1.0)
+    throw SceneError(at_kd + ": material '" + m.name + "': reflectance Kd " + rgb(mat.rho) +
+                     " must lie in [0, 1] in every channel (rho > 1 reflects more than it "
+                     "receives; --max-reflectance R clamps)");
+  if (mat.emission.minCoeff() < 0.0)
+    throw SceneError(where(m.file, m.ke_line ? m.ke_line : m.line) + ": material '" + m.name +
+                     "': emission Ke " + rgb(mat.emission) + " must be finite and >= 0");
+  const bool lossless = mat.rho.maxCoeff() == 1.0;
+  if (lossless && options.strict)
+    throw SceneError(at_kd + ": material '" + m.name + "': reflectance Kd " + rgb(mat.rho) +
+                     " must lie in [0, 1) in every channel with --strict (rho = 1 makes I - rho "
+                     "F singular in a closed enclosure that absorbs nothing)");
+  return lossless;
+}
+
+// Scene materials and, per usemtl name of the OBJ, the scene material it resolves to.
+struct Materials {
+  std::vector<std::int32_t> of_use;  // ObjData::materials index -> scene material
+  std::int32_t none = -1;            // faces without usemtl, and usemtl without a name
+  std::vector<bool> undefined;       // per usemtl name: not in any library (defaulted)
+  std::set<std::string> lossless;    // used materials with a channel of Kd = 1
+};
+
+Materials build_materials(const ObjData& obj, const std::vector<MtlMaterial>& defs,
+                          const LoadOptions& options, const std::string& name,
+                          Diagnostics& diag, Scene& scene) {
+  Materials out;
+  std::map<std::string, std::int32_t> by_name;
+  std::set<std::string> clamped, lossless;
+  for (const auto& m : defs) {
+    Material mat;
+    if (convert_material(m, options, mat, clamped)) lossless.insert(m.name);
+    by_name[m.name] = static_cast<std::int32_t>(scene.materials.size());
+    scene.materials.push_back(mat);
+  }
+  if (!clamped.empty())
+    diag.warn(name + ": Kd clamped to --max-reflectance " + num(options.max_reflectance) +
+              " in material(s) " + list_names(clamped));
+  auto add_default = [&](const std::string& mat_name) {
+    scene.materials.push_back({mat_name, options.default_reflectance, Eigen::Vector3d::Zero()});
+    return static_cast<std::int32_t>(scene.materials.size() - 1);
+  };
+  for (const auto& use : obj.materials) {
+    auto it = by_name.find(use.name);
+    if (it != by_name.end()) {
+      out.of_use.push_back(it->second);
+      out.undefined.push_back(false);
+      if (lossless.count(use.name)) out.lossless.insert(use.name);
+      continue;
+    }
+    out.undefined.push_back(true);
+    if (use.name.empty()) {
+      if (out.none < 0) out.none = add_default("default");
+      out.of_use.push_back(out.none);
+      continue;
+    }
+    out.of_use.push_back(add_default(use.name));
+  }
+  const bool bare = std::any_of(obj.faces.begin(), obj.faces.end(),
+                                [](const ObjFace& f) { return f.material < 0; });
+  if (bare && out.none < 0) out.none = add_default("default");
+  return out;
+}
+
+// The polygon of a face with repeated corners collapsed (same index or position as the
+// previous one, or the last equal to the first): they add nothing but zero-length edges.
+std::vector<Eigen::Vector3d> collapse_corners(const std::vector<Eigen::Vector3d>& verts,
+                                              Face& face, const std::vector<std::int32_t>& in) {
+  std::vector<Eigen::Vector3d> poly;
+  for (const std::int32_t vi : in) {
+    if (!poly.empty() && (vi == face.vertices.back() || verts[vi] == poly.back())) continue;
+    face.vertices.push_back(vi);
+    poly.push_back(verts[vi]);
+  }
+  while (poly.size() > 1 && poly.back() == poly.front()) {
+    poly.pop_back();
+    face.vertices.pop_back();
+  }
+  return poly;
+}
+
+// Faces (collapsed, degenerate ones dropped, non-planar ones split) and their surfaces:
+// one per (group, material), named `group`, or `group/material` when the group's faces
+// use several materials. Returns, per usemtl index + 1 (0 = none), the surfaces using it.
+std::map<std::int32_t, std::set<std::int32_t>> build_faces(const ObjData& obj,
+                                                           const Materials& mats,
+                                                           const std::string& name,
+                                                           Diagnostics& diag, LoadReport& report,
+                                                           Scene& scene) {
+  auto material_of = [&](const ObjFace& f) { return f.material < 0 ? mats.none : mats.of_use[f.material]; };
+  std::vector<std::set<std::int32_t>> group_materials(obj.groups.size());
+  for (const auto& f : obj.faces) group_materials[f.group].insert(material_of(f));
+  std::map<std::pair<std::int32_t, std::int32_t>, std::int32_t> surface_of;
+  std::map<std::int32_t, std::set<std::int32_t>> surfaces_of_use;
+  for (const auto& of : obj.faces) {
+    Face face;
+    face.line = of.line;
+    const std::vector<Eigen::Vector3d> poly = collapse_corners(scene.vertices, face, of.vertices);
+    const std::set<std::int32_t> distinct(face.vertices.begin(), face.vertices.end());
+    const double extent = polygon_extent(poly);
+    if (distinct.size() < 3 || polygon_area(poly) <= kDegenerateRelArea * extent * extent) {
+      ++report.degenerate_faces_dropped;
+      log_debug(where(name, of.line) + ": zero-area face dropped");
+      continue;
+    }
+    const std::int32_t mat = material_of(of);
+    auto it = surface_of.find({of.group, mat});
+    if (it == surface_of.end()) {
+      const std::string& group = obj.groups[of.group];
+      const std::string sname =
+          group_materials[of.group].size() > 1 ? group + "/" + scene.materials[mat].name : group;
+      it = surface_of.emplace(std::make_pair(of.group, mat),
+                              static_cast<std::int32_t>(scene.surfaces.size())).first;
+      scene.surfaces.push_back({sname, mat});
+    }
+    face.surface = it->second;
+    surfaces_of_use[of.material + 1].insert(face.surface);
+    const double off = planarity_deviation(poly);
+    if (off <= kPlanarityRelTol * extent) {
+      scene.faces.push_back(std::move(face));
+      continue;
+    }
+    if (poly.size() > kMaxSplitCorners)
+      throw SceneError(where(name, of.line) + ": non-planar polygon with " +
+                       std::to_string(poly.size()) + " corners (more than " +
+                       std::to_string(kMaxSplitCorners) + " cannot be split into triangles)");
+    ++report.nonplanar_faces_split;
+    diag.warn(where(name, of.line) + ": non-planar polygon (off its plane by " +
+              num(off) + ") split into triangles");
+    for (const auto& t : triangulate(poly)) {
+      Face tri = face;
+      tri.vertices = {face.vertices[t[0]], face.vertices[t[1]], face.vertices[t[2]]};
+      scene.faces.push_back(tri);
+    }
+  }
+  return surfaces_of_use;
+}
+
+// One warning per cause of a default material, naming the surfaces it affects; --strict
+// refuses instead (with the messages lambert gave before defaults existed).
+void report_default_materials(const ObjData& obj, const Materials& mats,
+                              const std::map<std::int32_t, std::set<std::int32_t>>& users,
+                              const std::string& name, const LoadOptions& options,
+                              Diagnostics& diag, const Scene& scene) {
+  auto surfaces = [&](std::int32_t use) {
+    std::set<std::string> names;
+    auto it = users.find(use + 1);
+    if (it != users.end())
+      for (auto s : it->second) names.insert(scene.surfaces[s].name);
+    return names;
+  };
+  const std::string deflt = "the default material (rho " + rgb(options.default_reflectance) +
+                            ", no emission; --default-reflectance R,G,B)";
+  for (size_t u = 0; u < obj.materials.size(); ++u) {
+    if (!mats.undefined[u]) continue;
+    const ObjMaterialUse& use = obj.materials[u];
+    const auto names = surfaces(static_cast<std::int32_t>(u));
+    const std::string at = where(name, use.line);
+    const std::string what = use.name.empty()
+                                 ? at + ": usemtl without a material name"
+                                 : at + ": material '" + use.name + "' is not defined" +
+                                       (obj.mtllibs.empty() ? " (no mtllib)" : " in the material library");
+    if (diag.strict()) throw SceneError(what);
+    if (!names.empty()) diag.warn(what + ": surface(s) " + list_names(names) + " use " + deflt);
+  }
+  const auto none = surfaces(-1);
+  if (none.empty()) return;
+  int first = 0;
+  for (const auto& f : obj.faces) {
+    if (f.material < 0) {
+      first = f.line;
+      break;
+    }
+  }
+  const std::string at = where(name, first);
+  diag.defaulted(at + ": face has no material (no usemtl before it)",
+                 at + ": faces without usemtl" + (obj.mtllibs.empty() ? " (and no mtllib)" : "") +
+                     ": surface(s) " + list_names(none) + " use " + deflt);
+}
+
+// Kd = 1 is lossless: accepted, but the system is singular when a closed set of such
+// surfaces absorbs nothing, which the loader (without form factors) cannot see.
+void report_lossless(const Materials& mats, const std::string& name, Diagnostics& diag,
+                     const Scene& scene) {
+  if (mats.lossless.empty()) return;
+  bool closed_risk = false;  // some channel in which every surface is lossless
+  for (int c = 0; c < 3; ++c) {
+    bool every = true;
+    for (const auto& s : scene.surfaces) every = every && scene.materials[s.material].rho[c] == 1.0;
+    closed_risk = closed_risk || every;
+  }
+  diag.warn(name + ": material(s) " + list_names(mats.lossless) +
+            " have Kd = 1 in some channel (lossless): the radiosity system is singular if such "
+            "surfaces enclose a space where nothing absorbs" +
+            (closed_risk ? " (here every surface is lossless in one channel)" : "") +
+            "; --max-reflectance 0.99 clamps");
+}
+
+// What was skipped, in one warning.
+void report_skipped(const ObjData& obj, const std::string& name, Diagnostics& diag,
+                    LoadReport& report) {
+  if (obj.skipped.empty()) return;
+  std::string list;
+  for (const auto& [what, s] : obj.skipped) {
+    report.skipped_statements += s.count;
+    list += (list.empty() ? "" : ", ") + std::to_string(s.count) + " " + what + " (first at line " +
+            std::to_string(s.first_line) + ")";
+  }
+  diag.warn(name + ": skipped what radiosity does not use: " + list);
+}
+
+// Sorted corner positions of a face: equal for two faces covering the same polygon.
+std::vector<std::array<double, 3>> corner_key(const Scene& scene, const Face& f) {
+  std::vector<std::array<double, 3>> key;
+  for (auto v : f.vertices) key.push_back({scene.vertices[v].x(), scene.vertices[v].y(), scene.vertices[v].z()});
+  std::sort(key.begin(), key.end());
+  return key;
+}
+
+std::uint64_t hash_key(const std::vector<std::array<double, 3>>& key) {
+  std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the coordinates' bits
+  for (const auto& p : key) {
+    for (double x : p) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &x, sizeof bits);
+      h = (h ^ bits) * 1099511628211ull;
+    }
+  }
+  return h;
+}
+
+// Faces with exactly the corners of an earlier face (a second copy of the floor) count
+// their area twice and push row sums of F above 1: one warning per pair of surfaces.
+// Faces are bucketed by a hash of their sorted corners and compared exactly.
+void report_coincident(const Scene& scene, const std::string& name, Diagnostics& diag,
+                       LoadReport& report) {
+  std::unordered_multimap<std::uint64_t, size_t> seen;
+  seen.reserve(scene.faces.size());
+  std::map<std::pair<std::int32_t, std::int32_t>, std::pair<size_t, int>> pairs;  // -> (f, count)
+  std::vector<std::pair<size_t, size_t>> examples;
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    const auto key = corner_key(scene, scene.faces[f]);
+    const std::uint64_t h = hash_key(key);
+    auto [lo, hi] = seen.equal_range(h);
+    auto it = std::find_if(lo, hi, [&](const auto& e) { return corner_key(scene, scene.faces[e.second]) == key; });
+    if (it == hi) {
+      seen.emplace(h, f);
+      continue;
+    }
+    ++report.coincident_faces;
+    const Face& a = scene.faces[it->second];
+    const Face& b = scene.faces[f];
+    auto [p, fresh] = pairs.emplace(std::minmax(a.surface, b.surface), std::make_pair(f, 0));
+    if (fresh) examples.emplace_back(it->second, f);
+    ++p->second.second;
+  }
+  for (const auto& [fa, fb] : examples) {
+    const Face& a = scene.faces[fa];
+    const Face& b = scene.faces[fb];
+    const int count = pairs[std::minmax(a.surface, b.surface)].second;
+    diag.warn(where(name, b.line) + ": face coincides with the face at line " + std::to_string(a.line) +
+              " (surfaces '" + scene.surfaces[a.surface].name + "' and '" +
+              scene.surfaces[b.surface].name + "', " + std::to_string(count) +
+              " coincident face(s)): its area counts twice");
+  }
+}
+
+// --emit: a rule sets E on the material of every surface it matches by surface or material
+// name; a material also used by surfaces the rule does not match is copied first, as
+// `material@surface`.
+void apply_emit(const std::vector<EmitRule>& rules, const std::string& name, Scene& scene) {
+  auto matches = [](const std::string& pattern, const std::string& s) {
+    return fnmatch(pattern.c_str(), s.c_str(), 0) == 0;
+  };
+  for (const auto& rule : rules) {
+    if (!rule.emission.allFinite() || rule.emission.minCoeff() < 0.0)
+      throw UsageError("--emit " + rule.pattern + ": emission must be finite and >= 0");
+    std::vector<bool> hit(scene.surfaces.size());
+    bool any = false;
+    for (size_t s = 0; s < scene.surfaces.size(); ++s) {
+      hit[s] = matches(rule.pattern, scene.surfaces[s].name) ||
+               matches(rule.pattern, scene.material_of(static_cast<std::int32_t>(s)).name);
+      any = any || hit[s];
+    }
+    if (!any)
+      throw UsageError("--emit '" + rule.pattern + "': no surface or material of " + name +
+                       " matches (lambert info lists the names)");
+    std::vector<bool> shared(scene.materials.size());  // also used by an unmatched surface
+    for (size_t s = 0; s < scene.surfaces.size(); ++s)
+      if (!hit[s]) shared[scene.surfaces[s].material] = true;
+    for (size_t s = 0; s < scene.surfaces.size(); ++s) {
+      if (!hit[s]) continue;
+      Surface& surf = scene.surfaces[s];
+      if (shared[surf.material]) {
+        Material copy = scene.materials[surf.material];
+        copy.name += "@" + surf.name;
+        surf.material = static_cast<std::int32_t>(scene.materials.size());
+        scene.materials.push_back(copy);
+      }
+      scene.materials[surf.material].emission = rule.emission;
+    }
+  }
+}
+
+// The camera sidecar: `eye`, `look_at`, `up`, `vfov` or `focal_mm` with `film_mm`.
 Camera read_camera(const std::string& path) {
-  std::ifstream in = open_or_throw(path);
+  std::ifstream file = open_or_throw(path);
+  LineReader lines(file, path);
   Camera cam;
   double focal = 0, film = 0, vfov = 0;
-  std::string line;
-  int lineno = 0;
+  std::string_view text;
   bool have_eye = false, have_at = false;
-  while (std::getline(in, line)) {
-    ++lineno;
-    std::istringstream ls(line);
+  while (lines.next(text)) {
+    std::istringstream ls{std::string(text)};
     std::string key;
     if (!(ls >> key) || key[0] == '#') continue;
     auto vec = [&](Eigen::Vector3d& v) {
       if (!(ls >> v.x() >> v.y() >> v.z()) || !v.allFinite())
-        throw SceneError(where(path, lineno) + ": '" + key + "' needs 3 finite numbers");
+        throw SceneError(lines.where() + ": '" + key + "' needs 3 finite numbers");
     };
     auto num = [&](double& x) {
       if (!(ls >> x) || !(x > 0) || !std::isfinite(x))
-        throw SceneError(where(path, lineno) + ": '" + key + "' needs a positive number");
+        throw SceneError(lines.where() + ": '" + key + "' needs a positive number");
     };
     if (key == "eye") { vec(cam.eye); have_eye = true; }
     else if (key == "look_at") { vec(cam.look_at); have_at = true; }
@@ -216,7 +478,7 @@ Camera read_camera(const std::string& path) {
     else if (key == "focal_mm") num(focal);
     else if (key == "film_mm") num(film);
     else if (key == "vfov") num(vfov);
-    else throw SceneError(where(path, lineno) + ": unknown camera key '" + key + "'");
+    else throw SceneError(lines.where() + ": unknown camera key '" + key + "'");
   }
   if (!have_eye || !have_at) throw SceneError(path + ": camera needs 'eye' and 'look_at'");
   if (vfov >= 180.0)
@@ -235,139 +497,60 @@ std::string builtin_cornell_box_path() {
   return (fs::path(LAMBERT_DATA_DIR) / "cornell_box" / "cornell_box.obj").string();
 }
 
-Scene load_obj(const std::string& path, LoadReport* report) {
-  const ObjLines lines = scan_obj(path);
-  const fs::path base = fs::path(path).parent_path();
-  MtlLines mtl_lines;
-  for (const auto& [lineno, lib] : lines.mtllib) {
-    const fs::path mtl = base / lib;
-    std::error_code ec;
-    if (!fs::exists(mtl, ec))
-      throw SceneError(where(path, lineno) + ": material library '" + lib + "' not found");
-    MtlLines more = scan_mtl(mtl.string());
-    mtl_lines.kd.insert(more.kd.begin(), more.kd.end());
-    mtl_lines.ke.insert(more.ke.begin(), more.ke.end());
-    mtl_lines.def.insert(more.def.begin(), more.def.end());
-  }
-
-  tinyobj::ObjReaderConfig config;
-  config.triangulate = false;
-  config.vertex_color = false;
-  config.mtl_search_path = base.string();
-  tinyobj::ObjReader reader;
-  if (!reader.ParseFromFile(path, config)) {
-    std::string err = reader.Error();
-    while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
-    for (char& ch : err) if (ch == '\n') ch = ' ';
-    throw SceneError(path + ": malformed OBJ: " + err);
-  }
-  const auto& attrib = reader.GetAttrib();
-  const auto& shapes = reader.GetShapes();
-  const auto& materials = reader.GetMaterials();
-
+Scene load_obj_stream(std::istream& in, const std::string& name, const MtlOpener& open_mtl,
+                      LoadReport* report_out, const LoadOptions& options) {
+  LoadReport report;
+  Diagnostics diag(options.strict, report);
+  ObjData obj = parse_obj(in, name);
+  const std::vector<MtlMaterial> defs = read_libraries(obj, name, open_mtl, diag);
   Scene scene;
-  scene.source = path;
-  std::map<std::string, int> material_index;
-  for (const auto& m : materials) {
-    material_index[m.name] = static_cast<int>(scene.materials.size());
-    scene.materials.push_back(convert_material(m, mtl_lines, path));
-  }
-  for (const auto& [lineno, name] : lines.usemtl) {
-    if (!material_index.count(name))
-      throw SceneError(where(path, lineno) + ": material '" + name + "' is not defined" +
-                       (lines.mtllib.empty() ? " (no mtllib)" : " in the material library"));
-  }
-  if (lines.first_face_without_material > 0)
-    throw SceneError(where(path, lines.first_face_without_material) +
-                     ": face has no material (no usemtl before it)");
+  scene.source = name;
+  const Materials mats = build_materials(obj, defs, options, name, diag, scene);
+  scene.vertices = std::move(obj.vertices);
+  const auto users = build_faces(obj, mats, name, diag, report, scene);
+  report_default_materials(obj, mats, users, name, options, diag, scene);
+  report_lossless(mats, name, diag, scene);
+  report_skipped(obj, name, diag, report);
+  if (report.degenerate_faces_dropped > 0)
+    diag.warn(name + ": " + std::to_string(report.degenerate_faces_dropped) + " zero-area face(s) dropped");
+  if (scene.faces.empty()) throw SceneError(name + ": empty scene: no faces with positive area");
+  const auto [lo, hi] = scene.bounds();
+  if ((hi - lo).norm() < kMinSceneExtent)
+    throw SceneError(name + ": scene extent " + num((hi - lo).norm()) +
+                     " is below 1e-50, where form factors underflow: rescale the scene");
+  report_coincident(scene, name, diag, report);
+  apply_emit(options.emit, name, scene);
+  for (const auto& s : scene.surfaces) report.has_emitter = report.has_emitter || scene.materials[s.material].emits();
+  if (!report.has_emitter)
+    diag.warn(name + ": no emitter (no material with Ke > 0): the radiosity is zero; add one with "
+              "--emit SURFACE_OR_MATERIAL=R,G,B (lambert info lists the names)");
+  scene.camera = framing_camera(lo, hi);
+  if (report_out) *report_out = std::move(report);
+  return scene;
+}
 
-  for (size_t v = 0; v * 3 + 2 < attrib.vertices.size(); ++v)
-    scene.vertices.emplace_back(attrib.vertices[3 * v], attrib.vertices[3 * v + 1],
-                                attrib.vertices[3 * v + 2]);
-
-  // Surfaces: one per (shape name, material); the material is appended to the name only
-  // when a shape uses several.
-  std::map<std::pair<std::string, int>, std::int32_t> surface_of;
-  size_t face_counter = 0;
-  int dropped = 0, split = 0;
-  for (size_t s = 0; s < shapes.size(); ++s) {
-    const auto& mesh = shapes[s].mesh;
-    const std::string shape_name =
-        shapes[s].name.empty() ? "surface" + std::to_string(s) : shapes[s].name;
-    std::set<int> mats(mesh.material_ids.begin(), mesh.material_ids.end());
-    size_t offset = 0;
-    for (size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
-      const int nv = mesh.num_face_vertices[f];
-      const int line = face_counter < lines.face_lines.size() ? lines.face_lines[face_counter] : 0;
-      ++face_counter;
-      const int mat = mesh.material_ids[f];
-      if (mat < 0 || mat >= static_cast<int>(scene.materials.size()))
-        throw SceneError(where(path, line) + ": face has no valid material");
-      Face face;
-      face.line = line;
-      std::vector<Eigen::Vector3d> poly;
-      std::set<int> distinct;
-      for (int k = 0; k < nv; ++k) {
-        const int vi = mesh.indices[offset + k].vertex_index;
-        // A corner repeating the previous one (same index or position) adds nothing to
-        // the polygon but would leave a zero-length edge: collapse it.
-        if (!poly.empty() && (vi == face.vertices.back() || scene.vertices[vi] == poly.back()))
-          continue;
-        face.vertices.push_back(vi);
-        distinct.insert(vi);
-        poly.push_back(scene.vertices[vi]);
-      }
-      while (poly.size() > 1 && poly.back() == poly.front()) {
-        poly.pop_back();
-        distinct.erase(face.vertices.back());
-        face.vertices.pop_back();
-      }
-      offset += nv;
-      const double diam = polygon_diameter(poly);
-      if (distinct.size() < 3 || polygon_area(poly) <= kDegenerateRelArea * diam * diam) {
-        ++dropped;
-        log_debug(where(path, line) + ": zero-area face dropped");
-        continue;
-      }
-      const auto key = std::make_pair(shape_name, mat);
-      auto it = surface_of.find(key);
-      if (it == surface_of.end()) {
-        const std::string name =
-            mats.size() > 1 ? shape_name + "/" + scene.materials[mat].name : shape_name;
-        it = surface_of.emplace(key, static_cast<std::int32_t>(scene.surfaces.size())).first;
-        scene.surfaces.push_back({name, mat});
-      }
-      face.surface = it->second;
-      if (planarity_deviation(poly) > kPlanarityRelTol * diam) {
-        ++split;
-        log_warn(where(path, line) + ": non-planar polygon (off its plane by " +
-                 std::to_string(planarity_deviation(poly)) + ") split into triangles");
-        for (const auto& t : triangulate(poly)) {
-          Face tri = face;
-          tri.vertices = {face.vertices[t[0]], face.vertices[t[1]], face.vertices[t[2]]};
-          scene.faces.push_back(tri);
-        }
-        continue;
-      }
-      scene.faces.push_back(std::move(face));
+Scene load_obj(const std::string& path, LoadReport* report, const LoadOptions& options) {
+  std::ifstream in = open_or_throw(path);
+  const fs::path base = fs::path(path).parent_path();
+  // An mtllib names a file next to the OBJ; exporters also write absolute or Windows paths
+  // of the author's machine, so the bare file name next to the OBJ is tried as well.
+  const MtlOpener open_mtl = [&](const std::string& lib) -> MtlFile {
+    std::string bare = lib;
+    std::replace(bare.begin(), bare.end(), '\\', '/');
+    bare = fs::path(bare).filename().string();
+    for (const fs::path& p : {base / lib, base / bare}) {
+      std::error_code ec;
+      if (bare.empty() || !fs::exists(p, ec) || fs::is_directory(p, ec)) continue;
+      auto f = std::make_unique<std::ifstream>(p, std::ios::binary);
+      if (!*f) throw IoError(p.string() + ": cannot open: " + std::strerror(errno));
+      return {std::move(f), p.string()};
     }
-  }
-  if (dropped > 0) log_warn(path + ": " + std::to_string(dropped) + " zero-area face(s) dropped");
-  if (scene.faces.empty()) throw SceneError(path + ": empty scene: no faces with positive area");
-
-  bool emits = false;
-  for (const auto& s : scene.surfaces) emits = emits || scene.materials[s.material].emits();
-  if (!emits) log_warn(path + ": no emitter (no material with Ke > 0): the radiosity is zero");
-
+    return {};
+  };
+  Scene scene = load_obj_stream(in, path, open_mtl, report, options);
   const fs::path camera_path = fs::path(path).replace_extension(".camera");
   std::error_code ec;
-  if (fs::exists(camera_path, ec)) {
-    scene.camera = read_camera(camera_path.string());
-  } else {
-    const auto [lo, hi] = scene.bounds();
-    scene.camera = framing_camera(lo, hi);
-  }
-  if (report) *report = {dropped, split, emits};
+  if (fs::exists(camera_path, ec)) scene.camera = read_camera(camera_path.string());
   return scene;
 }
 

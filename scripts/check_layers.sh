@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Checks the module dependency direction of STYLE.md:
 #   core <- geometry <- io <- apps,  core <- solvers <- apps
-# and that third-party libraries stay at the edge (Embree in geometry/bvh.cpp, OpenEXR and
-# tinyobjloader in io/*.cpp only). Exits 1 listing every violation.
+# and that third-party libraries stay at the edge (Embree in geometry/bvh.cpp, OpenEXR in
+# io/*.cpp only). Exits 1 listing every violation.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 status=0
@@ -17,7 +17,7 @@ forbid solvers "geometry/|io/|apps/" "solvers see a matrix, vectors and areas"
 forbid io "solvers/|apps/" "io sits below apps"
 hits=$(grep -rlE "#include [<\"]embree" core geometry solvers io apps | grep -v '^geometry/bvh.cpp$' || true)
 [[ -z "$hits" ]] || { echo "layering: Embree outside geometry/bvh.cpp: $hits"; status=1; }
-hits=$(grep -rlE "#include [<\"](OpenEXR/|Imf|tiny_obj_loader)" core geometry solvers io apps | grep -vE '^io/.*\.cpp$' || true)
-[[ -z "$hits" ]] || { echo "layering: OpenEXR/tinyobjloader outside io/*.cpp: $hits"; status=1; }
+hits=$(grep -rlE "#include [<\"](OpenEXR/|Imf)" core geometry solvers io apps | grep -vE '^io/.*\.cpp$' || true)
+[[ -z "$hits" ]] || { echo "layering: OpenEXR outside io/*.cpp: $hits"; status=1; }
 [[ $status -eq 0 ]] && echo "layering: ok"
 exit $status

@@ -6,7 +6,9 @@ cd "$(dirname "$0")/.."
 preset="${1:-release}"
 
 packages=(build-essential cmake pkg-config libembree-dev libeigen3-dev libopenexr-dev
-          libtinyobjloader-dev libgtest-dev libcli11-dev zlib1g-dev nlohmann-json3-dev)
+          libgtest-dev libcli11-dev zlib1g-dev nlohmann-json3-dev)
+# The fuzz preset builds with clang and links libFuzzer (from libclang-rt).
+[[ "$preset" == fuzz ]] && packages+=(clang libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -35,6 +35,28 @@ TEST(Cli, InfoDescribesTheBuiltInCornellBox) {
   EXPECT_NE(out.find("emitters: light"), std::string::npos);
 }
 
+// Loading options are shared by every command that loads a scene (apps/common.cpp).
+TEST(Cli, SceneLoadingOptionsAreCheckedAndApplied) {
+  const std::string room = std::string(LAMBERT_TEST_CORPUS_DIR) + "/obj/blender_room.obj";
+  const std::string bare = std::string(LAMBERT_TEST_CORPUS_DIR) + "/obj/no_mtllib.obj";
+  for (const char* bad : {"floor=nan,1,1", "floor=1,1", "floor=-1,0,0", "=1,1,1", "floor"})
+    EXPECT_EQ(run({"info", "-q", bare, "--emit", bad}), kExitUsage) << bad;
+  EXPECT_EQ(run({"info", "-q", bare, "--max-reflectance", "nan"}), kExitUsage);
+  EXPECT_EQ(run({"info", "-q", bare, "--max-reflectance", "1.5"}), kExitUsage);
+  EXPECT_EQ(run({"info", "-q", bare, "--default-reflectance", "0.5,nan,0.5"}), kExitUsage);
+  EXPECT_EQ(run({"info", "-q", bare, "--default-reflectance", "0.5,1.5,0.5"}), kExitUsage);
+  EXPECT_EQ(run({"info", "-q", bare, "--emit", "nothing=1,1,1"}), kExitUsage);
+  EXPECT_EQ(run({"info", "-q", bare, "--strict"}), kExitFailure);
+  EXPECT_EQ(run({"formfactors", "-q", bare, "--strict", "-o", "/tmp/never.mtx"}), kExitFailure);
+  ::testing::internal::CaptureStdout();
+  const int code = run({"info", "-q", room, "--list-surfaces", "--emit", "Cube=1,1,1"});
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  EXPECT_EQ(code, kExitOk);
+  EXPECT_EQ(out, "Room/Walls\tWalls\tno\nRoom/Red\tRed\tno\nCube\tMaterial\tyes\nLight\tEmission\tyes\n");
+  EXPECT_EQ(run({"info", "-q", bare, "--emit", "floor=1,1,1", "--default-reflectance", "0.2,0.2,0.2",
+                 "--max-reflectance", "0.9", "--patches", "10"}), kExitOk);
+}
+
 TEST(Cli, MissingSceneExitsWithOne) {
   EXPECT_EQ(run({"info", "-q", "/nonexistent.obj"}), kExitFailure);
 }

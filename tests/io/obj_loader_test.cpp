@@ -24,11 +24,11 @@ const char* kObj =
 
 // Writes the MTL and an OBJ into a temp dir and returns the load error message.
 std::string load_error(const testing::TempDir& dir, const std::string& obj,
-                       const std::string& mtl = kMtl) {
+                       const std::string& mtl = kMtl, const LoadOptions& options = {}) {
   dir.write("s.mtl", mtl);
   const std::string path = dir.write("s.obj", obj);
   try {
-    load_obj(path);
+    load_obj(path, nullptr, options);
   } catch (const Error& e) {
     return e.what();
   }
@@ -111,27 +111,38 @@ TEST(ObjLoader, NonFiniteCoordinateIsRejected) {
   EXPECT_NE(load_error(dir, "v 0 0 inf\n").find("not finite"), std::string::npos);
 }
 
-TEST(ObjLoader, MissingMtlAndUndefinedMaterialAreErrors) {
+// Issue 20 made these defaults with warnings; --strict keeps the refusals.
+TEST(ObjLoader, MissingMtlAndUndefinedMaterialAreErrorsWhenStrict) {
   testing::TempDir dir;
+  LoadOptions strict;
+  strict.strict = true;
   const std::string obj = std::string(kObj);
   std::string missing = obj;
   missing.replace(0, 12, "mtllib x.mtl");
-  EXPECT_NE(load_error(dir, missing).find("s.obj:1: material library 'x.mtl' not found"),
+  EXPECT_NE(load_error(dir, missing, kMtl, strict).find("s.obj:1: material library 'x.mtl' not found"),
             std::string::npos);
   std::string undefined = obj;
   undefined.replace(undefined.find("usemtl lamp"), 11, "usemtl glow");
-  EXPECT_NE(load_error(dir, undefined).find("s.obj:10: material 'glow' is not defined"),
+  EXPECT_NE(load_error(dir, undefined, kMtl, strict).find("s.obj:10: material 'glow' is not defined"),
             std::string::npos);
-  EXPECT_NE(load_error(dir, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").find("s.obj:4: face has no material"),
+  EXPECT_NE(load_error(dir, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", kMtl, strict).find("s.obj:4: face has no material"),
             std::string::npos);
 }
 
+// Issue 20: Kd = 1 is accepted with a warning; --strict refuses it as before, and Kd > 1 is
+// always refused.
 TEST(ObjLoader, ReflectanceOutsideUnitIntervalIsRejectedWithItsLine) {
   testing::TempDir dir;
+  LoadOptions strict;
+  strict.strict = true;
   const std::string bad_kd = "newmtl white\nKd 0.5 1.0 0.5\nnewmtl lamp\nKd 0 0 0\nKe 1 1 1\n";
-  const std::string err = load_error(dir, kObj, bad_kd);
+  const std::string err = load_error(dir, kObj, bad_kd, strict);
   EXPECT_NE(err.find("s.mtl:2: material 'white'"), std::string::npos) << err;
   EXPECT_NE(err.find("singular"), std::string::npos) << err;
+  EXPECT_EQ(load_error(dir, kObj, bad_kd), "");
+  const std::string above = "newmtl white\nKd 0.5 1.2 0.5\nnewmtl lamp\nKd 0 0 0\nKe 1 1 1\n";
+  EXPECT_NE(load_error(dir, kObj, above).find("s.mtl:2: material 'white': reflectance Kd 0.5 1.2 0.5 must lie in [0, 1]"),
+            std::string::npos);
   const std::string neg_kd = "newmtl white\nKd -0.1 0 0\nnewmtl lamp\nKd 0 0 0\nKe 1 1 1\n";
   EXPECT_NE(load_error(dir, kObj, neg_kd).find("s.mtl:2"), std::string::npos);
 }
