@@ -59,21 +59,24 @@ int clip_to_horizon(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const P
   return m;
 }
 
-double point_to_patch(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& g) {
-  if (g.normal.dot(x - g.p[0]) <= 0.0) return 0.0;  // x behind the receiving patch
-  Eigen::Vector3d out[5];
-  const int m = clip_to_horizon(x, nx, g, out);
-  if (m < 3) return 0.0;
+double contour_factor(const Eigen::Vector3d& nx, const Eigen::Vector3d* r, int m) {
   double sum = 0.0;
   for (int k = 0; k < m; ++k) {
-    const Eigen::Vector3d& a = out[k];
-    const Eigen::Vector3d& b = out[(k + 1) % m];
+    const Eigen::Vector3d& a = r[k];
+    const Eigen::Vector3d& b = r[(k + 1) % m];
     const Eigen::Vector3d c = a.cross(b);
     const double cn = c.norm();
     if (cn <= 0.0) continue;
     sum += std::atan2(cn, a.dot(b)) * nx.dot(c) / cn;
   }
   return std::max(0.0, -sum / (2.0 * M_PI));
+}
+
+double point_to_patch(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& g) {
+  if (g.normal.dot(x - g.p[0]) <= 0.0) return 0.0;  // x behind the receiving patch
+  Eigen::Vector3d out[5];
+  const int m = clip_to_horizon(x, nx, g, out);
+  return m < 3 ? 0.0 : contour_factor(nx, out, m);
 }
 
 namespace {

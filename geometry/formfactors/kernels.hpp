@@ -69,6 +69,10 @@ int clip_to_horizon(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const P
 /// respected, and is 0 when x lies behind the polygon's plane (only its front receives).
 double point_to_patch(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& g);
 
+/// The contour sum of point_to_patch over a polygon already clipped to x's horizon, given
+/// by its corners r[0..m) relative to x.
+double contour_factor(const Eigen::Vector3d& nx, const Eigen::Vector3d* r, int m);
+
 /// Highest Gauss-Legendre order available.
 constexpr int kMaxGaussOrder = 32;
 

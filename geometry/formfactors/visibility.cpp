@@ -68,19 +68,33 @@ KernelSampler::KernelSampler(const Eigen::Vector3d& x, const Eigen::Vector3d& nx
   Eigen::Vector3d r[5];
   const int m = clip_to_horizon(x, nx, b, r);
   if (m < 3) return;
+  factor_ = contour_factor(nx, r, m);
+  if (!(factor_ > 0.0)) return;
   Eigen::Vector3d w[5];
   for (int k = 0; k < m; ++k) w[k] = r[k].normalized();
-  double omega[3] = {0, 0, 0}, total = 0.0;
-  for (int k = 0; k + 2 < m; ++k) total += omega[k] = solid_angle(w[0], w[k + 1], w[k + 2]);
-  if (!(total > 0.0)) return;
   const double cos_max = max_cosine(nx, w, m);
-  area_mode_ = total < kSmallSolidAngle;
-  double measure[3] = {0, 0, 0};
-  for (int k = 0; k + 2 < m; ++k)
-    measure[k] = area_mode_ ? 0.5 * (r[k + 1] - r[0]).cross(r[k + 2] - r[0]).norm() : omega[k];
+  // The fan's triangle areas, and the solid angle they subtend to first order (A cosθ / r²
+  // at each centroid, cosθ = height / r): below kSmallSolidAngle, area sampling; above,
+  // the exact solid angles (an atan2 each) for Arvo's sampling.
+  double measure[3] = {0, 0, 0}, estimate = 0.0;
+  for (int k = 0; k + 2 < m; ++k) {
+    measure[k] = 0.5 * (r[k + 1] - r[0]).cross(r[k + 2] - r[0]).norm();
+    const double rc = ((r[0] + r[k + 1] + r[k + 2]) / 3.0).norm();
+    estimate += measure[k] * height / (rc * rc * rc);
+  }
+  area_mode_ = estimate < kSmallSolidAngle;
+  if (!area_mode_) {
+    double total = 0.0;
+    for (int k = 0; k + 2 < m; ++k) total += measure[k] = solid_angle(w[0], w[k + 1], w[k + 2]);
+    if (!(total > 0.0)) return;
+  }
   for (int k = 0; k < m; ++k) w_[k] = area_mode_ ? (x + r[k]).eval() : w[k];
   triangles_ = m - 2;
   for (int k = 0; k < triangles_; ++k) cdf_[k] = (k ? cdf_[k - 1] : 0.0) + measure[k];
+  if (!(cdf_[triangles_ - 1] > 0.0)) {
+    triangles_ = 0;
+    return;
+  }
   if (area_mode_) {
     // K = cosθ_x cosθ_y / r² with cosθ_y = height / r and r >= distance to b.
     const double rmin = std::max(distance_to_patch(x, b), height);

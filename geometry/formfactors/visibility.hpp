@@ -18,13 +18,16 @@ namespace lambert::ff {
 /// Draws points of a patch with density ∝ K(x, y) from a fixed point x. Two exact methods:
 /// directions uniform in the solid angle of b's part in front of x (Arvo 1995, per triangle
 /// of its fan), kept with probability cosθ_x / (bound of cosθ_x over b); or, when b subtends
-/// under kSmallSolidAngle (where Arvo's formulas lose digits), points uniform in area, kept
+/// under kSmallSolidAngle (to first order; where Arvo's formulas lose digits and K is
+/// nearly uniform over b), points uniform in area, kept
 /// with probability K / (bound of K over b). Both are rejection samplers of the same density.
 class KernelSampler {
  public:
   KernelSampler(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& b);
   /// True when no part of b is in front of x (nothing to sample).
   bool empty() const { return triangles_ == 0; }
+  /// The unoccluded factor F(x -> b) (point_to_patch, from the same clipped polygon).
+  double factor() const { return factor_; }
   /// A point of b. (u0, u1, u2) uniform in [0,1)^3 drive the first try (stratification);
   /// further tries draw from rng. After kMaxTries rejections the last try is returned and
   /// `exhausted` is set (never seen in practice: acceptance is >= ~cos of b's elevation).
@@ -45,6 +48,7 @@ class KernelSampler {
   int triangles_ = 0;
   bool area_mode_ = false;
   double bound_ = 1.0;            // upper bound of the acceptance numerator
+  double factor_ = 0.0;
 };
 
 /// Number of `rays` visibility rays from x (normal nx, on a patch) to points of b drawn by
