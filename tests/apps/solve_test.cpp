@@ -122,7 +122,8 @@ TEST(SolveCommand, HemicubeImbalanceIsReportedAsNonReciprocityNotAsResidual) {
             kExitOk);
   const std::string out = ::testing::internal::GetCapturedStdout();
   EXPECT_NE(out.find("non-reciprocity part"), std::string::npos) << out;
-  for (const auto& c : read_json(dir.file("B.json")).at("channels")) {
+  const auto report = read_json(dir.file("B.json"));  // a named value: a temporary would die
+  for (const auto& c : report.at("channels")) {
     const auto& e = c.at("energy");
     const double imbalance = e.at("relative_imbalance").get<double>();
     // Hemicube rows are not reciprocal: at N = 16 the imbalance is percent-level (measured
