@@ -68,6 +68,9 @@ void add_scene_options(CLI::App* cmd, SceneArgs& args) {
         return parse_finite_number(s, r) && r > 0 && r <= 1 ? std::string()
                                                             : "'" + s + "' is not a number in (0, 1]";
       });
+  cmd->add_flag("--vertex-colors-as-reflectance", args.load.vertex_colors_as_reflectance,
+                "Each face whose corners all have colours (v x y z r g b) reflects their mean "
+                "instead of its material's Kd");
   cmd->add_option("--emit", args.emit,
                   "NAME_OR_GLOB=R,G,B: surfaces (or materials) matching the name or glob emit "
                   "radiosity R,G,B (repeatable; later rules win)")

@@ -16,7 +16,7 @@ namespace lambert {
 /// Scene file, how to load it and meshing target.
 struct SceneArgs {
   std::string scene;                 ///< OBJ path; empty = built-in Cornell box
-  LoadOptions load;                  ///< --strict, --default-reflectance, --max-reflectance
+  LoadOptions load;  ///< --strict, --default-reflectance, --max-reflectance, --vertex-colors-as-reflectance
   std::vector<std::string> emit;     ///< --emit NAME_OR_GLOB=R,G,B, parsed by load_scene
   double max_edge = 0.0;             ///< --max-edge
   std::int64_t patches = 0;          ///< --patches
@@ -32,7 +32,8 @@ struct RunArgs {
 };
 
 /// Adds the positional SCENE, the loading options (--strict, --default-reflectance,
-/// --max-reflectance, --emit) and --max-edge / --patches to a subcommand.
+/// --max-reflectance, --vertex-colors-as-reflectance, --emit) and --max-edge / --patches to
+/// a subcommand.
 void add_scene_options(CLI::App* cmd, SceneArgs& args);
 /// Adds -j/--threads, --seed, -q/--quiet and -v/--verbose to a subcommand.
 void add_run_options(CLI::App* cmd, RunArgs& args);

@@ -105,6 +105,7 @@ int run_compare(const CompareOptions& opts) {
   const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);
   const RadiosityProblem problem = make_problem(loaded.mesh, ff.F);
   warn_about_lighting(loaded.mesh, ff.F);
+  check_closed_lossless(loaded.mesh, ff);
   std::vector<std::string> names = opts.solvers.empty() ? solver_names() : opts.solvers;
   // Drop repeated names, keeping the first occurrence's order.
   std::vector<std::string> unique_names;

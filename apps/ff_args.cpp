@@ -1,5 +1,6 @@
 #include "apps/ff_args.hpp"
 
+#include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
 #include "geometry/formfactors/analysis.hpp"
@@ -85,6 +86,13 @@ void warn_about_lighting(const PatchMesh& mesh, const SparseF& F) {
   LightingProblems p = find_lighting_problems(mesh, F);
   p.no_emitter = false;  // the scene loader has warned already, naming the file and --emit
   for (const std::string& line : lighting_warnings(mesh, p)) log_warn(line);
+}
+
+void check_closed_lossless(const PatchMesh& mesh, const FormFactors& ff, bool solving) {
+  const std::vector<ClosedLossless> sets = find_closed_lossless(mesh, ff);
+  if (sets.empty()) return;
+  if (solving) throw SceneError(closed_lossless_message(mesh, sets.front()));
+  for (const auto& c : sets) log_warn(closed_lossless_message(mesh, c) + " (a solve with this F is refused)");
 }
 
 Json ff_settings_json(const FormFactorOptions& o, const std::string& loaded_from) {

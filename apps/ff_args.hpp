@@ -41,6 +41,11 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
 /// emitter is warned about by the loader.)
 void warn_about_lighting(const PatchMesh& mesh, const SparseF& F);
 
+/// Refuses (SceneError, exit 1) a scene in which a closed set of lossless surfaces makes
+/// I - rho F singular (analysis.hpp's find_closed_lossless), naming them and the channel;
+/// with `solving` false (F is only saved) the same message is a warning instead.
+void check_closed_lossless(const PatchMesh& mesh, const FormFactors& ff, bool solving = true);
+
 /// The settings that made F, for reports: {estimator, samples, seed, threshold,
 /// hemicube_resolution, symmetrize, loaded_from} ("" when computed here), every setting null
 /// when unknown (see obtain_form_factors).

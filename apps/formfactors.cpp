@@ -144,6 +144,7 @@ int run_formfactors(const FormFactorsOptions& opts) {
   if (opts.output.empty()) throw UsageError("formfactors: -o/--output is required");
   const FormFactors ff = obtain_form_factors(scene, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
   warn_about_lighting(scene.mesh, ff.F);
+  check_closed_lossless(scene.mesh, ff, false);
   const FormFactorDiagnostics d = diagnose(scene.mesh, ff.F);
   print_diagnostics(scene, ff, d);
   const std::string settings = settings_string(ff.options, scene);

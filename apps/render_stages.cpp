@@ -89,6 +89,7 @@ void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOpti
   const Timer solve_timer;
   const RadiosityProblem problem = make_problem(scene.mesh, F.F);
   warn_about_lighting(scene.mesh, F.F);
+  check_closed_lossless(scene.mesh, F);
   SolveOptions so = solver;
   so.threads = run.threads;
   r.solution = solve_radiosity(problem, so);

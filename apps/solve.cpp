@@ -74,6 +74,7 @@ int run_solve(const SolveCommandOptions& opts) {
   const double ff_seconds = ff_timer.seconds();
   const RadiosityProblem problem = make_problem(loaded.mesh, ff.F);
   warn_about_lighting(loaded.mesh, ff.F);
+  check_closed_lossless(loaded.mesh, ff);
   SolveOptions so = opts.solve;
   so.threads = opts.run.threads;
   const RadiositySolution sol = solve_radiosity(problem, so);

@@ -18,6 +18,7 @@ namespace {
 struct Element {
   std::array<std::int32_t, 4> v{};
   int n = 3;
+  Eigen::Vector3d rho = Eigen::Vector3d::Zero();  ///< its face's (or else its material's)
 };
 
 // The elements of one surface before subdivision, with welded vertices.
@@ -39,14 +40,17 @@ SurfaceElements collect(const Scene& scene, std::int32_t surface) {
     return id;
   };
   std::vector<Eigen::Vector3d> poly;
+  const Eigen::Vector3d& material_rho = scene.material_of(surface).rho;
   for (const auto& f : scene.faces) {
     if (f.surface != surface) continue;
+    const Eigen::Vector3d rho = f.rho ? *f.rho : material_rho;
     poly.clear();
     for (auto v : f.vertices) poly.push_back(scene.vertices[v]);
     if (polygon_area(poly) <= 0.0) continue;
     if (poly.size() == 3 || (poly.size() == 4 && is_convex(poly))) {
       Element e;
       e.n = static_cast<int>(poly.size());
+      e.rho = rho;
       for (int k = 0; k < e.n; ++k) e.v[k] = local(poly[k]);
       out.elements.push_back(e);
       continue;
@@ -58,6 +62,7 @@ SurfaceElements collect(const Scene& scene, std::int32_t surface) {
       const double area = 0.5 * (poly[t[1]] - poly[t[0]]).cross(poly[t[2]] - poly[t[0]]).norm();
       if (area <= 1e-10 * diam * diam) continue;
       Element e;
+      e.rho = rho;
       for (int k = 0; k < 3; ++k) e.v[k] = local(poly[t[k]]);
       out.elements.push_back(e);
     }
@@ -175,15 +180,17 @@ void subdivide(const SurfaceElements& s, double max_edge, std::int32_t surface,
     }
     return a < b ? pts[t] : pts[n - t];
   };
+  const Eigen::Vector3d* rho = nullptr;  // of the element being subdivided
   auto emit = [&](std::array<std::int32_t, 4> v, int n) {
     Patch p = make_patch(mesh, v, n);
-    p.rho = mat.rho;
+    p.rho = *rho;
     p.emission = mat.emission;
     p.surface = surface;
     mesh.patches.push_back(p);
   };
   for (const auto& e : s.elements) {
     const auto& P = s.points;
+    rho = &e.rho;
     if (e.n == 3) {
       const std::int64_t n = count.at(edge_key(e.v[0], e.v[1]));
       // Grid point (a, b), a + b <= n: v0 + a/n (v1 - v0) + b/n (v2 - v0).

@@ -20,7 +20,7 @@ struct Patch {
   double area = 0.0;
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();    ///< unit front normal (winding)
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< area centroid
-  Eigen::Vector3d rho = Eigen::Vector3d::Zero();       ///< reflectance of its material
+  Eigen::Vector3d rho = Eigen::Vector3d::Zero();       ///< its face's Face::rho, else its material's
   Eigen::Vector3d emission = Eigen::Vector3d::Zero();  ///< emitted radiosity E (W/m^2)
   std::int32_t surface = 0;                            ///< index into Scene::surfaces
 };

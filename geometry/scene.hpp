@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,9 @@ struct Face {
   std::vector<std::int32_t> vertices;  ///< indices into Scene::vertices (>= 3)
   std::int32_t surface = 0;            ///< index into Scene::surfaces
   int line = 0;                        ///< source line of the face (0 if unknown)
+  /// Reflectance of this face when it differs from its surface's material (vertex colours,
+  /// --vertex-colors-as-reflectance); each channel in [0, 1]. Patches of the face get it.
+  std::optional<Eigen::Vector3d> rho;
 };
 
 /// A named surface: one OBJ group/object with one material. Output is reported per surface.

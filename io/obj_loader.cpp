@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <unordered_map>
@@ -212,6 +213,49 @@ Materials build_materials(const ObjData& obj, const std::vector<MtlMaterial>& de
   return out;
 }
 
+// --vertex-colors-as-reflectance: checks the file's colours and brings them to [0, 1].
+// Components above 1, all whole numbers up to 255, are the common 0..255 convention: every
+// colour of the file is divided by 255, with a warning (--strict refuses). Anything else
+// outside [0, 1] is refused. Without the option the colours are dropped (and counted as
+// skipped).
+void prepare_colors(ObjData& obj, const LoadOptions& options, const std::string& name,
+                    Diagnostics& diag) {
+  ObjColors& c = obj.colors;
+  if (!options.vertex_colors_as_reflectance) {
+    c.of_vertex.clear();
+    return;
+  }
+  if (c.of_vertex.empty()) {
+    diag.warn(name + ": --vertex-colors-as-reflectance: no vertex has a colour (v x y z r g b): "
+              "every face keeps its material's Kd");
+    return;
+  }
+  obj.skipped.erase("vertex colours");  // used, not skipped
+  if (c.min < 0.0)
+    throw SceneError(where(name, c.min_line) + ": vertex colour component " + num(c.min) +
+                     " is negative: a reflectance lies in [0, 1]");
+  if (c.max <= 1.0) return;
+  const std::string at = where(name, c.max_line) + ": vertex colour component " + num(c.max);
+  if (c.max > 255.0 || !c.all_integers)
+    throw SceneError(at + " is above 1: a reflectance lies in [0, 1] (colours in 0..255 are "
+                     "read when all are whole numbers); rescale the colours");
+  diag.defaulted(at + " is above 1: a reflectance lies in [0, 1]; rescale the colours",
+                 at + " is above 1: the file's colours are read as 0..255 and divided by 255");
+  for (auto& v : c.of_vertex) v /= 255.0;
+}
+
+// Mean colour of a face's corners; none unless every corner has a colour.
+std::optional<Eigen::Vector3d> corner_mean(const ObjColors& colors,
+                                           const std::vector<std::int32_t>& corners) {
+  if (colors.of_vertex.empty()) return std::nullopt;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const auto v : corners) {
+    if (std::isnan(colors.of_vertex[v][0])) return std::nullopt;
+    sum += colors.of_vertex[v];
+  }
+  return sum / static_cast<double>(corners.size());
+}
+
 // The polygon of a face with repeated corners collapsed (same index or position as the
 // previous one, or the last equal to the first): they add nothing but zero-length edges.
 std::vector<Eigen::Vector3d> collapse_corners(const std::vector<Eigen::Vector3d>& verts,
@@ -253,6 +297,7 @@ std::map<std::int32_t, std::set<std::int32_t>> build_faces(const ObjData& obj,
       log_debug(where(name, of.line) + ": zero-area face dropped");
       continue;
     }
+    face.rho = corner_mean(obj.colors, face.vertices);
     const std::int32_t mat = material_of(of);
     auto it = surface_of.find({of.group, mat});
     if (it == surface_of.end()) {
@@ -328,22 +373,63 @@ void report_default_materials(const ObjData& obj, const Materials& mats,
                      ": surface(s) " + list_names(none) + " use " + deflt);
 }
 
-// Kd = 1 is lossless: accepted, but the system is singular when a closed set of such
-// surfaces absorbs nothing, which the loader (without form factors) cannot see.
-void report_lossless(const Materials& mats, const std::string& name, Diagnostics& diag,
-                     const Scene& scene) {
-  if (mats.lossless.empty()) return;
-  bool closed_risk = false;  // some channel in which every surface is lossless
+// Faces coloured on some corners only (they keep Kd), --max-reflectance on colours, and
+// lossless colours (refused with --strict). Returns the surfaces with a lossless face colour.
+std::set<std::string> report_face_colors(const ObjColors& colors, const LoadOptions& options,
+                                         const std::string& name, Diagnostics& diag,
+                                         Scene& scene) {
+  std::set<std::string> partial, clamped, lossless;
+  int first_partial = 0;
+  for (Face& f : scene.faces) {
+    const std::string& surface = scene.surfaces[f.surface].name;
+    if (!f.rho) {
+      const bool some = !colors.of_vertex.empty() &&
+          std::any_of(f.vertices.begin(), f.vertices.end(),
+                      [&](std::int32_t v) { return !std::isnan(colors.of_vertex[v][0]); });
+      if (some && partial.insert(surface).second && first_partial == 0) first_partial = f.line;
+      continue;
+    }
+    if (options.max_reflectance > 0 && f.rho->maxCoeff() > options.max_reflectance) {
+      *f.rho = f.rho->cwiseMin(options.max_reflectance);
+      clamped.insert(surface);
+    }
+    if (f.rho->maxCoeff() < 1.0) continue;
+    if (options.strict)
+      throw SceneError(where(name, f.line) + ": face colour (mean of its corners) " + rgb(*f.rho) +
+                       " must lie in [0, 1) in every channel with --strict");
+    lossless.insert(surface);
+  }
+  if (!partial.empty())
+    diag.warn(where(name, first_partial) + ": faces with colours on only some corners keep "
+              "their material's Kd: surface(s) " + list_names(partial));
+  if (!clamped.empty())
+    diag.warn(name + ": vertex-colour reflectance clamped to --max-reflectance " +
+              num(options.max_reflectance) + " on surface(s) " + list_names(clamped));
+  return lossless;
+}
+
+// Kd = 1 (or a face colour of 1) is lossless: accepted, but the system is singular when a
+// closed set of such surfaces absorbs nothing, which the loader (without form factors)
+// cannot see; the commands check it once F is known (find_closed_lossless).
+void report_lossless(const Materials& mats, const std::set<std::string>& colored,
+                     const std::string& name, Diagnostics& diag, const Scene& scene) {
+  if (mats.lossless.empty() && colored.empty()) return;
+  bool closed_risk = false;  // some channel in which every face is lossless
   for (int c = 0; c < 3; ++c) {
     bool every = true;
-    for (const auto& s : scene.surfaces) every = every && scene.materials[s.material].rho[c] == 1.0;
+    for (const auto& f : scene.faces)
+      every = every && (f.rho ? *f.rho : scene.material_of(f.surface).rho)[c] == 1.0;
     closed_risk = closed_risk || every;
   }
-  diag.warn(name + ": material(s) " + list_names(mats.lossless) +
-            " have Kd = 1 in some channel (lossless): the radiosity system is singular if such "
-            "surfaces enclose a space where nothing absorbs" +
+  const std::string what =
+      (mats.lossless.empty() ? "" : "material(s) " + list_names(mats.lossless)) +
+      (mats.lossless.empty() || colored.empty() ? "" : " and ") +
+      (colored.empty() ? "" : "vertex colours of surface(s) " + list_names(colored));
+  diag.warn(name + ": " + what +
+            " have reflectance 1 in some channel (lossless): the radiosity system is singular "
+            "if such surfaces enclose a space where nothing absorbs" +
             (closed_risk ? " (here every surface is lossless in one channel)" : "") +
-            "; --max-reflectance 0.99 clamps");
+            ", which is refused once form factors are known; --max-reflectance 0.99 clamps");
 }
 
 // What was skipped, in one warning.
@@ -502,6 +588,7 @@ Scene load_obj_stream(std::istream& in, const std::string& name, const MtlOpener
   LoadReport report;
   Diagnostics diag(options.strict, report);
   ObjData obj = parse_obj(in, name);
+  prepare_colors(obj, options, name, diag);
   const std::vector<MtlMaterial> defs = read_libraries(obj, name, open_mtl, diag);
   Scene scene;
   scene.source = name;
@@ -509,7 +596,8 @@ Scene load_obj_stream(std::istream& in, const std::string& name, const MtlOpener
   scene.vertices = std::move(obj.vertices);
   const auto users = build_faces(obj, mats, name, diag, report, scene);
   report_default_materials(obj, mats, users, name, options, diag, scene);
-  report_lossless(mats, name, diag, scene);
+  const auto colored_lossless = report_face_colors(obj.colors, options, name, diag, scene);
+  report_lossless(mats, colored_lossless, name, diag, scene);
   report_skipped(obj, name, diag, report);
   if (report.degenerate_faces_dropped > 0)
     diag.warn(name + ": " + std::to_string(report.degenerate_faces_dropped) + " zero-area face(s) dropped");

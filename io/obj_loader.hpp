@@ -26,6 +26,9 @@ struct LoadOptions {
   Eigen::Vector3d default_reflectance = Eigen::Vector3d::Constant(0.5);  ///< default material
   double max_reflectance = 0.0;  ///< > 0: Kd channels above it are clamped to it, with a warning
   std::vector<EmitRule> emit;    ///< applied in order (a later rule overrides an earlier one)
+  /// Each face whose corners all have colours (`v x y z r g b`) gets their mean as its
+  /// reflectance (Face::rho) instead of its material's Kd.
+  bool vertex_colors_as_reflectance = false;
 };
 
 /// What the loader had to repair, default or skip (each also logged as a warning).

@@ -21,6 +21,9 @@ const std::set<std::string, std::less<>> kSkipped = {
     "d_interp", "shadow_obj", "trace_obj", "ctech", "stech", "maplib", "usemap", "call",
     "csh",     "res"};
 
+// The colour of a vertex that has none (ObjColors::of_vertex).
+const Eigen::Vector3d kNoColor = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+
 std::string quoted(std::string_view s) { return "'" + std::string(s) + "'"; }
 
 class ObjParser {
@@ -34,6 +37,8 @@ class ObjParser {
       if (tok_.empty()) continue;
       statement();
     }
+    if (!out_.colors.of_vertex.empty())  // vertices after the last coloured one have none
+      out_.colors.of_vertex.resize(out_.vertices.size(), kNoColor);
     return std::move(out_);
   }
 
@@ -79,9 +84,34 @@ class ObjParser {
     }
     if (out_.vertices.size() >= static_cast<size_t>(std::numeric_limits<std::int32_t>::max()))
       fail("more than 2^31 - 1 vertices");
-    if (n == 6) skip("vertex colours");
+    if (n == 6) color(Eigen::Vector3d(x[3], x[4], x[5]));
     if (n == 4) skip("vertex weights");
     out_.vertices.emplace_back(x[0], x[1], x[2]);
+  }
+
+  // The colour of the vertex being added (counted as skipped: the loader uses it only
+  // with --vertex-colors-as-reflectance).
+  void color(const Eigen::Vector3d& c) {
+    skip("vertex colours");
+    ObjColors& cs = out_.colors;
+    const int line = lines_.line_number();
+    if (cs.of_vertex.empty()) {
+      cs.first_line = line;
+      cs.max = c.maxCoeff();
+      cs.min = c.minCoeff();
+      cs.max_line = cs.min_line = line;
+    }
+    if (c.maxCoeff() > cs.max) {
+      cs.max = c.maxCoeff();
+      cs.max_line = line;
+    }
+    if (c.minCoeff() < cs.min) {
+      cs.min = c.minCoeff();
+      cs.min_line = line;
+    }
+    cs.all_integers = cs.all_integers && (c.array() == c.array().round()).all();
+    cs.of_vertex.resize(out_.vertices.size(), kNoColor);
+    cs.of_vertex.push_back(c);
   }
 
   // Resolves one index (1-based, or negative counting back) against `count` defined so far.

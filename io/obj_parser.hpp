@@ -39,6 +39,18 @@ struct ObjSkipped {
   int first_line = 0;
 };
 
+/// Vertex colours (`v x y z r g b`), kept for --vertex-colors-as-reflectance.
+struct ObjColors {
+  /// Per vertex once any vertex has a colour (else empty); NaN for a vertex without one.
+  std::vector<Eigen::Vector3d> of_vertex;
+  int first_line = 0;       ///< line of the first colour (0 = none)
+  double max = 0.0;         ///< largest component of any colour
+  int max_line = 0;         ///< its line
+  double min = 0.0;         ///< smallest component of any colour
+  int min_line = 0;         ///< its line
+  bool all_integers = true; ///< every component is a whole number (a 0..255 file)
+};
+
 /// What the parser kept of an OBJ file.
 struct ObjData {
   std::vector<Eigen::Vector3d> vertices;
@@ -46,6 +58,7 @@ struct ObjData {
   std::vector<ObjMaterialUse> materials;
   std::vector<ObjFace> faces;
   std::vector<ObjMtllib> mtllibs;
+  ObjColors colors;
   std::map<std::string, ObjSkipped> skipped;  ///< statement (or "vertex colours") -> count
 };
 

@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <numeric>
+#include <sstream>
+
+#include <Eigen/SparseCore>
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
@@ -13,6 +17,19 @@
 #include "geometry/formfactors/visibility.hpp"
 
 namespace lambert {
+namespace {
+
+// 'a', 'b' and N more: surface names for a one-line message.
+std::string surface_list(const PatchMesh& mesh, const std::vector<std::int32_t>& surfaces) {
+  constexpr size_t kNamed = 5;  // enough to recognise the surfaces, short enough for one line
+  std::string names;
+  for (size_t k = 0; k < std::min(kNamed, surfaces.size()); ++k)
+    names += (k ? ", '" : "'") + mesh.surface_names.at(surfaces[k]) + "'";
+  if (surfaces.size() > kNamed) names += " and " + std::to_string(surfaces.size() - kNamed) + " more";
+  return names;
+}
+
+}  // namespace
 
 FormFactorDiagnostics diagnose(const PatchMesh& mesh, const SparseF& F, int worst) {
   FormFactorDiagnostics d;
@@ -86,12 +103,7 @@ std::vector<std::string> lighting_warnings(const PatchMesh& mesh, const Lighting
                     " patch pairs): the scene may be inside out or its winding inverted — "
                     "lambert lights the front (counter-clockwise) side");
   if (!p.blind_emitters.empty()) {
-    constexpr size_t kNamed = 5;  // enough to recognise the surfaces, short enough for one line
-    std::string names;
-    for (size_t k = 0; k < std::min(kNamed, p.blind_emitters.size()); ++k)
-      names += (k ? ", '" : "'") + mesh.surface_names.at(p.blind_emitters[k]) + "'";
-    if (p.blind_emitters.size() > kNamed)
-      names += " and " + std::to_string(p.blind_emitters.size() - kNamed) + " more";
+    const std::string names = surface_list(mesh, p.blind_emitters);
     const bool one = p.blind_emitters.size() == 1;
     lines.push_back(std::string(one ? "emitter " : "emitters ") + names + (one ? " sees" : " see") +
                     " nothing from " + (one ? "its" : "their") +
@@ -99,6 +111,108 @@ std::vector<std::string> lighting_warnings(const PatchMesh& mesh, const Lighting
                     " may point away from the scene (inverted winding)");
   }
   return lines;
+}
+
+namespace {
+
+// Why this finds exactly the singular case. K = I - diag(rho) F with F >= 0 and row sums
+// <= 1 is singular iff diag(rho) F has eigenvalue 1, which for a non-negative matrix whose
+// row sums are <= 1 happens iff some set S keeps all of its rows' mass: rho_i sum_{j in S}
+// F_ij = 1 for every i in S (diag(rho) F restricted to S is stochastic; its all-ones vector
+// is the eigenvector). That needs rho_i = 1 on S, so S lies within the lossless patches L.
+// The largest such S is found by pruning: start from L and repeatedly drop a patch whose
+// leak, 1 - sum_{j still in the set} F_ij (what escapes, is absorbed elsewhere, or reaches a
+// dropped patch), exceeds its row's error; dropping only raises the others' leaks, so the
+// result is the greatest fixpoint, and any closed S survives (no row of it ever leaks).
+// A worklist over the lossless-to-lossless entries (column access from a transposed copy
+// of just those) makes it O(N + nnz).
+// The closed lossless set of one channel, empty if none.
+ClosedLossless closed_lossless_set(const PatchMesh& mesh, const FormFactors& ff, int channel) {
+  const SparseF& F = ff.F;
+  const std::int32_t n = mesh.size();
+  std::vector<char> in(n, 0);
+  for (std::int32_t i = 0; i < n; ++i) in[i] = mesh.patches[i].rho[channel] >= 1.0;
+  ClosedLossless out;
+  if (std::find(in.begin(), in.end(), 1) == in.end()) return out;
+  const bool have_err = ff.stderr_F.nonZeros() > 0;
+  std::vector<double> inside(n, 0.0), tol(n, kClosedRowTolerance);
+  std::vector<Eigen::Triplet<double, std::int32_t>> into;  // (row, column) inside L
+  for (std::int32_t i = 0; i < n; ++i) {
+    if (!in[i]) continue;
+    double var = 0.0;
+    // stderr_F shares F's sparsity pattern: walk both CSR arrays by position.
+    for (auto k = F.outerIndexPtr()[i]; k < F.outerIndexPtr()[i + 1]; ++k) {
+      const std::int32_t j = F.innerIndexPtr()[k];
+      if (have_err) var += std::pow(ff.stderr_F.valuePtr()[k], 2);
+      if (!in[j]) continue;
+      inside[i] += F.valuePtr()[k];
+      into.emplace_back(i, j, F.valuePtr()[k]);
+    }
+    tol[i] += kClosedSigmas * std::sqrt(var);
+  }
+  Eigen::SparseMatrix<double, Eigen::ColMajor, std::int32_t> by_column(n, n);
+  by_column.setFromTriplets(into.begin(), into.end());
+  std::vector<std::int32_t> drop;
+  for (std::int32_t i = 0; i < n; ++i)
+    if (in[i] && 1.0 - inside[i] > tol[i]) drop.push_back(i);
+  while (!drop.empty()) {
+    const std::int32_t j = drop.back();
+    drop.pop_back();
+    if (!in[j]) continue;
+    in[j] = 0;
+    for (decltype(by_column)::InnerIterator it(by_column, j); it; ++it) {
+      const auto i = static_cast<std::int32_t>(it.row());
+      if (!in[i]) continue;
+      inside[i] -= it.value();
+      if (1.0 - inside[i] > tol[i]) drop.push_back(i);
+    }
+  }
+  for (std::int32_t i = 0; i < n; ++i) {
+    if (!in[i]) continue;
+    out.patches.push_back(i);
+    out.surfaces.push_back(mesh.patches[i].surface);
+    out.max_leak = std::max(out.max_leak, 1.0 - inside[i]);
+  }
+  std::sort(out.surfaces.begin(), out.surfaces.end());
+  out.surfaces.erase(std::unique(out.surfaces.begin(), out.surfaces.end()), out.surfaces.end());
+  if (!out.patches.empty()) out.channels.push_back(channel);
+  return out;
+}
+
+}  // namespace
+
+std::vector<ClosedLossless> find_closed_lossless(const PatchMesh& mesh, const FormFactors& ff) {
+  LAMBERT_CHECK(ff.F.rows() == mesh.size() && ff.F.cols() == mesh.size(), "F does not match the mesh");
+  std::vector<ClosedLossless> out;
+  for (int c = 0; c < 3; ++c) {
+    ClosedLossless set = closed_lossless_set(mesh, ff, c);
+    if (set.patches.empty()) continue;
+    auto same = std::find_if(out.begin(), out.end(),
+                             [&](const ClosedLossless& o) { return o.patches == set.patches; });
+    if (same != out.end()) {
+      same->channels.push_back(c);
+      same->max_leak = std::max(same->max_leak, set.max_leak);
+    } else {
+      out.push_back(std::move(set));
+    }
+  }
+  return out;
+}
+
+std::string closed_lossless_message(const PatchMesh& mesh, const ClosedLossless& c) {
+  static const char* const kChannel[] = {"R", "G", "B"};
+  std::string channels;
+  for (size_t k = 0; k < c.channels.size(); ++k) channels += (k ? ", " : "") + std::string(kChannel[c.channels[k]]);
+  const bool one = c.surfaces.size() == 1;
+  std::ostringstream leak;
+  leak << std::setprecision(2) << std::max(0.0, c.max_leak);
+  return std::string(one ? "surface " : "surfaces ") + surface_list(mesh, c.surfaces) + " (" +
+         std::to_string(c.patches.size()) + " patches) " + (one ? "is" : "are") +
+         " lossless (reflectance 1) in channel " + channels +
+         " and no light leaves them (none escapes or reaches a surface that absorbs; largest "
+         "row leak " + leak.str() + ", within F's error): I - rho F is singular "
+         "and no solver can converge; give one of them a reflectance below 1, or clamp with "
+         "--max-reflectance 0.99";
 }
 
 SurfaceFactors surface_factors(const PatchMesh& mesh, const FormFactors& ff) {

@@ -49,6 +49,33 @@ LightingProblems find_lighting_problems(const PatchMesh& mesh, const SparseF& F)
 /// and the likely cause.
 std::vector<std::string> lighting_warnings(const PatchMesh& mesh, const LightingProblems& p);
 
+/// A closed set of lossless patches: every patch of it has reflectance 1 in the channel(s)
+/// and sends all the light it emits or reflects to patches of the set (none escapes, none
+/// reaches a patch that absorbs), within F's error. (I - rho F) is then singular.
+struct ClosedLossless {
+  std::vector<int> channels;           ///< 0 R, 1 G, 2 B: those with exactly this set
+  std::vector<std::int32_t> patches;   ///< the set, ascending
+  std::vector<std::int32_t> surfaces;  ///< their surfaces, ascending
+  double max_leak = 0.0;               ///< largest fraction of a row of F leaving the set
+};
+
+/// Every closed lossless set (one per distinct set; a channel has at most one, the largest).
+/// F's error per row: kClosedRowTolerance plus kClosedSigmas row standard errors when
+/// `ff.stderr_F` is present. O(N + nnz) time.
+std::vector<ClosedLossless> find_closed_lossless(const PatchMesh& mesh, const FormFactors& ff);
+
+/// Row leak below which F cannot tell a closed set from a leaking one, without stderr: the
+/// hybrid estimator's quadrature bound (README: 1e-6 of the unoccluded G per entry, so at
+/// most 1e-6 of a row sum <= 1); rounding of the row sums (~N 1e-16) is far below it.
+constexpr double kClosedRowTolerance = 1e-6;
+/// Row standard errors added to it when F has them: README's stderr covers an entry's
+/// error within +-2 stderr at 97 %; a set of many rows must have none misjudged, and a
+/// normal tail beyond 5 sigma (3e-7 per row) keeps that probable up to ~1e5 rows.
+constexpr double kClosedSigmas = 5.0;
+
+/// One line naming the surfaces and channels of a closed lossless set and the cure.
+std::string closed_lossless_message(const PatchMesh& mesh, const ClosedLossless& c);
+
 /// Surface-to-surface factors F_GH = Σ_{i∈G} A_i Σ_{j∈H} F_ij / A_G and standard errors.
 struct SurfaceFactors {
   std::vector<std::string> surfaces;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -12,7 +13,11 @@
 #include "apps/cli.hpp"
 #include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
+#include "apps/ff_args.hpp"
+#include "apps/problem.hpp"
 #include "geometry/analytic.hpp"
+#include "geometry/formfactors/formfactors.hpp"
+#include "solvers/radiosity.hpp"
 
 namespace lambert {
 
@@ -149,6 +154,115 @@ TEST(LightingWarnings, AWorkingSceneHasNoWarning) {
   const auto [code, err] = run_captured(small({"solve", obj, "-o", dir.file("B.csv")}));
   EXPECT_EQ(code, kExitOk) << err;
   EXPECT_EQ(count(err, "warning:"), 0) << err;
+}
+
+namespace {
+
+// cube() (the lamp "top" emits 1) with reflectance 1 everywhere except `absorbing` (0.5),
+// and without the face `missing`.
+Scene lossless_cube(const std::string& absorbing, const std::string& missing = "") {
+  Scene s = cube();
+  for (Material& m : s.materials) m.rho.setOnes();
+  for (Surface& surf : s.surfaces) {
+    if (surf.name != absorbing) continue;
+    s.materials.push_back({"absorber", Eigen::Vector3d::Constant(0.5), s.materials[surf.material].emission});
+    surf.material = static_cast<std::int32_t>(s.materials.size() - 1);
+  }
+  s.faces.erase(std::remove_if(s.faces.begin(), s.faces.end(),
+                               [&](const Face& f) { return s.surfaces[f.surface].name == missing; }),
+                s.faces.end());
+  return s;
+}
+
+// What the solve command does, kept in reach of the test: mesh (0.5), hybrid F, solve to
+// 1e-10; the energy balance of channel R and the average B of the surface `surface`.
+struct Solved {
+  EnergyBalance balance;
+  double surface_b = 0.0;
+  double escaped_bound = 0.0;   // sum_i A_i B_i |1 - rowsum_i|: the most F's row-sum error moves
+  double residual_bound = 0.0;  // ||A||_2 tol ||E||_2 >= |sum_i A_i r_i| (Cauchy-Schwarz)
+};
+
+Solved solve_cube(const Scene& s, const std::string& surface) {
+  MeshOptions mo;
+  mo.max_edge = 0.5;
+  const PatchMesh mesh = mesh_scene(s, mo);
+  FormFactorOptions fo;
+  fo.samples = 4;  // no occluders: hybrid is exact to quadrature whatever the rays
+  fo.progress = false;
+  const FormFactors ff = compute_form_factors(mesh, fo);
+  check_closed_lossless(mesh, ff);  // must not throw
+  const RadiosityProblem problem = make_problem(mesh, ff.F);
+  SolveOptions so;
+  so.tol = 1e-10;
+  const RadiositySolution sol = solve_radiosity(problem, so);
+  EXPECT_EQ(sol.status, SolveStatus::Converged);
+  Solved out;
+  out.balance = energy_balance(problem, sol.B, 0);
+  const Eigen::VectorXd row_sum = ff.F * Eigen::VectorXd::Ones(mesh.size());
+  for (std::int32_t i = 0; i < mesh.size(); ++i)
+    out.escaped_bound += problem.area[i] * sol.B(i, 0) * std::abs(1.0 - row_sum[i]);
+  out.residual_bound = problem.area.norm() * so.tol * problem.emission.col(0).norm();
+  for (const auto& avg : surface_averages(mesh, sol.B))
+    if (avg.name == surface) out.surface_b = avg.average[0];
+  return out;
+}
+
+}  // namespace
+
+// rho = 1 on every face of a closed box: no light is ever absorbed or escapes, so I - rho F
+// is singular; refused naming the faces and the channels, cured by --max-reflectance.
+TEST(LosslessSurfaces, AClosedLosslessCubeIsRefusedNamingItsFaces) {
+  testing::TempDir dir;
+  const std::string obj = write_obj(dir, "closed", lossless_cube(""));
+  const auto [code, err] = run_captured(small({"solve", obj, "-o", dir.file("B.csv")}));
+  EXPECT_EQ(code, kExitFailure) << err;
+  EXPECT_NE(err.find("surfaces 'left', 'right', 'floor', 'top', 'back' and 1 more (24 patches) "
+                     "are lossless (reflectance 1) in channel R, G, B and no light leaves them"),
+            std::string::npos) << err;
+  EXPECT_NE(err.find("--max-reflectance 0.99"), std::string::npos) << err;
+  const auto [ff_code, ff_err] = run_captured(small({"formfactors", obj, "-o", dir.file("F.bin")}));
+  EXPECT_EQ(ff_code, kExitOk) << ff_err;  // F itself is fine: only a solve is refused
+  EXPECT_NE(ff_err.find("(a solve with this F is refused)"), std::string::npos) << ff_err;
+  const auto [clamped, clamped_err] =
+      run_captured(small({"solve", obj, "--max-reflectance", "0.99", "-o", dir.file("B.csv")}));
+  EXPECT_EQ(clamped, kExitOk) << clamped_err;
+}
+
+// One absorbing face (rho = 0.5, the lamp, E = 1 on area 1): every watt emitted ends up
+// absorbed by it, A (1 - 0.5) H = E A, so its irradiance is H = 2 E and B = E + 0.5 H = 2 E,
+// whatever F is (the furnace argument with one absorber). Tolerances: what the F row sums
+// (within 1e-6 of 1, not exactly) let escape, plus the solver's residual share, both
+// bounded from the solution (see Solved); B's deviation is the imbalance divided by the
+// absorber's area (1) times (1 - 0.5) for H then 0.5 back for B: the same bound.
+TEST(LosslessSurfaces, ACubeWithOneAbsorbingFaceSolvesAndAbsorbsWhatItEmits) {
+  testing::TempDir dir;
+  const Scene s = lossless_cube("top");
+  const auto [code, err] =
+      run_captured(small({"solve", write_obj(dir, "one", s), "-o", dir.file("B.csv")}));
+  EXPECT_EQ(code, kExitOk) << err;
+  const Solved r = solve_cube(s, "top");
+  const double tol =
+      r.escaped_bound + r.residual_bound + std::abs(r.balance.non_reciprocity_part);
+  EXPECT_DOUBLE_EQ(r.balance.emitted, 1.0);
+  EXPECT_NEAR(r.balance.absorbed, r.balance.emitted, tol);
+  EXPECT_NEAR(r.surface_b, 2.0, tol);
+}
+
+// The same box open at the front: nothing absorbs, light escapes through the opening, and
+// all of it does, emitted = escaped (tolerance: the solver's residual share and F's
+// non-reciprocity share, rounding for hybrid's G_ij computed once per pair).
+TEST(LosslessSurfaces, AnOpenLosslessBoxSolvesAndLosesEverythingThroughTheOpening) {
+  testing::TempDir dir;
+  const Scene s = lossless_cube("", "front");
+  const auto [code, err] =
+      run_captured(small({"solve", write_obj(dir, "open", s), "-o", dir.file("B.csv")}));
+  EXPECT_EQ(code, kExitOk) << err;
+  const Solved r = solve_cube(s, "top");
+  EXPECT_NEAR(r.balance.escaped, r.balance.emitted,
+              r.residual_bound + std::abs(r.balance.non_reciprocity_part) + r.balance.absorbed);
+  // Lossless patches absorb (1 - rho) H with rho passed as 1 - 2^-53: ~1e-16 of B's power.
+  EXPECT_LT(r.balance.absorbed, 1e-12);
 }
 
 }  // namespace lambert

@@ -315,3 +315,21 @@ TEST(CornellBox, EverySolverAgreesWithDirect) {
 
 }  // namespace
 }  // namespace lambert
+
+namespace lambert {
+
+// --vertex-colors-as-reflectance reaches the patches through the shared scene options:
+// the floor's colours (0.3 0.4 0.4 and 0.55 0.2 0.2 instead of Kd 0.7) change its B.
+TEST(SolveCommand, VertexColoursAsReflectanceChangeTheSolution) {
+  testing::TempDir dir;
+  const std::string obj = std::string(LAMBERT_TEST_CORPUS_DIR) + "/obj/vertex_colors_reflectance.obj";
+  for (const char* flag : {"", "--vertex-colors-as-reflectance"}) {
+    std::vector<std::string> args = {"solve", obj, "-q", "--emit", "wall=1,1,1", "--samples", "4", "--max-edge", "0.5",
+                                     "-o", dir.file(flag[0] ? "colours.csv" : "kd.csv")};
+    if (flag[0]) args.push_back(flag);
+    EXPECT_EQ(testing::run(args), kExitOk) << flag;
+  }
+  EXPECT_NE(testing::slurp(dir.file("colours.csv")), testing::slurp(dir.file("kd.csv")));
+}
+
+}  // namespace lambert

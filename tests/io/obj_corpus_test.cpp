@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <sstream>
 
 #include "core/error.hpp"
+#include "geometry/mesh.hpp"
 #include "geometry/polygon.hpp"
 #include "io/obj_loader.hpp"
 
@@ -138,7 +140,7 @@ TEST(ObjCorpus, ReflectanceOneIsAcceptedWithAWarningAndClampedOnRequest) {
   const Scene s = load("kd_one.obj", r);
   EXPECT_EQ(surfaces(s).at("floor").first, "mirrorish");
   EXPECT_EQ(s.material_of(0).rho, Eigen::Vector3d::Ones());
-  EXPECT_TRUE(has_warning(r, corpus("kd_one.obj") + ": material(s) 'mirrorish' have Kd = 1 in some channel (lossless): the radiosity system is singular if such surfaces enclose a space where nothing absorbs; --max-reflectance 0.99 clamps"));
+  EXPECT_TRUE(has_warning(r, corpus("kd_one.obj") + ": material(s) 'mirrorish' have reflectance 1 in some channel (lossless): the radiosity system is singular if such surfaces enclose a space where nothing absorbs, which is refused once form factors are known; --max-reflectance 0.99 clamps"));
   EXPECT_NE(error_of("kd_one.obj", true).find("kd_one.mtl:2: material 'mirrorish': reflectance Kd 1 1 1 must lie in [0, 1)"), std::string::npos);
   LoadOptions o;
   o.max_reflectance = 0.99;
@@ -168,6 +170,110 @@ TEST(ObjCorpus, VertexColoursAreAcceptedAndSkipped) {
   EXPECT_DOUBLE_EQ(surfaces(s).at("floor").second, 1.0);
   EXPECT_EQ(s.vertices[1], Eigen::Vector3d(1, 0, 0));
   EXPECT_TRUE(has_warning(r, corpus("vertex_colors.obj") + ": skipped what radiosity does not use: 4 vertex colours (first at line 2)"));
+}
+
+// Per-face means of corner colours are sums of four doubles divided by 4: each operation
+// rounds by at most 2^-53 relative of values <= 1, so 5 roundings stay below 1e-15.
+constexpr double kMeanRounding = 1e-15;
+
+// Patch reflectances of a scene meshed into 0.5-sized patches, per (surface, x > 1 side).
+std::map<std::pair<std::string, bool>, std::vector<Eigen::Vector3d>> patch_rho(const Scene& s) {
+  MeshOptions mo;
+  mo.max_edge = 0.5;
+  const PatchMesh m = mesh_scene(s, mo);
+  std::map<std::pair<std::string, bool>, std::vector<Eigen::Vector3d>> out;
+  for (const auto& p : m.patches)
+    out[{m.surface_names[p.surface], p.centroid.x() > 1}].push_back(p.rho);
+  return out;
+}
+
+void expect_all_near(const std::vector<Eigen::Vector3d>& rhos, const Eigen::Vector3d& want) {
+  ASSERT_FALSE(rhos.empty());
+  for (const auto& r : rhos)
+    EXPECT_LT((r - want).cwiseAbs().maxCoeff(), kMeanRounding) << r.transpose();
+}
+
+TEST(ObjCorpus, VertexColoursBecomePerFaceReflectanceOfThePatches) {
+  LoadReport r;
+  LoadOptions o;
+  o.vertex_colors_as_reflectance = true;
+  const Scene s = load("vertex_colors_reflectance.obj", r, o);
+  ASSERT_EQ(s.surfaces.size(), 3u);  // colours split no surface
+  const auto rho = patch_rho(s);
+  expect_all_near(rho.at({"floor", false}), Eigen::Vector3d(0.3, 0.4, 0.4));
+  expect_all_near(rho.at({"floor", true}), Eigen::Vector3d(0.55, 0.2, 0.2));
+  expect_all_near(rho.at({"wall", false}), Eigen::Vector3d::Constant(0.7));  // white's Kd
+  expect_all_near(rho.at({"edge", false}), Eigen::Vector3d::Constant(0.7));
+  EXPECT_TRUE(has_warning(r, corpus("vertex_colors_reflectance.obj") +
+      ":23: faces with colours on only some corners keep their material's Kd: surface(s) 'edge'"));
+  for (const auto& w : r.warnings) EXPECT_EQ(w.find("skipped"), std::string::npos) << w;
+  // Without the option the colours are skipped and every patch reflects Kd.
+  LoadReport plain;
+  for (const auto& [key, rhos] : patch_rho(load("vertex_colors_reflectance.obj", plain)))
+    expect_all_near(rhos, Eigen::Vector3d::Constant(0.7));
+}
+
+TEST(ObjCorpus, VertexColoursIn0To255AreScaledWithAWarningOrRefusedWhenStrict) {
+  LoadReport r;
+  LoadOptions o;
+  o.vertex_colors_as_reflectance = true;
+  const Scene s = load("vertex_colors_255.obj", r, o);
+  expect_all_near(patch_rho(s).at({"floor", false}), Eigen::Vector3d(0.5, 0.3, 0.5));
+  const std::string at = corpus("vertex_colors_255.obj") + ":3: vertex colour component 255 is above 1";
+  EXPECT_TRUE(has_warning(r, at + ": the file's colours are read as 0..255 and divided by 255"));
+  o.strict = true;
+  try {
+    load("vertex_colors_255.obj", r, o);
+    ADD_FAILURE() << "--strict loaded 0..255 colours";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()), at + ": a reflectance lies in [0, 1]; rescale the colours");
+  }
+}
+
+TEST(ObjCorpus, VertexColourOfOneIsLosslessAndClampedByMaxReflectance) {
+  LoadOptions o;
+  o.vertex_colors_as_reflectance = true;
+  LoadReport r;
+  const Scene s = load("vertex_colors.obj", r, o);  // corner colours mean (0.5, 0.5, 0.5)...
+  expect_all_near(patch_rho(s).at({"floor", false}), Eigen::Vector3d::Constant(0.5));
+  // ...and a face whose corners are all white reflects 1: warned about, clamped on request.
+  LoadReport w;
+  const std::string white = "v 0 0 0 1 1 1\nv 1 0 0 1 1 1\nv 1 0 1 1 1 1\nf 1 3 2\n";
+  std::istringstream in(white);
+  const MtlOpener none = [](const std::string&) { return MtlFile{}; };
+  load_obj_stream(in, "w.obj", none, &w, o);
+  EXPECT_TRUE(has_warning(w, "w.obj: vertex colours of surface(s) 'default' have reflectance 1 in "
+      "some channel (lossless): the radiosity system is singular if such surfaces enclose a "
+      "space where nothing absorbs (here every surface is lossless in one channel), which is "
+      "refused once form factors are known; --max-reflectance 0.99 clamps"));
+  o.max_reflectance = 0.99;
+  std::istringstream in2(white);
+  const Scene c = load_obj_stream(in2, "w.obj", none, &w, o);
+  ASSERT_TRUE(c.faces[0].rho.has_value());
+  EXPECT_EQ(*c.faces[0].rho, Eigen::Vector3d::Constant(0.99));
+  EXPECT_TRUE(has_warning(w, "w.obj: vertex-colour reflectance clamped to --max-reflectance 0.99 on surface(s) 'default'"));
+}
+
+TEST(ObjCorpus, VertexColoursOutsideZeroOneThatAreNot0To255AreRefused) {
+  LoadOptions o;
+  o.vertex_colors_as_reflectance = true;
+  const MtlOpener none = [](const std::string&) { return MtlFile{}; };
+  auto error = [&](const std::string& text) {
+    std::istringstream in(text);
+    try {
+      load_obj_stream(in, "c.obj", none, nullptr, o);
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error("v 0 0 0 0 0 0\nv 1 0 0 1.5 0 0\nv 1 0 1 0 0 0\nf 1 3 2\n"),
+            "c.obj:2: vertex colour component 1.5 is above 1: a reflectance lies in [0, 1] "
+            "(colours in 0..255 are read when all are whole numbers); rescale the colours");
+  EXPECT_EQ(error("v 0 0 0 0 0 0\nv 1 0 0 0 -0.5 0\nv 1 0 1 0 0 0\nf 1 3 2\n"),
+            "c.obj:2: vertex colour component -0.5 is negative: a reflectance lies in [0, 1]");
+  EXPECT_EQ(error("v 0 0 0 0 0 0\nv 1 0 0 256 0 0\nv 1 0 1 0 0 0\nf 1 3 2\n").substr(0, 40),
+            "c.obj:2: vertex colour component 256 is ");
 }
 
 TEST(ObjCorpus, Utf8ByteOrderMarkIsSkippedAndUtf16Refused) {
