@@ -94,10 +94,18 @@ MeshOptions mesh_options(const SceneArgs& args) {
   return mo;
 }
 
-Study make_study(const AccuracyOptions& opts) {
+// Meshes a built-in case after the plan's checks (load_scene does the same for files).
+PatchMesh mesh_case(const Scene& scene, const SceneArgs& args, const JobPlan& plan) {
+  check_job_files({}, plan.outputs);
+  const MeshPlan mp = plan_mesh(scene, mesh_options(args));
+  if (mp.patches <= kMaxPatches) check_job_memory(mp.patches, plan);
+  return mesh_scene(scene, mesh_options(args));
+}
+
+Study make_study(const AccuracyOptions& opts, const JobPlan& plan) {
   Study s;
   if (opts.analytic_case.empty()) {
-    LoadedScene loaded = load_scene(opts.scene);
+    LoadedScene loaded = load_scene(opts.scene, plan);
     s.name = loaded.scene.source;
     s.scene = std::move(loaded.scene);
     s.mesh = std::move(loaded.mesh);
@@ -107,7 +115,7 @@ Study make_study(const AccuracyOptions& opts) {
   s.name = opts.analytic_case;
   if (opts.analytic_case == "unit_cube") {
     s.scene = unit_cube();
-    s.mesh = mesh_scene(s.scene, mesh_options(opts.scene));
+    s.mesh = mesh_case(s.scene, opts.scene, plan);
     // Every face sees the opposite face with kCubeOpposite and each of four neighbours with
     // kCubeAdjacent (equal areas, so both directions have the same value).
     for (std::int32_t g = 0; g < 6; ++g)
@@ -121,7 +129,7 @@ Study make_study(const AccuracyOptions& opts) {
   for (auto& c : analytic_cases()) {
     if (c.name != opts.analytic_case) continue;
     s.scene = std::move(c.scene);
-    s.mesh = mesh_scene(s.scene, mesh_options(opts.scene));
+    s.mesh = mesh_case(s.scene, opts.scene, plan);
     const std::int32_t a = surface_index(s.mesh, "a"), b = surface_index(s.mesh, "b");
     const std::vector<double> area = surface_areas(s.mesh);
     s.exact.push_back({a, b, c.exact_ab});
@@ -374,7 +382,16 @@ CLI::App* add_accuracy_command(CLI::App& app, AccuracyOptions& opts) {
 
 int run_accuracy(const AccuracyOptions& opts) {
   apply_run_options(opts.run);
-  const Study study = make_study(opts);
+  const std::string base_path = output_prefix(opts.output, "accuracy");
+  const std::string csv = base_path + "_table.csv", surf = base_path + "_surfaces.csv";
+  const std::string svg = base_path + "_error_vs_time.svg", png = base_path + "_error_vs_time.png";
+  JobPlan plan = job_plan(opts.run);
+  plan.outputs = {{"-o", csv}, {"-o", surf}, {"-o", svg}, {"-o", png}};
+  // The largest F held at a time: an all-pairs estimate with standard errors (the hybrid
+  // reference) beside the run's own.
+  plan.ff = FormFactorOptions{};
+  plan.ff->with_stderr = true;
+  const Study study = make_study(opts, plan);
   const PatchMesh& mesh = study.mesh;
   const bool analytic = !study.exact.empty();
   std::printf("%s: %zu surfaces, %d patches\n", study.name.c_str(), mesh.surface_names.size(),
@@ -447,9 +464,6 @@ int run_accuracy(const AccuracyOptions& opts) {
 
   print_table(study, rows);
   print_failure_modes(rows);
-  const std::string base_path = output_prefix(opts.output, "accuracy");
-  const std::string csv = base_path + "_table.csv", surf = base_path + "_surfaces.csv";
-  const std::string svg = base_path + "_error_vs_time.svg", png = base_path + "_error_vs_time.png";
   write_table_csv(csv, study, rows);
   write_surfaces_csv(surf, rows, ref_row.surfaces);
   const std::vector<Plot> plots = error_plots(rows, analytic);

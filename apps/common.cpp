@@ -1,11 +1,21 @@
 #include "apps/common.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/memory.hpp"
 #include "io/obj_loader.hpp"
 
 namespace lambert {
@@ -47,7 +57,128 @@ std::string parse_emit(const std::string& text, EmitRule& rule) {
   return why;
 }
 
+std::string shortest(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
+// The path as compared for collisions: absolute, with "." and ".." and symbolic links of the
+// existing part resolved.
+std::string canonical_text(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path p = std::filesystem::weakly_canonical(path, ec);
+  return ec ? std::filesystem::absolute(path).lexically_normal().string() : p.string();
+}
+
+// Creates and removes a probe file in `dir`; returns the reason it cannot, empty when it can.
+std::string probe_directory(const std::filesystem::path& dir) {
+  const std::string probe =
+      (dir / (".lambert-probe." + std::to_string(::getpid()))).string();
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+  if (fd < 0) return std::strerror(errno);
+  ::close(fd);
+  std::remove(probe.c_str());
+  return "";
+}
+
+// The memory limit of a job in bytes: --max-memory, $LAMBERT_MAX_MEMORY or MemAvailable,
+// with where it came from; nullopt = no check.
+std::optional<std::pair<double, std::string>> memory_limit(const std::string& option) {
+  std::string text = option, from = "--max-memory";
+  if (text.empty()) {
+    const char* env = std::getenv("LAMBERT_MAX_MEMORY");
+    if (env != nullptr && *env != '\0') {
+      text = env;
+      from = "LAMBERT_MAX_MEMORY";
+    }
+  }
+  if (text.empty()) {
+    const auto available = available_memory_bytes();
+    if (!available) return std::nullopt;
+    return std::make_pair(*available, std::string("MemAvailable"));
+  }
+  const auto bytes = parse_size(text);
+  if (!bytes) throw UsageError(from + ": '" + text + "' is not a size such as 512M or 8G");
+  if (*bytes == 0) return std::nullopt;
+  return std::make_pair(*bytes, from + " " + text);
+}
+
 }  // namespace
+
+CLI::Validator finite_number(double lo, double hi, bool open_low) {
+  const std::string range =
+      std::isinf(hi) ? (open_low ? "> " : ">= ") + shortest(lo)
+                     : "in " + std::string(open_low ? "(" : "[") + shortest(lo) + ", " +
+                           shortest(hi) + "]";
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        double x = 0;
+        const bool ok = parse_finite_number(text, x) && (open_low ? x > lo : x >= lo) && x <= hi;
+        return ok ? "" : "'" + text + "' is not a finite number " + range;
+      },
+      "NUMBER " + range);
+}
+
+CLI::Validator any_finite_number() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double x = 0;
+        return parse_finite_number(text, x) ? "" : "'" + text + "' is not a finite number";
+      },
+      "NUMBER");
+}
+
+JobPlan job_plan(const RunArgs& run) {
+  JobPlan plan;
+  plan.max_memory = run.max_memory;
+  return plan;
+}
+
+void check_job_files(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs) {
+  namespace fs = std::filesystem;
+  std::vector<std::pair<std::string, const NamedFile*>> seen;  // canonical path, its file
+  for (const NamedFile& in : inputs)
+    if (!in.path.empty()) seen.emplace_back(canonical_text(in.path), &in);
+  const size_t n_inputs = seen.size();
+  for (const NamedFile& out : outputs) {
+    if (out.path.empty()) continue;
+    const std::string key = canonical_text(out.path);
+    for (size_t k = 0; k < seen.size(); ++k) {
+      if (seen[k].first != key) continue;
+      const NamedFile& other = *seen[k].second;
+      throw UsageError(out.path + ": the output " + out.option + " would overwrite " +
+                       (k < n_inputs ? "the input " : "the output ") + other.option + " '" +
+                       other.path + "': choose another name");
+    }
+    seen.emplace_back(key, &out);
+  }
+  std::vector<fs::path> probed;
+  for (const NamedFile& out : outputs) {
+    if (out.path.empty()) continue;
+    const fs::path parent = fs::path(canonical_text(out.path)).parent_path();
+    if (std::find(probed.begin(), probed.end(), parent) != probed.end()) continue;
+    probed.push_back(parent);
+    const std::string why = probe_directory(parent);
+    if (!why.empty())
+      throw IoError(out.path + ": cannot write " + out.option + " into '" + parent.string() +
+                    "': " + why);
+  }
+}
+
+void check_job_memory(std::int64_t patches, const JobPlan& plan) {
+  const auto limit = memory_limit(plan.max_memory);
+  if (!limit) return;
+  const double mesh = mesh_peak_bytes(patches);
+  const double ff = plan.ff ? form_factor_peak_bytes(patches, *plan.ff) : 0.0;
+  if (mesh + ff <= limit->first) return;
+  throw UsageError("this job needs about " + format_bytes(mesh + ff) + " (" +
+                   std::to_string(patches) + " patches: mesh " + format_bytes(mesh) +
+                   (plan.ff ? ", form factors " + format_bytes(ff) + " at the all-pairs bound" : "") +
+                   ") but the limit is " + format_bytes(limit->first) + " (" + limit->second +
+                   "): use fewer --patches or a larger --max-edge (--threshold does not lower the "
+                   "peak), or set --max-memory / LAMBERT_MAX_MEMORY (0 = no check)");
+}
 
 void add_scene_options(CLI::App* cmd, SceneArgs& args) {
   cmd->add_option("scene", args.scene, "OBJ scene file (default: the built-in Cornell box)");
@@ -79,7 +210,7 @@ void add_scene_options(CLI::App* cmd, SceneArgs& args) {
         return parse_emit(s, r);
       });
   auto* edge = cmd->add_option("--max-edge", args.max_edge, "Longest patch edge, in scene units")
-                   ->check(CLI::PositiveNumber);
+                   ->check(finite_number(0.0, std::numeric_limits<double>::infinity(), true));
   cmd->add_option("--patches", args.patches, "Approximate total number of patches")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{100000000}))
       ->excludes(edge);
@@ -91,6 +222,12 @@ void add_run_options(CLI::App* cmd, RunArgs& args) {
   cmd->add_option("--seed", args.seed, "Random seed (results are bitwise reproducible)");
   cmd->add_flag("-q,--quiet", args.quiet, "No progress or log output on stderr");
   cmd->add_flag("-v,--verbose", args.verbose, "More log output on stderr");
+  cmd->add_option("--max-memory", args.max_memory,
+                  "Refuse a job whose estimated memory exceeds SIZE (e.g. 512M, 8G; 0 = no "
+                  "check; default: $LAMBERT_MAX_MEMORY, else the available memory)")
+      ->check([](const std::string& s) {
+        return parse_size(s) ? std::string() : "'" + s + "' is not a size such as 512M or 8G";
+      });
 }
 
 void apply_run_options(const RunArgs& args) {
@@ -143,12 +280,22 @@ Scene load_scene_file(const SceneArgs& args) {
   return load_obj(args.scene.empty() ? builtin_cornell_box_path() : args.scene, nullptr, options);
 }
 
-LoadedScene load_scene(const SceneArgs& args) {
+LoadedScene load_scene(const SceneArgs& args, const JobPlan& plan) {
   LoadedScene out;
   out.scene = load_scene_file(args);
+  std::vector<NamedFile> inputs = plan.inputs;
+  for (size_t k = 0; k < out.scene.files.size(); ++k) {
+    const std::string& f = out.scene.files[k];
+    const bool camera = std::filesystem::path(f).extension() == ".camera";
+    inputs.push_back({k == 0 ? "scene" : camera ? "camera sidecar" : "material library", f});
+  }
+  check_job_files(inputs, plan.outputs);
   MeshOptions mo;
   mo.max_edge = args.max_edge;
   mo.target_patches = args.patches > 0 || args.max_edge > 0 ? args.patches : args.default_patches;
+  const MeshPlan mesh_plan = plan_mesh(out.scene, mo);
+  if (mesh_plan.patches <= kMaxPatches) check_job_memory(mesh_plan.patches, plan);
+  mo.max_edge = mesh_plan.max_edge;  // planned: mesh_scene need not search again
   out.mesh = mesh_scene(out.scene, mo);
   out.max_edge = out.mesh.max_edge;
   return out;

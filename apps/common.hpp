@@ -4,9 +4,12 @@
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "geometry/bvh.hpp"
+#include "geometry/formfactors/formfactors.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/scene.hpp"
 #include "io/obj_loader.hpp"
@@ -29,13 +32,14 @@ struct RunArgs {
   std::uint64_t seed = 1;   ///< --seed
   bool quiet = false;       ///< -q
   bool verbose = false;     ///< -v
+  std::string max_memory;   ///< --max-memory SIZE; empty = $LAMBERT_MAX_MEMORY or MemAvailable
 };
 
 /// Adds the positional SCENE, the loading options (--strict, --default-reflectance,
 /// --max-reflectance, --vertex-colors-as-reflectance, --emit) and --max-edge / --patches to
 /// a subcommand.
 void add_scene_options(CLI::App* cmd, SceneArgs& args);
-/// Adds -j/--threads, --seed, -q/--quiet and -v/--verbose to a subcommand.
+/// Adds -j/--threads, --seed, -q/--quiet, -v/--verbose and --max-memory to a subcommand.
 void add_run_options(CLI::App* cmd, RunArgs& args);
 /// Applies --quiet / --verbose to the logger.
 void apply_run_options(const RunArgs& args);
@@ -64,9 +68,46 @@ CLI::Validator output_prefix_check();
 /// a name ending in '/', created if needed) the prefix DIR/<name>; otherwise -o is the prefix.
 std::string output_prefix(const std::string& output, const std::string& name);
 
+/// CLI11 check for a floating-point option: a finite number (NaN and inf refused) in
+/// [lo, hi], or (lo, hi] when `open_low`; hi = infinity means no upper bound. The message
+/// states the range.
+CLI::Validator finite_number(double lo, double hi, bool open_low = false);
+
+/// CLI11 check for a floating-point value that may be any finite number (NaN, inf refused).
+CLI::Validator any_finite_number();
+
+/// A file a command reads or writes, with the option that names it (for messages).
+struct NamedFile {
+  std::string option;  ///< e.g. "--ff", "-o", "the scene"
+  std::string path;
+};
+
+/// What a command will read, write and hold in memory, checked by load_scene after loading
+/// the scene and before meshing it (so before any work that takes time).
+struct JobPlan {
+  std::vector<NamedFile> inputs;   ///< besides the scene's own files (Scene::files)
+  std::vector<NamedFile> outputs;  ///< every file the command may write
+  std::optional<FormFactorOptions> ff;  ///< F that will be computed here (none: loaded or unused)
+  std::string max_memory;          ///< RunArgs::max_memory
+};
+
+/// A plan with the run's --max-memory and nothing else.
+JobPlan job_plan(const RunArgs& run);
+
+/// Refuses (UsageError) an output that is an input or another output (paths compared after
+/// std::filesystem::weakly_canonical, so ./a/../s.obj is s.obj), then checks that every
+/// output directory accepts a new file by creating and removing a probe file (IoError).
+void check_job_files(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs);
+
+/// Refuses (UsageError) a job whose estimated peak memory (mesh_peak_bytes, and
+/// form_factor_peak_bytes for plan.ff) exceeds the limit: --max-memory, else
+/// $LAMBERT_MAX_MEMORY, else MemAvailable (no check where none is known; "0" = no check).
+void check_job_memory(std::int64_t patches, const JobPlan& plan);
+
 /// Loads the scene (or the built-in Cornell box) with the loading options.
 Scene load_scene_file(const SceneArgs& args);
-/// Loads the scene (or the built-in Cornell box) and meshes it.
-LoadedScene load_scene(const SceneArgs& args);
+/// Loads the scene (or the built-in Cornell box), checks the plan's files against the
+/// scene's and its memory estimate (check_job_files, check_job_memory), and meshes it.
+LoadedScene load_scene(const SceneArgs& args, const JobPlan& plan = {});
 
 }  // namespace lambert

@@ -101,7 +101,13 @@ CLI::App* add_compare_command(CLI::App& app, CompareOptions& opts) {
 
 int run_compare(const CompareOptions& opts) {
   apply_run_options(opts.run);
-  const LoadedScene loaded = load_scene(opts.scene);
+  const std::string base = output_prefix(opts.output, "compare");
+  const std::string table = base + "_table.csv", history = base + "_history.csv";
+  const std::string svg = base + "_convergence.svg", png = base + "_convergence.png";
+  JobPlan plan = job_plan(opts.run);
+  plan.outputs = {{"-o", table}, {"-o", history}, {"-o", svg}, {"-o", png}};
+  plan_form_factors(plan, opts.ff, opts.run);
+  const LoadedScene loaded = load_scene(opts.scene, plan);
   const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);
   const RadiosityProblem problem = make_problem(loaded.mesh, ff.F);
   warn_about_lighting(loaded.mesh, ff.F);
@@ -113,7 +119,6 @@ int run_compare(const CompareOptions& opts) {
     if (std::find(unique_names.begin(), unique_names.end(), n) == unique_names.end())
       unique_names.push_back(n);
   names = unique_names;
-  const std::string base = output_prefix(opts.output, "compare");
 
   std::vector<CompareRow> rows;
   for (const auto& name : names) {
@@ -157,8 +162,6 @@ int run_compare(const CompareOptions& opts) {
                 r.solution.seconds, r.residual, r.max_diff);
     all_converged = all_converged && r.solution.status == SolveStatus::Converged;
   }
-  const std::string table = base + "_table.csv", history = base + "_history.csv";
-  const std::string svg = base + "_convergence.svg", png = base + "_convergence.png";
   write_table_csv(table, rows);
   write_history_csv(history, rows);
   const auto plots = convergence_plots(rows, plot_channel(problem), opts.solve.tol);

@@ -19,7 +19,7 @@ void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load) {
           ->capture_default_str());
   compute_only.push_back(
       cmd->add_option("--threshold", args.threshold, "Drop form factors below this value")
-          ->check(CLI::Range(0.0, 1.0)));
+          ->check(finite_number(0.0, 1.0)));
   compute_only.push_back(cmd->add_option("--hemicube-res", args.hemicube_resolution,
                                          "Hemicube top-face resolution (estimator hemicube)")
                              ->check(CLI::Range(4, 8192))
@@ -35,6 +35,16 @@ void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load) {
   // A loaded F keeps the settings that made it: an option that would change them is refused
   // rather than silently ignored (and then misreported).
   for (CLI::Option* o : compute_only) ff->excludes(o);
+}
+
+void plan_form_factors(JobPlan& plan, const FormFactorArgs& args, const RunArgs& run,
+                       bool with_stderr) {
+  if (!args.ff_file.empty()) {
+    plan.inputs.push_back({"--ff", args.ff_file});
+    return;
+  }
+  plan.ff = make_ff_options(args, run);
+  plan.ff->with_stderr = with_stderr;
 }
 
 FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run) {

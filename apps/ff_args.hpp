@@ -26,6 +26,11 @@ struct FormFactorArgs {
 /// --hemicube-res, --symmetrize): given together, they are a usage error.
 void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load = true);
 
+/// Adds F to a job plan: --ff as an input, or the computation's options for the memory
+/// estimate.
+void plan_form_factors(JobPlan& plan, const FormFactorArgs& args, const RunArgs& run,
+                       bool with_stderr = false);
+
 /// Builds FormFactorOptions from the arguments.
 FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run);
 

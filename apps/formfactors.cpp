@@ -119,8 +119,12 @@ CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts) {
   auto* by = cmd->add_flag("--by-surface", opts.by_surface, "Write the surface-to-surface view-factor table as JSON");
   auto* pt = cmd->add_option("--point", opts.point, "Sensor point X,Y,Z (differential area)")
                  ->delimiter(',')
-                 ->expected(3);
-  auto* nm = cmd->add_option("--normal", opts.normal, "Sensor normal NX,NY,NZ")->delimiter(',')->expected(3);
+                 ->expected(3)
+                 ->check(any_finite_number());
+  auto* nm = cmd->add_option("--normal", opts.normal, "Sensor normal NX,NY,NZ")
+                 ->delimiter(',')
+                 ->expected(3)
+                 ->check(any_finite_number());
   pt->needs(nm);
   nm->needs(pt);
   pt->excludes(by);
@@ -129,7 +133,20 @@ CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts) {
 
 int run_formfactors(const FormFactorsOptions& opts) {
   apply_run_options(opts.run);
-  const LoadedScene scene = load_scene(opts.scene);
+  namespace fs = std::filesystem;
+  if (opts.output.empty() && opts.point.empty())
+    throw UsageError("formfactors: -o/--output is required");
+  const std::string report =
+      !opts.report.empty() || opts.output.empty()
+          ? opts.report
+          : fs::path(opts.output).replace_extension(".report.json").string();
+  JobPlan plan = job_plan(opts.run);
+  plan.outputs = {{"-o", opts.output}};
+  if (opts.point.empty()) {
+    plan.outputs.push_back({"--report", report});
+    plan_form_factors(plan, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
+  }
+  const LoadedScene scene = load_scene(opts.scene, plan);
   if (!opts.point.empty()) {
     const FormFactorOptions o = make_ff_options(opts.ff, opts.run);
     const PointFactors pf = point_form_factors(scene.mesh, parse_vec(opts.point), parse_vec(opts.normal), o);
@@ -141,14 +158,12 @@ int run_formfactors(const FormFactorsOptions& opts) {
     }
     return 0;
   }
-  if (opts.output.empty()) throw UsageError("formfactors: -o/--output is required");
   const FormFactors ff = obtain_form_factors(scene, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
   warn_about_lighting(scene.mesh, ff.F);
   check_closed_lossless(scene.mesh, ff, false);
   const FormFactorDiagnostics d = diagnose(scene.mesh, ff.F);
   print_diagnostics(scene, ff, d);
   const std::string settings = settings_string(ff.options, scene);
-  namespace fs = std::filesystem;
   const std::string ext = fs::path(opts.output).extension().string();
   if (opts.by_surface) {
     write_json_file(opts.output, surface_json(surface_factors(scene.mesh, ff)));
@@ -158,10 +173,6 @@ int run_formfactors(const FormFactorsOptions& opts) {
     write_ff_binary(opts.output, ff, {mesh_hash(scene.mesh), settings});
   }
   log_info("wrote " + opts.output);
-  const std::string report =
-      !opts.report.empty() ? opts.report : fs::path(opts.output).replace_extension(".report.json").string();
-  if (report == opts.output)
-    throw UsageError("formfactors: --report and -o name the same file '" + report + "'");
   write_json_file(report, diagnostics_json(scene, ff, d, settings));
   log_info("wrote " + report);
   return 0;

@@ -28,7 +28,7 @@ int run_info(const InfoOptions& opts) {
     }
     return 0;
   }
-  const LoadedScene loaded = load_scene(opts.scene);
+  const LoadedScene loaded = load_scene(opts.scene, job_plan(opts.run));
   const Scene& scene = loaded.scene;
   const PatchMesh& mesh = loaded.mesh;
 

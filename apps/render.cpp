@@ -60,7 +60,15 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opts) {
 
 int run_render(const RenderOptions& opts) {
   apply_run_options(opts.run);
-  const LoadedScene loaded = load_scene(opts.scene);
+  const std::string png = opts.png.empty()
+                              ? std::filesystem::path(opts.output).replace_extension(".png").string()
+                              : opts.png;
+  JobPlan plan = job_plan(opts.run);
+  plan.outputs = {{"-o", opts.output}, {"--png", png}, {"--vertex-exr", opts.vertex_exr},
+                  {"--ply", opts.ply}};
+  if (opts.radiosity.empty()) plan_form_factors(plan, opts.ff, opts.run);
+  else plan.inputs.push_back({"--radiosity", opts.radiosity});
+  const LoadedScene loaded = load_scene(opts.scene, plan);
   const Camera camera = make_camera(loaded.scene, opts.camera);
   RadiosityResult r;
   if (!opts.radiosity.empty()) {
@@ -77,12 +85,7 @@ int run_render(const RenderOptions& opts) {
   const double ev = choose_exposure(opts.shade, image);
   OutputPaths paths;
   paths.image_exr = opts.output;
-  paths.png = opts.png.empty()
-                  ? std::filesystem::path(opts.output).replace_extension(".png").string()
-                  : opts.png;
-  if (paths.png == opts.output)
-    throw UsageError("render: the EXR (-o) and the PNG (--png) would both be written to '" +
-                     opts.output + "'");
+  paths.png = png;
   paths.vertex_exr = opts.vertex_exr;
   paths.ply = opts.ply;
   const auto written = write_outputs(paths, loaded.mesh, shaded, image, ev,

@@ -23,11 +23,16 @@ Eigen::Vector3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; 
 
 void add_camera_options(CLI::App* cmd, CameraArgs& args) {
   cmd->add_option("--eye", args.eye, "Camera position X Y Z (default: the scene's camera)")
-      ->expected(3);
-  cmd->add_option("--look-at", args.look_at, "Point the camera looks at, X Y Z")->expected(3);
-  cmd->add_option("--up", args.up, "Camera up vector X Y Z")->expected(3);
+      ->expected(3)
+      ->check(any_finite_number());
+  cmd->add_option("--look-at", args.look_at, "Point the camera looks at, X Y Z")
+      ->expected(3)
+      ->check(any_finite_number());
+  cmd->add_option("--up", args.up, "Camera up vector X Y Z")
+      ->expected(3)
+      ->check(any_finite_number());
   cmd->add_option("--fov", args.fov, "Vertical field of view, degrees")
-      ->check(CLI::Range(0.1, 179.0));
+      ->check(finite_number(0.1, 179.0));
   cmd->add_option("--size", args.size, "Image size WxH in pixels (default 512x512)");
 }
 

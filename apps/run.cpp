@@ -188,12 +188,6 @@ int run_run(const RunOptions& opts) {
   stage(1,
         "loading and meshing " + (opts.scene.scene.empty() ? std::string("the built-in Cornell box")
                                                            : opts.scene.scene));
-  const LoadedScene loaded = load_scene(opts.scene);
-  const Camera camera = make_camera(loaded.scene, opts.camera);
-  t.load = timer.seconds();
-  log_info("      " + std::to_string(loaded.mesh.size()) + " patches on " +
-           std::to_string(loaded.mesh.surface_names.size()) + " surfaces");
-
   const std::string name = opts.name.empty() ? default_name(opts.scene) : opts.name;
   if (name.empty() || name.find('/') != std::string::npos)
     throw UsageError("--name must be a non-empty file name prefix without '/'");
@@ -202,6 +196,22 @@ int run_run(const RunOptions& opts) {
   if (!std::filesystem::is_directory(opts.output_dir))
     throw IoError(opts.output_dir + ": cannot create the output directory" +
                   (ec ? ": " + ec.message() : std::string()));
+  const std::filesystem::path dir(opts.output_dir);
+  OutputPaths paths;
+  paths.image_exr = (dir / (name + ".exr")).string();
+  paths.png = (dir / (name + ".png")).string();
+  paths.vertex_exr = (dir / (name + "_vertices.exr")).string();
+  paths.ply = (dir / (name + ".ply")).string();
+  const std::string report_path = (dir / "report.json").string();
+  JobPlan plan = job_plan(opts.run);
+  plan.outputs = {{"-o", paths.image_exr}, {"-o", paths.png}, {"-o", paths.vertex_exr},
+                  {"-o", paths.ply},       {"-o", report_path}};
+  plan_form_factors(plan, opts.ff, opts.run);
+  const LoadedScene loaded = load_scene(opts.scene, plan);
+  const Camera camera = make_camera(loaded.scene, opts.camera);
+  t.load = timer.seconds();
+  log_info("      " + std::to_string(loaded.mesh.size()) + " patches on " +
+           std::to_string(loaded.mesh.surface_names.size()) + " surfaces");
 
   stage(2, "form factors (" +
                (opts.ff.ff_file.empty() ? opts.ff.estimator + ", " +
@@ -231,15 +241,8 @@ int run_run(const RunOptions& opts) {
 
   stage(6, "writing " + opts.output_dir + "/" + name + ".*");
   timer.reset();
-  const std::filesystem::path dir(opts.output_dir);
-  OutputPaths paths;
-  paths.image_exr = (dir / (name + ".exr")).string();
-  paths.png = (dir / (name + ".png")).string();
-  paths.vertex_exr = (dir / (name + "_vertices.exr")).string();
-  paths.ply = (dir / (name + ".ply")).string();
   const std::string settings = run_settings(opts, loaded, r, camera);
   std::vector<std::string> files = write_outputs(paths, loaded.mesh, shaded, image, ev, settings);
-  const std::string report_path = (dir / "report.json").string();
   files.push_back(report_path);
   t.write = timer.seconds();
   const Report report{opts, loaded, r, shaded, rs, camera, ev, t, files, settings};

@@ -67,7 +67,10 @@ CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts) {
 int run_solve(const SolveCommandOptions& opts) {
   apply_run_options(opts.run);
   const Timer total;
-  const LoadedScene loaded = load_scene(opts.scene);
+  JobPlan plan = job_plan(opts.run);
+  plan.outputs = {{"-o", opts.output}, {"the summary", summary_path(opts.output)}};
+  plan_form_factors(plan, opts.ff, opts.run);
+  const LoadedScene loaded = load_scene(opts.scene, plan);
   const double load_seconds = total.seconds();
   const Timer ff_timer;
   const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);

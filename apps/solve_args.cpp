@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "apps/common.hpp"
+
 namespace lambert {
 
 void add_solve_options(CLI::App* cmd, SolveOptions& o, bool with_solver) {
@@ -10,13 +12,13 @@ void add_solve_options(CLI::App* cmd, SolveOptions& o, bool with_solver) {
         ->check(CLI::IsMember(solver_names()))
         ->capture_default_str();
   cmd->add_option("--tol", o.tol, "Stop when ||E - K B||_2 / ||E||_2 <= tol")
-      ->check(CLI::Range(1e-16, 0.5))
+      ->check(finite_number(1e-16, 0.5))
       ->capture_default_str();
   cmd->add_option("--max-iter", o.max_iterations, "Iteration limit per channel")
       ->check(CLI::Range(1, 100000000))
       ->capture_default_str();
   cmd->add_option("--omega", o.omega, "SOR relaxation factor, in (0, 2)")
-      ->check(CLI::Range(1e-3, 1.999))
+      ->check(finite_number(1e-3, 1.999))
       ->capture_default_str();
   cmd->add_option("--preconditioner", o.preconditioner, "bicgstab/gmres/cg preconditioner")
       ->check(CLI::IsMember({"none", "diagonal", "ilut"}))

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <unordered_map>
@@ -246,20 +247,32 @@ std::vector<Eigen::Vector3d> PatchMesh::corners(std::int32_t i) const {
   return c;
 }
 
-PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options) {
-  LAMBERT_CHECK(options.max_edge >= 0 && options.target_patches >= 0, "negative mesh target");
+namespace {
+
+std::string shortest(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
+std::vector<SurfaceElements> collect_all(const Scene& scene) {
   std::vector<SurfaceElements> surfaces;
   for (size_t s = 0; s < scene.surfaces.size(); ++s)
     surfaces.push_back(collect(scene, static_cast<std::int32_t>(s)));
+  return surfaces;
+}
 
+MeshPlan plan_surfaces(const Scene& scene, const std::vector<SurfaceElements>& surfaces,
+                       const MeshOptions& options) {
+  LAMBERT_CHECK(options.max_edge >= 0 && options.target_patches >= 0, "negative mesh target");
+  auto total = [&](double h) {
+    std::int64_t t = 0;
+    for (const auto& s : surfaces) t += count_patches(s, h);
+    return t;
+  };
   double max_edge = options.max_edge;
   if (max_edge <= 0 && options.target_patches > 0) {
     // Bisection on log(max_edge): the patch count is monotone (non-increasing) in max_edge.
-    auto total = [&](double h) {
-      std::int64_t t = 0;
-      for (const auto& s : surfaces) t += count_patches(s, h);
-      return t;
-    };
     const auto [lo_corner, hi_corner] = scene.bounds();
     double hi = (hi_corner - lo_corner).norm();  // one element per edge or fewer
     double lo = hi * 1e-4;
@@ -277,13 +290,31 @@ PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options) {
       max_edge = dlo < dhi ? lo : hi;
     }
   }
+  return {max_edge, total(max_edge)};
+}
 
-  std::int64_t predicted = 0;
-  for (const auto& s : surfaces) predicted += count_patches(s, max_edge);
-  if (predicted > kMaxPatches)
-    throw UsageError("meshing with max edge " + std::to_string(max_edge) + " would make " +
-                     std::to_string(predicted) + " patches (limit " + std::to_string(kMaxPatches) +
-                     "): choose a larger --max-edge");
+}  // namespace
+
+MeshPlan plan_mesh(const Scene& scene, const MeshOptions& options) {
+  return plan_surfaces(scene, collect_all(scene), options);
+}
+
+double mesh_peak_bytes(std::int64_t patches) {
+  // Per patch: the Patch itself, about one vertex (position and surface id), 2x capacity
+  // while the vectors grow; and the Embree BVH over the quads (float corners and index,
+  // about 4 x 16 + 16 bytes per primitive plus nodes, ~128 bytes).
+  const double per_patch = 2.0 * (sizeof(Patch) + sizeof(Eigen::Vector3d) + sizeof(std::int32_t)) + 128.0;
+  return static_cast<double>(patches) * per_patch;
+}
+
+PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options) {
+  const std::vector<SurfaceElements> surfaces = collect_all(scene);
+  const MeshPlan plan = plan_surfaces(scene, surfaces, options);
+  const double max_edge = plan.max_edge;
+  if (plan.patches > kMaxPatches)
+    throw UsageError("meshing with max edge " + shortest(max_edge) + " would make " +
+                     std::to_string(plan.patches) + " patches (limit " +
+                     std::to_string(kMaxPatches) + "): choose a larger --max-edge");
 
   PatchMesh mesh;
   for (const auto& s : scene.surfaces) mesh.surface_names.push_back(s.name);

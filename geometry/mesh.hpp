@@ -49,6 +49,16 @@ struct MeshOptions {
   std::int64_t target_patches = 0;  ///< approximate total patch count
 };
 
+/// What mesh_scene will build, computed without building it (O(faces) per trial edge).
+struct MeshPlan {
+  double max_edge = 0.0;      ///< the edge bound mesh_scene will use
+  std::int64_t patches = 0;   ///< the exact patch count it will produce
+};
+/// The edge bound and patch count mesh_scene(scene, options) will use and produce.
+MeshPlan plan_mesh(const Scene& scene, const MeshOptions& options);
+/// Approximate peak memory (bytes) of a mesh of `patches` patches and its BVH.
+double mesh_peak_bytes(std::int64_t patches);
+
 /// Subdivides every surface of `scene`. Faces with more than 4 vertices and concave quads
 /// are triangulated first. Each element edge of length L shared within a surface gets
 /// n = ceil(L / max_edge) segments, raised until every triangle has equal counts on its

@@ -42,6 +42,9 @@ struct Surface {
 /// A whole scene as loaded from a file (or built by a test).
 struct Scene {
   std::string source;  ///< file name it came from (for messages)
+  /// Every file it was read from (the OBJ, its material libraries, its camera sidecar):
+  /// the inputs that no output of a run may overwrite.
+  std::vector<std::string> files;
   std::vector<Eigen::Vector3d> vertices;
   std::vector<Face> faces;
   std::vector<Surface> surfaces;

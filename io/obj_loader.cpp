@@ -620,6 +620,7 @@ Scene load_obj_stream(std::istream& in, const std::string& name, const MtlOpener
 Scene load_obj(const std::string& path, LoadReport* report, const LoadOptions& options) {
   std::ifstream in = open_or_throw(path);
   const fs::path base = fs::path(path).parent_path();
+  std::vector<std::string> files{path};
   // An mtllib names a file next to the OBJ; exporters also write absolute or Windows paths
   // of the author's machine, so the bare file name next to the OBJ is tried as well.
   const MtlOpener open_mtl = [&](const std::string& lib) -> MtlFile {
@@ -631,6 +632,7 @@ Scene load_obj(const std::string& path, LoadReport* report, const LoadOptions& o
       if (bare.empty() || !fs::exists(p, ec) || fs::is_directory(p, ec)) continue;
       auto f = std::make_unique<std::ifstream>(p, std::ios::binary);
       if (!*f) throw IoError(p.string() + ": cannot open: " + std::strerror(errno));
+      files.push_back(p.string());
       return {std::move(f), p.string()};
     }
     return {};
@@ -638,7 +640,11 @@ Scene load_obj(const std::string& path, LoadReport* report, const LoadOptions& o
   Scene scene = load_obj_stream(in, path, open_mtl, report, options);
   const fs::path camera_path = fs::path(path).replace_extension(".camera");
   std::error_code ec;
-  if (fs::exists(camera_path, ec)) scene.camera = read_camera(camera_path.string());
+  if (fs::exists(camera_path, ec)) {
+    scene.camera = read_camera(camera_path.string());
+    files.push_back(camera_path.string());
+  }
+  scene.files = std::move(files);
   return scene;
 }
 

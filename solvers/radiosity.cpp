@@ -109,7 +109,7 @@ void validate_problem(const RadiosityProblem& p) {
 
 double relative_residual(const RadiosityProblem& problem, const Eigen::MatrixX3d& B, int channel) {
   const ChannelSystem s = make_channel_system(problem, channel, 1);
-  return s.relative_residual_uncounted(B.col(channel));
+  return s.relative_residual_uncounted(B.col(channel) / s.e_scale);
 }
 
 // Energy bookkeeping (power, W in scene units). H = F B is the irradiance: for a reciprocal
@@ -162,7 +162,7 @@ RadiositySolution solve_radiosity(const RadiosityProblem& problem, const SolveOp
       report = entry.solve(system, options, b);
       report.matvecs = system.matvecs;
     }
-    sol.B.col(c) = b;
+    sol.B.col(c) = b * system.e_scale;
     if (severity(report.status) > severity(sol.status)) sol.status = report.status;
   }
   sol.seconds = timer.seconds();

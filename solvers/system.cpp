@@ -55,6 +55,11 @@ ChannelSystem make_channel_system(const RadiosityProblem& problem, int channel, 
   s.F = problem.F;
   s.rho = problem.rho.col(channel);
   s.E = problem.emission.col(channel);
+  const double e_max = s.E.cwiseAbs().maxCoeff();
+  if (e_max > 0.0) {
+    s.e_scale = e_max;
+    s.E /= e_max;
+  }
   s.area = problem.area;
   s.f_diag = problem.F->diagonal();
   s.e_norm = s.E.norm();

@@ -22,10 +22,14 @@ void multiply_f(const SparseRowMatrix& F, const Eigen::VectorXd& x, Eigen::Vecto
 struct ChannelSystem {
   const SparseRowMatrix* F = nullptr;
   Eigen::VectorXd rho;     ///< rho_c per patch
-  Eigen::VectorXd E;       ///< E_c per patch
+  /// E_c per patch divided by e_scale: K B = E is linear, so the solvers work on a system
+  /// whose emission is at most 1 and B is multiplied back by e_scale. Unscaled, ||E||_2
+  /// and ||r||_2 overflow to inf for any E above ~1e154 (their squares pass DBL_MAX).
+  Eigen::VectorXd E;
+  double e_scale = 1.0;    ///< max_i |E_c,i| (1 when nothing is emitted)
   Eigen::VectorXd area;    ///< A per patch
   Eigen::VectorXd f_diag;  ///< F_ii (0 for planar patches; kept for generality)
-  double e_norm = 0.0;     ///< ||E||_2
+  double e_norm = 0.0;     ///< ||E||_2 of the scaled E
   int threads = 1;
   mutable std::int64_t matvecs = 0;  ///< products with F performed so far
 

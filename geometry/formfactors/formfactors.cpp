@@ -125,22 +125,46 @@ struct EstimatorEntry {
   const char* name;
   bool traces_rays;  ///< needs a BVH and reports replicate standard errors (needs samples >= 4)
   FormFactors (*compute)(const PatchMesh&, const FormFactorOptions&, const Bvh*);
+  double (*peak_bytes)(std::int64_t patches, const FormFactorOptions&);
 };
+
+// Peak of compute_pairwise for n patches, all n(n-1)/2 pairs exchanging energy (the bound:
+// a closed scene reaches it): the per-row upper lists (16-byte entries, up to 2x capacity
+// while a std::vector grows) live until the CSR F (12 bytes per entry, both triangles) is
+// filled; standard errors add 8-byte variances (2x capacity) and a CSR of the same size.
+double pairwise_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
+  const double n = static_cast<double>(patches), pairs = n * (n - 1.0) / 2.0;
+  const double per_pair = 2.0 * 16.0 + 2.0 * 12.0 + (o.with_stderr ? 2.0 * 8.0 + 2.0 * 12.0 : 0.0);
+  return pairs * per_pair;
+}
+
+// Peak of compute_hemicube: a row holds at most one entry per hemicube pixel (res^2 on the
+// top face, 4 x res x ceil(res/2) on the sides) and at most n - 1; rows are kept as 16-byte
+// entries until the CSR F (12 bytes per entry) is filled; --symmetrize builds one more F.
+double hemicube_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
+  const double n = static_cast<double>(patches), res = o.hemicube_resolution;
+  const double pixels = res * res + 4.0 * res * std::ceil(res / 2.0);
+  const double entries = n * std::min(n - 1.0, pixels);
+  return entries * (16.0 + 12.0 + (o.symmetrize ? 2.0 * 12.0 : 0.0));
+}
 
 const std::vector<EstimatorEntry>& registry() {
   static const std::vector<EstimatorEntry> table = {
       {"hybrid", true,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
          return ff::compute_pairwise(m, o, *b, ff::estimate_hybrid);
-       }},
+       },
+       pairwise_peak_bytes},
       {"mc", true,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
          return ff::compute_pairwise(m, o, *b, ff::estimate_mc);
-       }},
+       },
+       pairwise_peak_bytes},
       {"hemicube", false,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh*) {
          return ff::compute_hemicube(m, o);  // rasterises: no rays
-       }},
+       },
+       hemicube_peak_bytes},
   };
   return table;
 }
@@ -175,6 +199,12 @@ std::vector<std::string> form_factor_estimators() {
   std::vector<std::string> names;
   for (const auto& e : registry()) names.emplace_back(e.name);
   return names;
+}
+
+double form_factor_peak_bytes(std::int64_t patches, const FormFactorOptions& options) {
+  for (const auto& e : registry())
+    if (options.estimator == e.name) return e.peak_bytes(patches, options);
+  throw UsageError("unknown form-factor estimator '" + options.estimator + "'");
 }
 
 FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions& options,

@@ -53,6 +53,12 @@ struct FormFactors {
 /// Names of the available estimators ("mc", "hybrid", ...).
 std::vector<std::string> form_factor_estimators();
 
+/// Upper bound (bytes) on the memory compute_form_factors needs for `patches` patches with
+/// these options, before any work: the all-pairs estimators from the N(N-1)/2 pair bound, the
+/// hemicube from at most one entry per pixel per row. --threshold prunes only after the
+/// estimate, so it does not lower the peak. Throws UsageError for an unknown estimator.
+double form_factor_peak_bytes(std::int64_t patches, const FormFactorOptions& options);
+
 class Bvh;
 
 /// Computes F for every patch pair of `mesh` with the chosen estimator. Multi-threaded;

@@ -1,6 +1,8 @@
 #include "core/atomic_file.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -46,6 +48,32 @@ TEST(AtomicFile, CompleteWriteReplacesTheFile) {
 TEST(AtomicFile, MissingDirectoryIsAnIoError) {
   testing::TempDir dir;
   EXPECT_THROW(write_stream_atomically(dir.file("nope/out.txt"), [](std::ostream&) {}), IoError);
+}
+
+TEST(AtomicFile, TemporaryNamesAreRecognisedExactly) {
+  EXPECT_EQ(stale_temporary_pid(".B.csv.tmp.123.csv"), 123);
+  EXPECT_EQ(stale_temporary_pid(".F.tmp.77"), 77);  // no extension
+  EXPECT_FALSE(stale_temporary_pid(".B.csv.tmp.123.exr"));  // extension does not match
+  EXPECT_FALSE(stale_temporary_pid("B.csv.tmp.123.csv"));   // not hidden
+  EXPECT_FALSE(stale_temporary_pid(".B.csv.tmp..csv"));     // no pid
+  EXPECT_FALSE(stale_temporary_pid(".notes.txt"));
+}
+
+TEST(AtomicFile, WritingIntoAFolderRemovesTemporariesOfDeadProcessesOnly) {
+  testing::TempDir dir;
+  // A pid that is certainly dead: a child that has exited and been reaped.
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ASSERT_GT(child, 0);
+  ::waitpid(child, nullptr, 0);
+  const std::string dead = dir.write(".B.csv.tmp." + std::to_string(child) + ".csv", "stale");
+  const std::string live = dir.write(".B.csv.tmp." + std::to_string(::getppid()) + ".csv", "x");
+  const std::string other = dir.write(".B.csv.tmp.old.csv", "not ours");
+  write_stream_atomically(dir.file("report.json"), [](std::ostream& out) { out << "{}"; });
+  EXPECT_FALSE(std::filesystem::exists(dead));
+  EXPECT_TRUE(std::filesystem::exists(live));   // its process may still be writing
+  EXPECT_TRUE(std::filesystem::exists(other));  // not our naming
+  EXPECT_EQ(slurp(dir.file("report.json")), "{}");
 }
 
 }  // namespace lambert

@@ -120,17 +120,23 @@ TEST(SolverRegistry, ListsEverySolverOnce) {
   EXPECT_STREQ(to_string(SolveStatus::MaxIterations), "max-iterations");
 }
 
+// The furnace: a closed enclosure of n patches, uniform rho and E; returns the largest
+// row-sum defect |sum_j F_ij - 1|.
+double make_furnace(OwnedProblem& o, int n, const Eigen::Vector3d& rho, const Eigen::Vector3d& e) {
+  make_enclosure(o, n, 11);
+  const Eigen::VectorXd row_sum = o.F * Eigen::VectorXd::Ones(n);
+  o.p.rho = rho.transpose().replicate(n, 1);
+  o.p.emission = e.transpose().replicate(n, 1);
+  return (row_sum.array() - 1.0).abs().maxCoeff();
+}
+
 TEST(SolveRadiosity, FurnaceGivesEOverOneMinusRhoForEverySolver) {
   OwnedProblem o;
   const int n = 40;
-  make_enclosure(o, n, 11);
-  const Eigen::VectorXd row_sum = o.F * Eigen::VectorXd::Ones(n);
-  const double defect = (row_sum.array() - 1.0).abs().maxCoeff();
-  ASSERT_LT(defect, 1e-12) << "the synthetic enclosure is not closed";
   const Eigen::Vector3d rho(0.3, 0.6, 0.9);
   const Eigen::Vector3d e(1.0, 2.0, 0.5);
-  o.p.rho = rho.transpose().replicate(n, 1);
-  o.p.emission = e.transpose().replicate(n, 1);
+  const double defect = make_furnace(o, n, rho, e);
+  ASSERT_LT(defect, 1e-12) << "the synthetic enclosure is not closed";
   const double tol = 1e-10;
   for (const auto& name : solver_names()) {
     const RadiositySolution s = solve_radiosity(o.p, options_for(name, tol));
@@ -142,6 +148,32 @@ TEST(SolveRadiosity, FurnaceGivesEOverOneMinusRhoForEverySolver) {
       const double bound = error_bound(o.p, c, tol) + rho[c] * defect * exact / (1.0 - rho[c]) +
                            1e-13 * exact;  // rounding of O(N) sums
       for (int i = 0; i < n; ++i) ASSERT_NEAR(s.B(i, c), exact, bound) << name << " c" << c;
+    }
+  }
+}
+
+TEST(SolveRadiosity, HugeFiniteEmissionSolvesLikeUnitEmission) {
+  // E = 1e200: ||E||_2 computed naively squares 1e200 to inf (past DBL_MAX ~1.8e308), so an
+  // unscaled residual norm is inf/inf and every solve ends as numerical-issue.
+  const int n = 40;
+  const Eigen::Vector3d rho(0.3, 0.6, 0.9);
+  const Eigen::Vector3d e(1.0, 2.0, 0.5);
+  const double kHuge = 1e200;
+  OwnedProblem o, unit;  // unit: the same system with E / kHuge, for the bound
+  const double defect = make_furnace(o, n, rho, kHuge * e);
+  make_furnace(unit, n, rho, e);
+  const double tol = 1e-10;
+  for (const auto& name : solver_names()) {
+    const RadiositySolution s = solve_radiosity(o.p, options_for(name, tol));
+    EXPECT_EQ(s.status, SolveStatus::Converged) << name;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_LE(s.channels[c].residual, tol) << name;
+      // The furnace bound of FurnaceGivesEOverOneMinusRhoForEverySolver relative to kHuge:
+      // K is linear, so B / kHuge solves the unit system and obeys its bound.
+      const double exact = e[c] / (1.0 - rho[c]);
+      const double bound = error_bound(unit.p, c, tol) +
+                           rho[c] * defect * exact / (1.0 - rho[c]) + 1e-13 * exact;
+      for (int i = 0; i < n; ++i) ASSERT_NEAR(s.B(i, c) / kHuge, exact, bound) << name << " c" << c;
     }
   }
 }
