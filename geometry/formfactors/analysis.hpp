@@ -96,9 +96,10 @@ struct PointFactors {
 };
 
 /// F_{dA -> surface} = Σ_{j∈surface} F_{dA->j}^{unoccluded} · (visible fraction of j), with
-/// the exact point-to-patch factor and `samples` visibility rays per patch (Kronecker
-/// points on j). stderr from the delta-method variance of the kernel-weighted visible fractions. The normal
-/// need not be unit length. Deterministic for a given seed.
+/// the exact point-to-patch factor and `samples` visibility rays per patch to points drawn
+/// with the kernel's density (visibility.hpp, the kernel hybrid uses). stderr from
+/// replicates (replicates.hpp). The normal need not be unit length. Deterministic for a
+/// given seed.
 PointFactors point_form_factors(const PatchMesh& mesh, const Eigen::Vector3d& point,
                                 const Eigen::Vector3d& normal, const FormFactorOptions& options);
 

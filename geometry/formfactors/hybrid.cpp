@@ -14,9 +14,12 @@
 // For distant cells (x, y) is drawn jointly ∝ K over cell x b by rejection instead, with
 // w_r = 1 and no contour evaluation per ray (CellMode below).
 // Unoccluded pairs get G0 exactly (V = 1) and fully blocked ones exactly 0. The ratio of
-// weights is consistent with a bias O(Var(w) / k), far below the statistical error (w
-// varies by ~10 % within a cell). The standard error comes from R independent replicates
-// (replicates.hpp) plus the quadrature's error bound, 1e-6 G0 (kQuadratureTolerance). Cost per pair: the quadrature nodes (9 .. ~500 contour evaluations) + k rays.
+// weights is consistent, with a bias O(Var(w) / k) (w stays within a factor ~2 in the
+// nearest cells, near 1 elsewhere), far below the statistical error: over the calibration
+// cases (tests/geometry/calibration_test.cpp, 200 seeds) the mean error is < 0.1 stderr.
+// The standard error comes from R independent replicates (replicates.hpp) plus the
+// quadrature's error bound, 1e-6 G0 (kQuadratureTolerance). Cost per pair: the quadrature
+// nodes (9 .. ~500 contour evaluations) + k rays.
 
 #include <algorithm>
 
