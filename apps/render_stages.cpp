@@ -55,8 +55,7 @@ Camera make_camera(const Scene& scene, const CameraArgs& args) {
     cam.width = w;
     cam.height = h;
   }
-  const Eigen::Vector3d forward = cam.look_at - cam.eye;
-  if (!(forward.norm() > 0) || !(forward.normalized().cross(cam.up.normalized()).norm() > 1e-6))
+  if (!camera_problem(cam).empty())
     throw UsageError(
         "camera: --look-at must differ from --eye and --up must not be parallel "
         "to the view direction");

@@ -16,6 +16,15 @@ Eigen::Vector3d Camera::ray_direction(double px, double py) const {
   return forward + sx * right + sy * true_up;
 }
 
+std::string camera_problem(const Camera& c) {
+  const Eigen::Vector3d forward = c.look_at - c.eye;
+  if (!(forward.norm() > 0) || !std::isfinite(forward.norm()))
+    return "look_at must differ from eye (by a finite distance)";
+  if (!(forward.normalized().cross(c.up.normalized()).norm() > 1e-6))
+    return "up must not be zero or parallel to the view direction (look_at - eye)";
+  return "";
+}
+
 Camera cornell_camera() {
   Camera c;
   c.eye = Eigen::Vector3d(278, 273, -800);

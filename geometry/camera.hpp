@@ -2,6 +2,7 @@
 // Pinhole camera.
 
 #include <Eigen/Core>
+#include <string>
 
 namespace lambert {
 
@@ -19,6 +20,12 @@ struct Camera {
   /// (0,0) the top-left corner of the image and (width, height) the bottom-right.
   Eigen::Vector3d ray_direction(double px, double py) const;
 };
+
+/// Why `camera` cannot form an image ("" when it can): `look_at` equal to (or, numerically,
+/// indistinguishable from) `eye`, or `up` parallel to the view direction (|forward x up| of
+/// the unit vectors <= 1e-6, where the image's right axis has lost about 6 of its 16
+/// digits). Names the offending setting first ("look_at ...", "up ...").
+std::string camera_problem(const Camera& camera);
 
 /// The published Cornell box camera: eye (278, 273, -800) looking along +z, up +y,
 /// 35 mm focal length on a 25 mm film: vfov = 2 atan(12.5/35) = 39.3077 degrees.

@@ -1,6 +1,9 @@
 #include "io/ff_file.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cinttypes>
 #include <cmath>
 #include <cstdlib>
@@ -12,6 +15,8 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/sampling.hpp"
+#include "io/line_reader.hpp"
+#include "io/strict_number.hpp"
 
 namespace lambert {
 namespace {
@@ -26,6 +31,9 @@ namespace {
 //   u64      checksum: mix64 chain over every byte above (detects truncation/corruption)
 constexpr char kMagic[8] = {'L', 'M', 'B', 'R', 'T', 'F', 'F', '\0'};
 constexpr std::uint32_t kVersion = 1;
+// The binary format is little-endian and read and written as raw memory: a big-endian host
+// refuses it (reading and writing) rather than swapping, and is pointed to Matrix Market.
+constexpr bool kHostIsLittleEndian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
 constexpr const char* kMmHashKey = "% lambert-mesh-hash: ";
 constexpr const char* kMmSettingsKey = "% lambert-settings: ";
 
@@ -100,8 +108,132 @@ void check_identity(const std::string& path, std::uint64_t hash, std::int64_t n,
   }
 }
 
+// Checks shared by both readers. Every message is one line naming the file and the first
+// offending entry. Entries are named by patch index (0-based, as in the radiosity CSV).
+
+// A row sum above 1 + tolerance is refused. The values round-trip exactly (bits, or %.17g),
+// so without stored errors only the summation rounds: Σ over m terms ≤ 1 errs by at most
+// m·2^-53 ≈ 1.1e-16·m, below 1e-9 for any row of up to 9e6 entries.
+constexpr double kRowSumRounding = 1e-9;
+// With stored standard errors the allowance adds kRowSumErrors × Σ_j stderr_ij: the
+// entries' errors may be fully correlated (hybrid's quadrature bound is 1e-6 × G of every
+// pair), so the row sum's error is bounded by Σ_j stderr_ij, not by its root-sum-square; 4
+// of them exceed a (correlated, normal) error with probability 3e-5 per row.
+constexpr double kRowSumErrors = 4.0;
+
+// The allowance above 1 of a row sum, from what the file states about its own error.
+struct RowSumRule {
+  bool check = true;  // false: a lambert F saved without errors, which states no bound
+  bool with_errors = false;
+};
+
+RowSumRule row_sum_rule(const FormFactors& ff, const std::string& settings) {
+  RowSumRule rule;
+  rule.with_errors = ff.stderr_F.nonZeros() == ff.F.nonZeros() && ff.F.nonZeros() > 0;
+  FormFactorOptions o;
+  // lambert's estimators are noisy (mc: infinite variance for neighbours, a 64-sample mc F
+  // of the Cornell box at 150 patches has row sums up to 1.77; hybrid's visible fraction
+  // is sampled, 1.001 at 4 samples; the hemicube has its proximity error): saved without
+  // errors they state no bound, so only their entries are checked. A file without lambert
+  // settings (another tool's) gets the rounding allowance only.
+  rule.check = rule.with_errors || !parse_ff_settings(settings, o);
+  return rule;
+}
+
+std::string patch_pair(std::int64_t i, std::int64_t j) {
+  return "entry (" + std::to_string(i) + ", " + std::to_string(j) + ")";
+}
+
+std::string value_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// What is physically wrong with the value of F_ij (or its standard error), or "".
+std::string bad_value(double v, std::int64_t i, std::int64_t j, bool is_stderr) {
+  const char* what = is_stderr ? "standard error" : "value";
+  if (!std::isfinite(v)) return std::string(what) + " " + value_text(v) + " is not finite";
+  if (v < 0) return std::string(what) + " " + value_text(v) + " is negative";
+  if (!is_stderr && i == j && v != 0)
+    return "nonzero diagonal " + value_text(v) + " (a planar patch sees none of itself)";
+  return "";
+}
+
+// Row sums against 1: Σ_j F_ij ≤ 1 + kRowSumRounding + the file's stated error (row_sum_rule).
+void check_row_sums(const FormFactors& ff, const std::string& settings, const std::string& path) {
+  const RowSumRule rule = row_sum_rule(ff, settings);
+  for (std::int32_t i = 0; rule.check && i < ff.F.outerSize(); ++i) {
+    double sum = 0, err = 0;
+    const std::int32_t begin = ff.F.outerIndexPtr()[i], end = ff.F.outerIndexPtr()[i + 1];
+    for (std::int32_t k = begin; k < end; ++k) {
+      sum += ff.F.valuePtr()[k];
+      if (rule.with_errors) err += ff.stderr_F.valuePtr()[k];
+    }
+    const double allowed = 1.0 + kRowSumRounding + kRowSumErrors * err;
+    if (sum > allowed)
+      throw SceneError(path + ": row of patch " + std::to_string(i) + " sums to " +
+                       value_text(sum) + ", above 1 by more than its stated error (allowed " +
+                       value_text(allowed) + "): not a form-factor matrix");
+  }
+}
+
+// Binary structure and values: row starts from 0 to nnz and monotone, columns in range,
+// strictly increasing within a row, values (and standard errors) finite, non-negative,
+// zero on the diagonal. Linear in nnz.
+void check_binary_entries(const FormFactors& ff, const std::string& path) {
+  const std::int64_t n = ff.F.rows(), nnz = ff.F.nonZeros();
+  const std::int32_t* outer = ff.F.outerIndexPtr();
+  const std::int32_t* col = ff.F.innerIndexPtr();
+  const bool with_err = ff.stderr_F.nonZeros() == nnz && nnz > 0;
+  auto corrupt = [&](const std::string& what) { return IoError(path + ": " + what); };
+  if (outer[0] != 0) throw corrupt("row starts begin at " + std::to_string(outer[0]) + ", not 0");
+  if (outer[n] != nnz)
+    throw corrupt("row starts end at " + std::to_string(outer[n]) + ", not at nnz " +
+                  std::to_string(nnz));
+  for (std::int64_t i = 0; i < n; ++i) {
+    if (outer[i + 1] < outer[i])
+      throw corrupt("row starts decrease at patch " + std::to_string(i + 1));
+    if (outer[i + 1] > nnz)
+      throw corrupt("row start of patch " + std::to_string(i + 1) + " beyond nnz");
+    for (std::int32_t k = outer[i]; k < outer[i + 1]; ++k) {
+      if (col[k] < 0 || col[k] >= n)
+        throw corrupt("patch " + std::to_string(i) + ": column " + std::to_string(col[k]) +
+                      " out of range [0, " + std::to_string(n) + ")");
+      if (k > outer[i] && col[k] <= col[k - 1])
+        throw corrupt(patch_pair(i, col[k]) + (col[k] == col[k - 1] ? " repeated" : " unsorted") +
+                      " (columns must increase within a row)");
+      std::string why = bad_value(ff.F.valuePtr()[k], i, col[k], false);
+      if (why.empty() && with_err) why = bad_value(ff.stderr_F.valuePtr()[k], i, col[k], true);
+      if (!why.empty()) throw SceneError(path + ": " + patch_pair(i, col[k]) + ": " + why);
+    }
+  }
+}
+
+// Size of the file behind `in` (from the current end), restoring the position to 0.
+std::int64_t stream_size(std::istream& in, const std::string& path) {
+  in.clear();
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  in.seekg(0);
+  if (size < 0 || !in) throw IoError(path + ": cannot determine the file size (not a regular file?)");
+  return size;
+}
+
+constexpr std::int64_t kBinaryHeaderBytes = 8 + 4 + 4 + 8 + 8 + 8 + 4;
+
+// The byte count a binary F file with this header has: header, settings, row starts,
+// columns, values (and standard errors), checksum. Fits in 64 bits for n, nnz < 2^31.
+std::int64_t binary_size(std::int64_t n, std::int64_t nnz, std::uint32_t len, bool with_err) {
+  return kBinaryHeaderBytes + len + 4 * (n + 1) + (4 + 8) * nnz + (with_err ? 8 * nnz : 0) + 8;
+}
+
 FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t expected_hash,
                         std::int32_t expected_n, FormFactorFileInfo* info) {
+  if (!kHostIsLittleEndian)
+    throw IoError(path + ": binary form-factor files are little-endian and this host is not: "
+                         "use a Matrix Market (.mtx) file");
+  const std::int64_t file_size = stream_size(in, path);
   Reader r(in, path);
   char magic[8];
   r.get(magic, 8);
@@ -115,11 +247,19 @@ FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t
   const auto len = r.get<std::uint32_t>();
   // Bounds before any allocation: a corrupt header must not trigger a huge allocation or
   // signed overflow (n <= INT32_MAX makes n * n fit in 64 bits).
+  if (flags > 1u) throw IoError(path + ": corrupt header: unknown flags " + std::to_string(flags));
   if (n < 0 || n > INT32_MAX || nnz < 0 || nnz > n * n || nnz > INT32_MAX || len > (1u << 20))
-    throw IoError(path + ": corrupt form-factor file header");
+    throw IoError(path + ": corrupt header (n " + std::to_string(n) + ", nnz " +
+                  std::to_string(nnz) + ", settings length " + std::to_string(len) + ")");
+  const std::int64_t implied = binary_size(n, nnz, len, flags & 1u);
+  if (implied != file_size)
+    throw IoError(path + ": " + (implied > file_size ? "truncated" : "trailing bytes") +
+                  ": the header (n " + std::to_string(n) + ", nnz " + std::to_string(nnz) +
+                  ") implies " + std::to_string(implied) + " bytes, the file has " +
+                  std::to_string(file_size));
   std::string settings(len, '\0');
   r.get(settings.data(), len);
-  check_identity(path, hash, n, expected_hash, expected_n);
+  if (expected_n >= 0) check_identity(path, hash, n, expected_hash, expected_n);
   FormFactors ff;
   ff.F.resize(n, n);
   ff.F.resizeNonZeros(nnz);
@@ -131,66 +271,150 @@ FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t
     r.get(ff.stderr_F.valuePtr(), sizeof(double) * nnz);
   }
   const std::uint64_t computed = r.checksum();
-  std::uint64_t stored;
-  in.read(reinterpret_cast<char*>(&stored), sizeof stored);
-  if (in.gcount() != sizeof stored || stored != computed)
-    throw IoError(path + ": form-factor file is corrupt (checksum mismatch)");
-  // Structural sanity, so that a corrupt file can never index out of bounds later.
-  const auto* outer = ff.F.outerIndexPtr();
-  bool ok = outer[0] == 0 && outer[n] == nnz;
-  for (std::int64_t i = 0; ok && i < n; ++i) ok = outer[i] <= outer[i + 1];
-  for (std::int64_t k = 0; ok && k < nnz; ++k)
-    ok = ff.F.innerIndexPtr()[k] >= 0 && ff.F.innerIndexPtr()[k] < n;
-  if (!ok) throw IoError(path + ": form-factor file is corrupt (bad indices)");
+  const auto stored = r.get<std::uint64_t>();
+  if (stored != computed) throw IoError(path + ": form-factor file is corrupt (checksum mismatch)");
+  check_binary_entries(ff, path);
+  check_row_sums(ff, settings, path);
   if (info) *info = {hash, settings};
   return ff;
+}
+
+// Matrix Market: every entry line is "i j value" (1-based), at least 6 bytes with its
+// newline ("1 2 0\n"), which bounds the entry count by the file size before reserving.
+constexpr std::int64_t kMinEntryBytes = 6;
+
+struct MmEntry {
+  std::int32_t i, j;  // 0-based
+  double v;
+  int line;
+};
+
+bool equal_ignoring_case(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (size_t k = 0; k < a.size(); ++k)
+    if (std::tolower(static_cast<unsigned char>(a[k])) != std::tolower(static_cast<unsigned char>(b[k])))
+      return false;
+  return true;
+}
+
+bool is_blank_line(std::string_view line) {
+  return std::all_of(line.begin(), line.end(), [](char c) { return is_blank(c); });
+}
+
+// The header line and the comments up to the size line (returned in `line`).
+FormFactorFileInfo read_mm_header(LineReader& lines, std::string_view& line, bool& have_hash) {
+  std::vector<std::string_view> tok;
+  if (lines.next(line)) split_fields(line, tok);
+  const char* expected[] = {"%%MatrixMarket", "matrix", "coordinate", "real", "general"};
+  bool ok = tok.size() == 5;
+  for (size_t k = 0; ok && k < 5; ++k) ok = equal_ignoring_case(tok[k], expected[k]);
+  if (!ok) throw IoError(lines.where() + ": not a Matrix Market 'coordinate real general' file");
+  FormFactorFileInfo meta;
+  have_hash = false;
+  const std::string_view hash_key = kMmHashKey, settings_key = kMmSettingsKey;
+  while (lines.next(line)) {
+    if (is_blank_line(line)) continue;
+    if (line[0] != '%') return meta;
+    if (line.substr(0, hash_key.size()) == hash_key) {
+      const std::string_view hex = line.substr(hash_key.size());
+      const auto [end, ec] = std::from_chars(hex.data(), hex.data() + hex.size(), meta.mesh_hash, 16);
+      if (have_hash || ec != std::errc() || end != hex.data() + hex.size() || hex.size() != 16)
+        throw SceneError(lines.where() + ": " + (have_hash ? "second mesh hash" :
+                         "mesh hash must be 16 hexadecimal digits"));
+      have_hash = true;
+    } else if (line.substr(0, settings_key.size()) == settings_key) {
+      meta.settings = std::string(line.substr(settings_key.size()));
+    }
+  }
+  throw IoError(lines.where() + ": truncated: no size line");
+}
+
+// One entry line "i j value": exactly three fields, indices in [1, n], value finite, >= 0
+// and 0 on the diagonal.
+MmEntry parse_mm_entry(const LineReader& lines, std::string_view line, std::int64_t n,
+                       std::vector<std::string_view>& tok) {
+  split_fields(line, tok);
+  if (tok.size() != 3)
+    throw SceneError(lines.where() + ": expected 'row column value', found " +
+                     std::to_string(tok.size()) + " fields");
+  std::int64_t i = 0, j = 0;
+  double v = 0;
+  std::string why = parse_integer(tok[0], i);
+  if (why.empty()) why = parse_integer(tok[1], j);
+  if (!why.empty()) throw SceneError(lines.where() + ": index: " + why);
+  why = parse_finite(tok[2], v);
+  if (!why.empty()) throw SceneError(lines.where() + ": value '" + std::string(tok[2]) + "': " + why);
+  if (i < 1 || i > n || j < 1 || j > n)
+    throw SceneError(lines.where() + ": entry (" + std::to_string(i) + ", " + std::to_string(j) +
+                     ") out of range [1, " + std::to_string(n) + "]");
+  why = bad_value(v, i, j, false);
+  if (!why.empty()) throw SceneError(lines.where() + ": " + why);
+  return {static_cast<std::int32_t>(i - 1), static_cast<std::int32_t>(j - 1), v, lines.line_number()};
+}
+
+// F from entries sorted by (row, column), refusing a repeated entry (Matrix Market would
+// sum them; a form-factor file never has any).
+SparseF assemble_mm(std::vector<MmEntry>& entries, std::int64_t n, const std::string& path) {
+  std::sort(entries.begin(), entries.end(), [](const MmEntry& a, const MmEntry& b) {
+    return a.i != b.i ? a.i < b.i : a.j != b.j ? a.j < b.j : a.line < b.line;
+  });
+  SparseF F(n, n);
+  F.resizeNonZeros(static_cast<Eigen::Index>(entries.size()));
+  std::int32_t* outer = F.outerIndexPtr();
+  std::fill(outer, outer + n + 1, 0);
+  for (size_t k = 0; k < entries.size(); ++k) {
+    const MmEntry& e = entries[k];
+    if (k > 0 && e.i == entries[k - 1].i && e.j == entries[k - 1].j)
+      throw SceneError(path + ":" + std::to_string(e.line) + ": entry (" + std::to_string(e.i + 1) +
+                       ", " + std::to_string(e.j + 1) + ") repeated (first on line " +
+                       std::to_string(entries[k - 1].line) + ")");
+    ++outer[e.i + 1];
+    F.innerIndexPtr()[k] = e.j;
+    F.valuePtr()[k] = e.v;
+  }
+  for (std::int64_t i = 0; i < n; ++i) outer[i + 1] += outer[i];
+  return F;
 }
 
 FormFactors read_matrix_market(std::istream& in, const std::string& path,
                                std::uint64_t expected_hash, std::int32_t expected_n,
                                FormFactorFileInfo* info) {
-  std::string line;
-  int lineno = 1;
-  std::getline(in, line);
-  if (line.rfind("%%MatrixMarket matrix coordinate real general", 0) != 0)
-    throw IoError(path + ":1: not a Matrix Market 'coordinate real general' file");
-  FormFactorFileInfo meta;
+  const std::int64_t file_size = stream_size(in, path);
+  LineReader lines(in, path);
+  std::string_view line;
   bool have_hash = false;
-  while (std::getline(in, line)) {
-    ++lineno;
-    if (line.empty()) continue;
-    if (line[0] != '%') break;
-    if (line.rfind(kMmHashKey, 0) == 0) {
-      meta.mesh_hash = std::strtoull(line.c_str() + std::strlen(kMmHashKey), nullptr, 16);
-      have_hash = true;
-    } else if (line.rfind(kMmSettingsKey, 0) == 0) {
-      meta.settings = line.substr(std::strlen(kMmSettingsKey));
-    }
-  }
-  if (!have_hash)
+  const FormFactorFileInfo meta = read_mm_header(lines, line, have_hash);
+  if (!have_hash && expected_n >= 0)
     throw SceneError(path + ": no lambert mesh hash in the header: cannot check it belongs to "
                             "this scene");
+  std::vector<std::string_view> tok;
+  split_fields(line, tok);
   std::int64_t rows = 0, cols = 0, nnz = 0;
-  std::istringstream size_line(line);
-  if (!(size_line >> rows >> cols >> nnz) || rows != cols || rows < 0 || rows > INT32_MAX ||
-      nnz < 0 || nnz > rows * rows || nnz > INT32_MAX)
-    throw IoError(path + ":" + std::to_string(lineno) + ": malformed size line");
-  check_identity(path, meta.mesh_hash, rows, expected_hash, expected_n);
-  std::vector<Eigen::Triplet<double, std::int32_t>> t;
-  t.reserve(nnz);
-  for (std::int64_t k = 0; k < nnz; ++k) {
-    ++lineno;
-    std::int64_t i, j;
-    double v;
-    if (!std::getline(in, line)) throw IoError(path + ": truncated: expected " + std::to_string(nnz) + " entries");
-    std::istringstream ls(line);
-    if (!(ls >> i >> j >> v) || i < 1 || j < 1 || i > rows || j > rows || !std::isfinite(v))
-      throw IoError(path + ":" + std::to_string(lineno) + ": malformed entry");
-    t.emplace_back(static_cast<std::int32_t>(i - 1), static_cast<std::int32_t>(j - 1), v);
+  const bool parsed = tok.size() == 3 && parse_integer(tok[0], rows).empty() &&
+                      parse_integer(tok[1], cols).empty() && parse_integer(tok[2], nnz).empty();
+  if (!parsed || rows != cols || rows < 0 || rows > INT32_MAX || nnz < 0 || nnz > rows * rows ||
+      nnz > INT32_MAX)
+    throw IoError(lines.where() + ": malformed size line (expected 'N N NNZ', a square matrix)");
+  if (nnz > (file_size + 1) / kMinEntryBytes)
+    throw IoError(lines.where() + ": truncated: the size line promises " + std::to_string(nnz) +
+                  " entries, a file of " + std::to_string(file_size) + " bytes holds at most " +
+                  std::to_string((file_size + 1) / kMinEntryBytes));
+  if (expected_n >= 0) check_identity(path, meta.mesh_hash, rows, expected_hash, expected_n);
+  std::vector<MmEntry> entries;
+  entries.reserve(static_cast<size_t>(nnz));
+  while (lines.next(line)) {
+    if (is_blank_line(line)) continue;
+    if (static_cast<std::int64_t>(entries.size()) == nnz)
+      throw SceneError(lines.where() + ": extra line after the " + std::to_string(nnz) +
+                       " entries the size line announced");
+    entries.push_back(parse_mm_entry(lines, line, rows, tok));
   }
+  if (static_cast<std::int64_t>(entries.size()) != nnz)
+    throw IoError(path + ": truncated: " + std::to_string(entries.size()) + " of " +
+                  std::to_string(nnz) + " entries");
   FormFactors ff;
-  ff.F.resize(rows, rows);
-  ff.F.setFromTriplets(t.begin(), t.end());
+  ff.F = assemble_mm(entries, rows, path);
+  check_row_sums(ff, meta.settings, path);
   if (info) *info = meta;
   return ff;
 }
@@ -277,6 +501,9 @@ void write_matrix_market(const std::string& path, const SparseF& F, const FormFa
 
 void write_ff_binary(const std::string& path, const FormFactors& ff, const FormFactorFileInfo& info) {
   LAMBERT_CHECK(ff.F.isCompressed(), "F must be compressed");
+  if (!kHostIsLittleEndian)
+    throw IoError(path + ": binary form-factor files are little-endian and this host is not: "
+                         "write a Matrix Market (.mtx) file");
   write_stream_atomically(
       path,
       [&](std::ostream& out) {
@@ -301,17 +528,23 @@ void write_ff_binary(const std::string& path, const FormFactors& ff, const FormF
       true);
 }
 
-FormFactors read_form_factors(const std::string& path, std::uint64_t expected_mesh_hash,
-                              std::int32_t expected_n, FormFactorFileInfo* info) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open: " + std::strerror(errno));
+FormFactors read_form_factors(std::istream& in, const std::string& name,
+                              std::uint64_t expected_mesh_hash, std::int32_t expected_n,
+                              FormFactorFileInfo* info) {
   char magic[8] = {};
   in.read(magic, 8);
   in.clear();
   in.seekg(0);
   if (std::memcmp(magic, kMagic, 8) == 0)
-    return read_binary(in, path, expected_mesh_hash, expected_n, info);
-  return read_matrix_market(in, path, expected_mesh_hash, expected_n, info);
+    return read_binary(in, name, expected_mesh_hash, expected_n, info);
+  return read_matrix_market(in, name, expected_mesh_hash, expected_n, info);
+}
+
+FormFactors read_form_factors(const std::string& path, std::uint64_t expected_mesh_hash,
+                              std::int32_t expected_n, FormFactorFileInfo* info) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path + ": cannot open: " + std::strerror(errno));
+  return read_form_factors(in, path, expected_mesh_hash, expected_n, info);
 }
 
 }  // namespace lambert

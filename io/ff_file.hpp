@@ -3,6 +3,7 @@
 // compact binary format with a header that ties the file to the meshed scene.
 
 #include <cstdint>
+#include <istream>
 #include <string>
 
 #include "geometry/formfactors/formfactors.hpp"
@@ -36,9 +37,18 @@ void write_matrix_market(const std::string& path, const SparseF& F, const FormFa
 void write_ff_binary(const std::string& path, const FormFactors& ff, const FormFactorFileInfo& info);
 
 /// Reads a saved F (binary or Matrix Market, by content) and checks that it was made from
-/// the same meshed scene: throws SceneError naming the file if the hash or size differ,
-/// IoError if unreadable or corrupt.
+/// the same meshed scene: throws SceneError naming the file if the hash or size differ or
+/// an entry is impossible (negative, non-finite, diagonal, repeated, a row sum above 1 by
+/// more than the stored error), IoError if unreadable, truncated or corrupt. Every message
+/// is one line naming the file and the first offending entry or line (README: "Form-factor
+/// files"). Memory is bounded by the file's size before anything is allocated.
 FormFactors read_form_factors(const std::string& path, std::uint64_t expected_mesh_hash,
                               std::int32_t expected_n, FormFactorFileInfo* info = nullptr);
+
+/// read_form_factors from a seekable stream named `name` in messages. `expected_n` < 0
+/// accepts any mesh (no identity check; for fuzzing and inspection).
+FormFactors read_form_factors(std::istream& in, const std::string& name,
+                              std::uint64_t expected_mesh_hash, std::int32_t expected_n,
+                              FormFactorFileInfo* info = nullptr);
 
 }  // namespace lambert

@@ -1,5 +1,6 @@
 #include "io/line_reader.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -64,16 +65,23 @@ bool LineReader::next(std::string_view& line) {
   return true;
 }
 
-void split_tokens(std::string_view line, std::vector<std::string_view>& out) {
+void split_fields(std::string_view line, std::vector<std::string_view>& out) {
   out.clear();
   std::size_t k = 0;
   while (k < line.size()) {
     while (k < line.size() && is_blank(line[k])) ++k;
-    if (k == line.size() || line[k] == '#') break;
+    if (k == line.size()) break;
     const std::size_t b = k;
     while (k < line.size() && !is_blank(line[k])) ++k;
     out.push_back(line.substr(b, k - b));
   }
+}
+
+void split_tokens(std::string_view line, std::vector<std::string_view>& out) {
+  split_fields(line, out);
+  const auto comment =
+      std::find_if(out.begin(), out.end(), [](std::string_view t) { return t[0] == '#'; });
+  out.erase(comment, out.end());
 }
 
 std::string join_tokens(const std::vector<std::string_view>& tokens, std::size_t first) {

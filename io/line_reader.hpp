@@ -1,6 +1,6 @@
 #pragma once
 // Bounded, line-ending-agnostic text line reading and whitespace tokenizing for the text
-// formats lambert reads (OBJ, MTL).
+// formats lambert reads (OBJ, MTL, Matrix Market, radiosity CSV, camera sidecar).
 
 #include <cstddef>
 #include <istream>
@@ -44,6 +44,9 @@ class LineReader {
 
 /// True for the whitespace that separates tokens: space, tab, form feed, vertical tab.
 inline bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\f' || c == '\v'; }
+
+/// Splits a line into blank-separated fields (replacing `out`'s content), '#' included.
+void split_fields(std::string_view line, std::vector<std::string_view>& out);
 
 /// Splits a line into blank-separated tokens (replacing `out`'s content); a token starting
 /// with '#' begins a comment that runs to the end of the line.

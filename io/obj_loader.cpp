@@ -18,6 +18,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "geometry/polygon.hpp"
+#include "io/camera_file.hpp"
 #include "io/line_reader.hpp"
 #include "io/mtl_parser.hpp"
 #include "io/obj_parser.hpp"
@@ -538,43 +539,6 @@ void apply_emit(const std::vector<EmitRule>& rules, const std::string& name, Sce
   }
 }
 
-// The camera sidecar: `eye`, `look_at`, `up`, `vfov` or `focal_mm` with `film_mm`.
-Camera read_camera(const std::string& path) {
-  std::ifstream file = open_or_throw(path);
-  LineReader lines(file, path);
-  Camera cam;
-  double focal = 0, film = 0, vfov = 0;
-  std::string_view text;
-  bool have_eye = false, have_at = false;
-  while (lines.next(text)) {
-    std::istringstream ls{std::string(text)};
-    std::string key;
-    if (!(ls >> key) || key[0] == '#') continue;
-    auto vec = [&](Eigen::Vector3d& v) {
-      if (!(ls >> v.x() >> v.y() >> v.z()) || !v.allFinite())
-        throw SceneError(lines.where() + ": '" + key + "' needs 3 finite numbers");
-    };
-    auto num = [&](double& x) {
-      if (!(ls >> x) || !(x > 0) || !std::isfinite(x))
-        throw SceneError(lines.where() + ": '" + key + "' needs a positive number");
-    };
-    if (key == "eye") { vec(cam.eye); have_eye = true; }
-    else if (key == "look_at") { vec(cam.look_at); have_at = true; }
-    else if (key == "up") vec(cam.up);
-    else if (key == "focal_mm") num(focal);
-    else if (key == "film_mm") num(film);
-    else if (key == "vfov") num(vfov);
-    else throw SceneError(lines.where() + ": unknown camera key '" + key + "'");
-  }
-  if (!have_eye || !have_at) throw SceneError(path + ": camera needs 'eye' and 'look_at'");
-  if (vfov >= 180.0)
-    throw SceneError(path + ": 'vfov' must be below 180 degrees (a pinhole cannot see more)");
-  if (focal > 0 && film > 0) vfov = 2.0 * std::atan(0.5 * film / focal) * 180.0 / M_PI;
-  if (vfov > 0) cam.vfov_degrees = vfov;
-  cam.defined = true;
-  return cam;
-}
-
 }  // namespace
 
 std::string builtin_cornell_box_path() {
@@ -641,7 +605,7 @@ Scene load_obj(const std::string& path, LoadReport* report, const LoadOptions& o
   const fs::path camera_path = fs::path(path).replace_extension(".camera");
   std::error_code ec;
   if (fs::exists(camera_path, ec)) {
-    scene.camera = read_camera(camera_path.string());
+    scene.camera = read_camera_file(camera_path.string());
     files.push_back(camera_path.string());
   }
   scene.files = std::move(files);

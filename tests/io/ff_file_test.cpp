@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <fstream>
+#include <limits>
+#include <vector>
 
 #include "common/temp_dir.hpp"
 #include "core/error.hpp"
@@ -150,6 +153,187 @@ TEST(FormFactorFile, MatrixMarketKeepsTheSettingsInItsHeaderComments) {
   EXPECT_EQ(back.estimator, "mc");
   EXPECT_EQ(back.samples, 64);
   EXPECT_EQ(back.seed, 5u);
+}
+
+}  // namespace lambert
+
+// Hostile form-factor files (issue 10): each is generated here and must be refused with one
+// message naming the file and the first offending entry, never crash or allocate by its
+// header.
+namespace lambert {
+namespace {
+
+constexpr std::uint64_t kHash = 0x1234;
+
+// A 3-patch F with the given CSR arrays, written with write_ff_binary (so the checksum is
+// valid and only the content is wrong).
+std::string write_csr(const testing::TempDir& dir, std::vector<std::int32_t> outer,
+                      std::vector<std::int32_t> cols, std::vector<double> values,
+                      std::vector<double> errors = {}, const std::string& settings = "") {
+  const auto put = [&](SparseF& m, const std::vector<double>& v) {
+    m.resize(3, 3);
+    m.resizeNonZeros(static_cast<Eigen::Index>(cols.size()));
+    std::copy(outer.begin(), outer.end(), m.outerIndexPtr());
+    std::copy(cols.begin(), cols.end(), m.innerIndexPtr());
+    std::copy(v.begin(), v.end(), m.valuePtr());
+  };
+  FormFactors ff;
+  put(ff.F, values);
+  if (!errors.empty()) put(ff.stderr_F, errors);
+  const std::string path = dir.file("F.bin");
+  write_ff_binary(path, ff, {kHash, settings});
+  return path;
+}
+
+std::string bytes_of(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The message of the error read_form_factors throws (of type E), or a failure.
+template <typename E>
+std::string refusal(const std::string& path, std::int32_t n = 3) {
+  try {
+    read_form_factors(path, kHash, n);
+  } catch (const E& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "wrong exception type: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << path << " was accepted";
+  return "";
+}
+
+bool has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+}  // namespace
+
+TEST(FormFactorFile, BinaryHeaderImplyingMoreBytesIsTruncatedBeforeAllocating) {
+  Fixture f;
+  testing::TempDir dir;
+  write_ff_binary(dir.file("F.bin"), f.ff, f.info);
+  std::string bytes = bytes_of(dir.file("F.bin"));
+  // n at byte 16, nnz at byte 24 (little-endian i64): the largest the header bounds allow,
+  // a few hundred bytes of file; allocating by the header would take 2^31 × 20 B = 43 GB.
+  const std::int64_t n = INT32_MAX, nnz = INT32_MAX;
+  std::memcpy(&bytes[16], &n, 8);
+  std::memcpy(&bytes[24], &nnz, 8);
+  std::ofstream(dir.file("huge.bin"), std::ios::binary) << bytes;
+  EXPECT_TRUE(has(refusal<IoError>(dir.file("huge.bin"), f.mesh.size()), "truncated"));
+  // One flipped bit in nnz (still <= n^2) must also say truncated, not read garbage.
+  bytes = bytes_of(dir.file("F.bin"));
+  bytes[24] ^= 0x40;
+  std::ofstream(dir.file("flip.bin"), std::ios::binary) << bytes;
+  EXPECT_TRUE(has(refusal<IoError>(dir.file("flip.bin"), f.mesh.size()), "implies"));
+  std::ofstream(dir.file("long.bin"), std::ios::binary) << bytes_of(dir.file("F.bin")) << "x";
+  EXPECT_TRUE(has(refusal<IoError>(dir.file("long.bin"), f.mesh.size()), "trailing bytes"));
+}
+
+TEST(FormFactorFile, BinaryWithBadStructureIsRefused) {
+  testing::TempDir dir;
+  // Row starts must run from 0 to nnz and never decrease; columns in range, increasing.
+  EXPECT_TRUE(has(refusal<IoError>(write_csr(dir, {0, 2, 1, 2}, {1, 2}, {.1, .1})),
+                  "decrease at patch 2"));
+  EXPECT_TRUE(has(refusal<IoError>(write_csr(dir, {1, 1, 2, 2}, {1, 2}, {.1, .1})), "begin at 1"));
+  EXPECT_TRUE(has(refusal<IoError>(write_csr(dir, {0, 1, 2, 2}, {3, 2}, {.1, .1})),
+                  "column 3 out of range"));
+  EXPECT_TRUE(has(refusal<IoError>(write_csr(dir, {0, 2, 2, 2}, {2, 1}, {.1, .1})),
+                  "entry (0, 1) unsorted"));
+  EXPECT_TRUE(has(refusal<IoError>(write_csr(dir, {0, 2, 2, 2}, {1, 1}, {.1, .1})),
+                  "entry (0, 1) repeated"));
+}
+
+TEST(FormFactorFile, BinaryWithImpossibleValuesIsRefused) {
+  testing::TempDir dir;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_TRUE(has(refusal<SceneError>(write_csr(dir, {0, 1, 2, 2}, {1, 0}, {.1, nan})),
+                  "entry (1, 0): value nan is not finite"));
+  EXPECT_TRUE(has(refusal<SceneError>(write_csr(dir, {0, 1, 2, 2}, {1, 0}, {inf, .1})),
+                  "entry (0, 1): value inf"));
+  EXPECT_TRUE(has(refusal<SceneError>(write_csr(dir, {0, 1, 2, 2}, {1, 0}, {.1, -.5})),
+                  "entry (1, 0): value -0.5 is negative"));
+  EXPECT_TRUE(has(refusal<SceneError>(write_csr(dir, {0, 1, 1, 2}, {1, 2}, {.1, .3})),
+                  "entry (2, 2): nonzero diagonal"));
+  EXPECT_TRUE(has(refusal<SceneError>(write_csr(dir, {0, 1, 2, 2}, {1, 0}, {.1, .1}, {.01, nan})),
+                  "entry (1, 0): standard error nan"));
+  EXPECT_TRUE(has(refusal<SceneError>(write_csr(dir, {0, 1, 2, 2}, {1, 0}, {.1, .1}, {-1, .1})),
+                  "entry (0, 1): standard error -1 is negative"));
+  // An explicit zero on the diagonal is harmless and accepted.
+  EXPECT_NO_THROW(read_form_factors(write_csr(dir, {0, 1, 2, 2}, {0, 0}, {0, .5}), kHash, 3));
+}
+
+TEST(FormFactorFile, RowSumAboveOneByMoreThanTheStatedErrorIsRefused) {
+  testing::TempDir dir;
+  EXPECT_TRUE(has(refusal<SceneError>(write_csr(dir, {0, 2, 2, 2}, {1, 2}, {5, 5})),
+                  "row of patch 0 sums to 10"));
+  // Without stored errors only rounding is allowed (1e-9, see ff_file.cpp): 1 + 1e-8 fails,
+  // 1 + 1e-10 passes.
+  EXPECT_TRUE(has(refusal<SceneError>(write_csr(dir, {0, 2, 2, 2}, {1, 2}, {.5, .5 + 1e-8})),
+                  "above 1 by more than its stated error"));
+  EXPECT_NO_THROW(read_form_factors(write_csr(dir, {0, 2, 2, 2}, {1, 2}, {.5, .5 + 1e-10}), kHash, 3));
+  // With stored errors the allowance is 1e-9 + 4 Σ_j stderr_ij: stderrs of 2e-9 each give
+  // 1e-9 + 1.6e-8 = 1.7e-8, so an excess of 1e-8 passes and one of 3e-8 fails.
+  EXPECT_NO_THROW(read_form_factors(
+      write_csr(dir, {0, 2, 2, 2}, {1, 2}, {.5, .5 + 1e-8}, {2e-9, 2e-9}), kHash, 3));
+  EXPECT_TRUE(has(refusal<SceneError>(
+                      write_csr(dir, {0, 2, 2, 2}, {1, 2}, {.5, .5 + 3e-8}, {2e-9, 2e-9})),
+                  "row of patch 0"));
+  // A lambert F saved without errors states no bound (noisy estimators: mc row sums reach
+  // 1.77 on the Cornell box): only its entries are checked.
+  EXPECT_NO_THROW(read_form_factors(
+      write_csr(dir, {0, 2, 2, 2}, {1, 2}, {.9, .9}, {},
+                "estimator=hemicube samples=4 seed=0 threshold=0"),
+      kHash, 3));
+}
+
+TEST(FormFactorFile, MatrixMarketWithHugeNnzInATinyFileIsTruncated) {
+  testing::TempDir dir;
+  // 115 bytes promising 2^31 - 1 entries: reserving them would take 34 GB.
+  const std::string path = dir.write(
+      "F.mtx", "%%MatrixMarket matrix coordinate real general\n% lambert-mesh-hash: "
+               "0000000000001234\n100000 100000 2147483647\n1 2 0.5\n");
+  EXPECT_TRUE(has(refusal<IoError>(path), "truncated: the size line promises 2147483647"));
+}
+
+TEST(FormFactorFile, MatrixMarketWithBadEntriesIsRefusedNamingTheLine) {
+  testing::TempDir dir;
+  const std::string head =
+      "%%MatrixMarket matrix coordinate real general\n% lambert-mesh-hash: 0000000000001234\n";
+  // {body after the header (line 3 is the size line), expected part of the message}
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"3 3 2\n1 2 0.25\n1 2 0.25\n", ":5: entry (1, 2) repeated (first on line 4)"},
+      {"3 3 1\n1 2 -0.25\n", ":4: value -0.25 is negative"},
+      {"3 3 1\n1 2 nan\n", ":4: value 'nan': not finite"},
+      {"3 3 1\n1 2 1e400\n", ":4: value '1e400': out of the range"},
+      {"3 3 1\n1 4 0.5\n", ":4: entry (1, 4) out of range [1, 3]"},
+      {"3 3 1\n0 1 0.5\n", ":4: entry (0, 1) out of range"},
+      {"3 3 1\n2 2 0.5\n", ":4: nonzero diagonal"},
+      {"3 3 1\n1 2 0.5 extra\n", ":4: expected 'row column value', found 4 fields"},
+      {"3 3 1\n1 2 0.5 % comment\n", ":4: expected 'row column value'"},
+      {"3 3 1\n1 2 0.5\n2 1 0.5\n", ":5: extra line after the 1 entries"},
+      {"3 3 3\n1 2 0.5\n2 1 0.5\n", ": truncated: 2 of 3 entries"},
+      {"3 3 2\n1 2 0.75\n1 3 0.75\n", ": row of patch 0 sums to 1.5"},
+      {"3 3 1 x\n1 2 0.5\n", ":3: malformed size line"},
+      {"3 3 1\n1 2.0 0.5\n", ":4: index: not an integer"},
+  };
+  for (const auto& [body, expected] : cases) {
+    const std::string path = dir.write("F.mtx", head + body);
+    std::string message;
+    try {
+      read_form_factors(path, kHash, 3);
+    } catch (const Error& e) {
+      message = e.what();
+    }
+    EXPECT_TRUE(has(message, path + expected)) << body << "-> " << message;
+  }
+  // Blank lines (a final newline, CRLF) are fine.
+  EXPECT_NO_THROW(read_form_factors(dir.write("ok.mtx", head + "3 3 2\r\n1 2 0.5\r\n\r\n2 1 0.5\r\n\n"), kHash, 3));
 }
 
 }  // namespace lambert
