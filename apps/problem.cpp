@@ -19,11 +19,9 @@ RadiosityProblem make_problem(const PatchMesh& mesh, const SparseRowMatrix& F) {
   p.area.resize(n);
   for (std::int32_t i = 0; i < n; ++i) {
     const Patch& patch = mesh.patches[i];
-    // rho = 1 (lossless) is a valid scene once check_closed_lossless has ruled out a
-    // singular system; the solvers' contract is rho in [0, 1), so it is passed as the
-    // largest double below 1 (1 - 2^-53): B changes by ~1e-16 relative per reflection.
-    for (int c = 0; c < 3; ++c)
-      p.rho(i, c) = patch.rho[c] >= 1.0 ? std::nextafter(1.0, 0.0) : patch.rho[c];
+    // rho = 1 (lossless) is passed as it is: check_closed_lossless has ruled out the one
+    // singular case, a closed set of lossless patches.
+    p.rho.row(i) = patch.rho.transpose();
     p.emission.row(i) = patch.emission.transpose();
     p.area[i] = patch.area;
   }

@@ -99,8 +99,10 @@ void validate_problem(const RadiosityProblem& p) {
     if (!(p.area[i] > 0.0) || !std::isfinite(p.area[i]))
       throw UsageError("patch " + std::to_string(i) + " has non-positive area");
     for (int c = 0; c < 3; ++c) {
-      if (!(p.rho(i, c) >= 0.0 && p.rho(i, c) < 1.0))
-        throw UsageError("patch " + std::to_string(i) + ": rho must be in [0, 1)");
+      // rho = 1 (lossless) is allowed: the system is singular only for a closed set of
+      // lossless patches, which the caller rules out (analysis.hpp, find_closed_lossless).
+      if (!(p.rho(i, c) >= 0.0 && p.rho(i, c) <= 1.0))
+        throw UsageError("patch " + std::to_string(i) + ": rho must be in [0, 1]");
       if (!(p.emission(i, c) >= 0.0) || !std::isfinite(p.emission(i, c)))
         throw UsageError("patch " + std::to_string(i) + ": emission must be finite and >= 0");
     }

@@ -21,7 +21,7 @@ const char* to_string(SolveStatus status);
 /// The problem: one shared F and per-patch, per-channel rho and E, and patch areas.
 struct RadiosityProblem {
   const SparseRowMatrix* F = nullptr;  ///< N x N form factors (row i: F_ij)
-  Eigen::MatrixX3d rho;                ///< N x 3 reflectance, each in [0, 1)
+  Eigen::MatrixX3d rho;                ///< N x 3 reflectance, each in [0, 1]
   Eigen::MatrixX3d emission;           ///< N x 3 emitted radiosity E (W/m^2)
   Eigen::VectorXd area;                ///< N patch areas
 };
@@ -99,7 +99,7 @@ double relative_residual(const RadiosityProblem& problem, const Eigen::MatrixX3d
 EnergyBalance energy_balance(const RadiosityProblem& problem, const Eigen::MatrixX3d& B,
                              int channel);
 
-/// Checks sizes and ranges of a problem (N x N F, rho in [0, 1), E >= 0, A > 0); throws
+/// Checks sizes and ranges of a problem (N x N F, rho in [0, 1], E >= 0, A > 0); throws
 /// UsageError naming what is wrong.
 void validate_problem(const RadiosityProblem& problem);
 

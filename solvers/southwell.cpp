@@ -111,7 +111,8 @@ ChannelReport solve_southwell(const ChannelSystem& system, const SolveOptions& o
     report.note = std::to_string(refinements) + " refinement(s): F is not exactly reciprocal";
   if (options.ambient) {
     const double rho_avg = a.dot(rho) / a.sum();
-    const double ambient = a.dot(r) / a.sum() / (1.0 - rho_avg);
+    // A lossless scene (rho_avg = 1) has no ambient estimate of this form: none is added.
+    const double ambient = rho_avg < 1.0 ? a.dot(r) / a.sum() / (1.0 - rho_avg) : 0.0;
     B += r + rho * ambient;
     report.note += std::string(report.note.empty() ? "" : "; ") + "ambient term added (" +
                    std::to_string(ambient) + ")";
