@@ -36,7 +36,8 @@ bool parse_finite_number(const std::string& text, double& x) {
 // a reason, empty on success.
 std::string parse_rgb(const std::string& text, bool unit, Eigen::Vector3d& out) {
   const std::string want = unit ? "R,G,B with three numbers in [0, 1]" : "R,G,B with three finite numbers >= 0";
-  std::istringstream in(text);
+  if (!text.empty() && text.back() == ',') return "'" + text + "' is not " + want;
+  std::istringstream in(text);  // (getline drops an empty last field: checked above)
   std::string part;
   int n = 0;
   while (std::getline(in, part, ',')) {

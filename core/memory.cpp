@@ -28,7 +28,7 @@ std::optional<double> parse_size(const std::string& text) {
   const double n = std::strtod(number.c_str(), nullptr);
   std::string suffix = digits == std::string::npos ? "" : text.substr(digits);
   for (char& c : suffix) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  if (suffix.size() > 1 && suffix.back() == 'B') suffix.pop_back();
+  if (!suffix.empty() && suffix.back() == 'B') suffix.pop_back();  // 512B, 2GB, 2GiB
   if (suffix.size() == 2 && suffix[1] == 'I') suffix.pop_back();  // KiB, MiB, ...
   static const std::string kUnits = "KMGT";
   double scale = 1.0;

@@ -119,6 +119,7 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
   const int R = replicate_count(ctx.samples);
   double replicate[kReplicates];
   double num = 0.0, den = 0.0;
+  int used = 0;
   bool unverified = false;
   for (int rep = 0; rep < R; ++rep) {
     const Kronecker4 seq(hash_keys(key, static_cast<std::uint64_t>(rep)));
@@ -160,7 +161,9 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
     }
     num += rnum;
     den += rden;
-    replicate[rep] = rden > 0.0 ? G0 * rnum / rden : G0;
+    // A replicate all of whose rays were skipped has no estimate: it is left out of the
+    // variance as it is of the pooled ratio.
+    if (rden > 0.0) replicate[used++] = G0 * rnum / rden;
   }
   if (!(den > 0.0)) {
     // No ray could be traced: report the unoccluded value, flagged (the driver warns).
@@ -173,8 +176,8 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
   // worst case measured by the sweep in tests/geometry/quadrature_test.cpp), so that the
   // error bar of an unoccluded pair (no sampling error) is not zero.
   const double quad = kQuadratureTolerance * G0;
-  est.var = replicate_variance(replicate, R) + quad * quad;
-  est.unverified = unverified;
+  est.var = replicate_variance(replicate, used) + quad * quad;
+  est.unverified = unverified || used < R;
   return est;
 }
 

@@ -45,6 +45,8 @@ TEST(Cli, SceneLoadingOptionsAreCheckedAndApplied) {
   EXPECT_EQ(run({"info", "-q", bare, "--max-reflectance", "1.5"}), kExitUsage);
   EXPECT_EQ(run({"info", "-q", bare, "--default-reflectance", "0.5,nan,0.5"}), kExitUsage);
   EXPECT_EQ(run({"info", "-q", bare, "--default-reflectance", "0.5,1.5,0.5"}), kExitUsage);
+  // A trailing comma is a fourth, empty value (getline used to drop it silently).
+  EXPECT_EQ(run({"info", "-q", bare, "--default-reflectance", "0.5,0.5,0.5,"}), kExitUsage);
   EXPECT_EQ(run({"info", "-q", bare, "--emit", "nothing=1,1,1"}), kExitUsage);
   EXPECT_EQ(run({"info", "-q", bare, "--strict"}), kExitFailure);
   EXPECT_EQ(run({"formfactors", "-q", bare, "--strict", "-o", "/tmp/never.mtx"}), kExitFailure);

@@ -161,6 +161,9 @@ TEST_F(JobChecks, JobsBeyondTheMemoryLimitAreRefused) {
 TEST_F(JobChecks, MemoryLimitZeroTurnsTheCheckOff) {
   ::setenv("LAMBERT_MAX_MEMORY", "1K", 1);
   EXPECT_EQ(run({"info", obj(), "-q", "--patches", "60", "--max-memory", "0"}), kExitOk);
+  // A size in plain bytes ("B" suffix) is a size: 512B is far too small, so refused as such.
+  expect_refused({"info", obj(), "-q", "--patches", "60", "--max-memory", "512B"}, kExitUsage,
+                 "needs about");
   ::unsetenv("LAMBERT_MAX_MEMORY");
 }
 
