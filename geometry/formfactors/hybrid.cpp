@@ -64,13 +64,11 @@ constexpr double kMinJointAcceptance = 0.2;
 // a's plane (at most the largest over b's front corners) and -n_b · d is x's height above
 // b's plane (at most the largest over the cell's corners); r is at least the distance from
 // the cell's bounding sphere to b.
-CellMode cell_mode(const QuadCell& cell, const PatchGeom& a, const PatchGeom& b,
-                   const std::vector<PatchGeom>& bfront, double bfront_area) {
+// `ha` is the largest height of b's front part above a's plane (one per pair).
+CellMode cell_mode(const QuadCell& cell, const PatchGeom& b, double ha, double bfront_area) {
   CellMode m;
   m.ready = true;
-  double ha = 0.0, hb = 0.0;
-  for (const PatchGeom& t : bfront)
-    for (int k = 0; k < t.n; ++k) ha = std::max(ha, a.normal.dot(t.p[k] - a.p[0]));
+  double hb = 0.0;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (int k = 0; k < cell.g.n; ++k) {
     hb = std::max(hb, b.normal.dot(cell.g.p[k] - b.p[0]));
@@ -106,6 +104,9 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
   bcdf.clear();
   for (const PatchGeom& t : bfront) bcdf.push_back((bcdf.empty() ? 0.0 : bcdf.back()) + t.area);
   if (bcdf.empty() || !(bcdf.back() > 0.0)) return est;
+  double ha = 0.0;  // for cell_mode
+  for (const PatchGeom& t : bfront)
+    for (int k = 0; k < t.n; ++k) ha = std::max(ha, a.normal.dot(t.p[k] - a.p[0]));
   // A point uniform on b's front part from three uniforms.
   auto on_b = [&](double u, double s2, double t2) {
     const double pick = u * bcdf.back();
@@ -131,7 +132,7 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
           std::lower_bound(cdf.begin(), cdf.end(), pick) - cdf.begin(), cells.size() - 1);
       const double lo = c ? cdf[c - 1] : 0.0;
       const double within = std::clamp((pick - lo) / cells[c].G, 0.0, 1.0);
-      if (!modes[c].ready) modes[c] = cell_mode(cells[c], a, b, bfront, bcdf.back());
+      if (!modes[c].ready) modes[c] = cell_mode(cells[c], b, ha, bcdf.back());
       Eigen::Vector3d x, y;
       double w = 1.0;
       bool exhausted = true;
