@@ -432,7 +432,7 @@ int run_accuracy(const AccuracyOptions& opts) {
                 mesh.surface_names[study.exact[0].h].c_str(), study.exact[0].value);
   } else {
     double max_se = 0.0, sum2 = 0.0;
-    for (std::int32_t k = 0; k < ref.stderr_F.nonZeros(); ++k) {
+    for (std::int64_t k = 0; k < ref.stderr_F.nonZeros(); ++k) {
       max_se = std::max(max_se, ref.stderr_F.valuePtr()[k]);
       sum2 += std::pow(ref.stderr_F.valuePtr()[k], 2);
     }

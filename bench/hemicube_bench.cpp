@@ -37,7 +37,7 @@ struct Measure {
 void compare(const SparseF& F, const SparseF& ref, Measure& m) {
   const SparseF diff = F - ref;
   double sum2 = 0.0;
-  for (std::int32_t k = 0; k < diff.nonZeros(); ++k) sum2 += std::pow(diff.valuePtr()[k], 2);
+  for (std::int64_t k = 0; k < diff.nonZeros(); ++k) sum2 += std::pow(diff.valuePtr()[k], 2);
   m.rms = std::sqrt(sum2 / std::max<std::int64_t>(1, diff.nonZeros()));
   m.row_sum = (diff * Eigen::VectorXd::Ones(F.cols())).cwiseAbs().maxCoeff();
 }
@@ -117,7 +117,7 @@ int main(int argc, char** argv) {
   ro.progress = false;
   const FormFactors ref = compute_form_factors(mesh, ro);
   double se2 = 0.0;
-  for (std::int32_t k = 0; k < ref.stderr_F.nonZeros(); ++k) se2 += std::pow(ref.stderr_F.valuePtr()[k], 2);
+  for (std::int64_t k = 0; k < ref.stderr_F.nonZeros(); ++k) se2 += std::pow(ref.stderr_F.valuePtr()[k], 2);
   const double ref_se = std::sqrt(se2 / std::max<std::int64_t>(1, ref.stderr_F.nonZeros()));
   std::printf("reference: hybrid k=%d in %.1f s, RMS standard error per entry %.3e "
               "(errors below ~2x this are not resolved)\n\n",

@@ -21,16 +21,21 @@
 namespace lambert {
 namespace {
 
-// Binary layout (little-endian), version 1:
+// Binary layout (little-endian), version 2:
 //   char[8]  magic "LMBRTFF\0"
-//   u32      version (1)          u32 flags (bit 0: standard errors follow the values)
+//   u32      version (2)          u32 flags (bit 0: standard errors follow the values)
 //   i64      n                    i64 nnz
 //   u64      mesh hash            u32 settings length, then that many bytes (UTF-8)
-//   i32[n+1] row starts           i32[nnz] column indices       f64[nnz] values
+//   i64[n+1] row starts           i32[nnz] column indices       f64[nnz] values
 //   f64[nnz] standard errors (if flag bit 0)
 //   u64      checksum: mix64 chain over every byte above (detects truncation/corruption)
+// Version 1 (read, never written) is the same with i32 row starts, so nnz < 2^31.
 constexpr char kMagic[8] = {'L', 'M', 'B', 'R', 'T', 'F', 'F', '\0'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;
+// Arrays whose width on disk differs from memory go through a buffer of this many elements
+// (a multiple of 8 bytes for 4- and 8-byte elements, so the checksum, a chain over 8-byte
+// words, is the same as over the whole array in one piece).
+constexpr std::int64_t kChunk = 1 << 14;
 // The binary format is little-endian and read and written as raw memory: a big-endian host
 // refuses it (reading and writing) rather than swapping, and is pointed to Matrix Market.
 constexpr bool kHostIsLittleEndian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
@@ -66,6 +71,16 @@ class Writer {
   void put(const T& v) {
     put(&v, sizeof v);
   }
+  /// Writes `count` elements of `from` as Disk (a narrowing the caller has checked).
+  template <typename Disk, typename Mem>
+  void put_array(const Mem* from, std::int64_t count) {
+    std::vector<Disk> buf(static_cast<size_t>(std::min(count, kChunk)));
+    for (std::int64_t at = 0; at < count; at += kChunk) {
+      const std::int64_t m = std::min(kChunk, count - at);
+      for (std::int64_t k = 0; k < m; ++k) buf[k] = static_cast<Disk>(from[at + k]);
+      put(buf.data(), sizeof(Disk) * static_cast<size_t>(m));
+    }
+  }
   std::uint64_t checksum() const { return sum_.h; }
 
  private:
@@ -87,6 +102,16 @@ class Reader {
     T v;
     get(&v, sizeof v);
     return v;
+  }
+  /// Reads `count` elements stored as Disk into `to`.
+  template <typename Disk, typename Mem>
+  void get_array(Mem* to, std::int64_t count) {
+    std::vector<Disk> buf(static_cast<size_t>(std::min(count, kChunk)));
+    for (std::int64_t at = 0; at < count; at += kChunk) {
+      const std::int64_t m = std::min(kChunk, count - at);
+      get(buf.data(), sizeof(Disk) * static_cast<size_t>(m));
+      for (std::int64_t k = 0; k < m; ++k) to[at + k] = static_cast<Mem>(buf[k]);
+    }
   }
   std::uint64_t checksum() const { return sum_.h; }
 
@@ -165,8 +190,8 @@ void check_row_sums(const FormFactors& ff, const std::string& settings, const st
   const RowSumRule rule = row_sum_rule(ff, settings);
   for (std::int32_t i = 0; rule.check && i < ff.F.outerSize(); ++i) {
     double sum = 0, err = 0;
-    const std::int32_t begin = ff.F.outerIndexPtr()[i], end = ff.F.outerIndexPtr()[i + 1];
-    for (std::int32_t k = begin; k < end; ++k) {
+    const auto begin = ff.F.outerIndexPtr()[i], end = ff.F.outerIndexPtr()[i + 1];
+    for (auto k = begin; k < end; ++k) {
       sum += ff.F.valuePtr()[k];
       if (rule.with_errors) err += ff.stderr_F.valuePtr()[k];
     }
@@ -183,8 +208,8 @@ void check_row_sums(const FormFactors& ff, const std::string& settings, const st
 // zero on the diagonal. Linear in nnz.
 void check_binary_entries(const FormFactors& ff, const std::string& path) {
   const std::int64_t n = ff.F.rows(), nnz = ff.F.nonZeros();
-  const std::int32_t* outer = ff.F.outerIndexPtr();
-  const std::int32_t* col = ff.F.innerIndexPtr();
+  const auto* outer = ff.F.outerIndexPtr();
+  const auto* col = ff.F.innerIndexPtr();
   const bool with_err = ff.stderr_F.nonZeros() == nnz && nnz > 0;
   auto corrupt = [&](const std::string& what) { return IoError(path + ": " + what); };
   if (outer[0] != 0) throw corrupt("row starts begin at " + std::to_string(outer[0]) + ", not 0");
@@ -196,7 +221,7 @@ void check_binary_entries(const FormFactors& ff, const std::string& path) {
       throw corrupt("row starts decrease at patch " + std::to_string(i + 1));
     if (outer[i + 1] > nnz)
       throw corrupt("row start of patch " + std::to_string(i + 1) + " beyond nnz");
-    for (std::int32_t k = outer[i]; k < outer[i + 1]; ++k) {
+    for (auto k = outer[i]; k < outer[i + 1]; ++k) {
       if (col[k] < 0 || col[k] >= n)
         throw corrupt("patch " + std::to_string(i) + ": column " + std::to_string(col[k]) +
                       " out of range [0, " + std::to_string(n) + ")");
@@ -223,9 +248,12 @@ std::int64_t stream_size(std::istream& in, const std::string& path) {
 constexpr std::int64_t kBinaryHeaderBytes = 8 + 4 + 4 + 8 + 8 + 8 + 4;
 
 // The byte count a binary F file with this header has: header, settings, row starts,
-// columns, values (and standard errors), checksum. Fits in 64 bits for n, nnz < 2^31.
-std::int64_t binary_size(std::int64_t n, std::int64_t nnz, std::uint32_t len, bool with_err) {
-  return kBinaryHeaderBytes + len + 4 * (n + 1) + (4 + 8) * nnz + (with_err ? 8 * nnz : 0) + 8;
+// columns, values (and standard errors), checksum. Fits in 64 bits for n < 2^31, nnz <= n^2.
+std::int64_t binary_size(std::uint32_t version, std::int64_t n, std::int64_t nnz,
+                         std::uint32_t len, bool with_err) {
+  const std::int64_t row_start_bytes = version == 1 ? 4 : 8;
+  return kBinaryHeaderBytes + len + row_start_bytes * (n + 1) + (4 + 8) * nnz +
+         (with_err ? 8 * nnz : 0) + 8;
 }
 
 FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t expected_hash,
@@ -238,8 +266,9 @@ FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t
   char magic[8];
   r.get(magic, 8);
   const auto version = r.get<std::uint32_t>();
-  if (version != kVersion)
-    throw IoError(path + ": unsupported form-factor file version " + std::to_string(version));
+  if (version != 1 && version != kVersion)
+    throw IoError(path + ": unsupported form-factor file version " + std::to_string(version) +
+                  " (this lambert reads versions 1 and 2)");
   const auto flags = r.get<std::uint32_t>();
   const auto n = r.get<std::int64_t>();
   const auto nnz = r.get<std::int64_t>();
@@ -248,10 +277,11 @@ FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t
   // Bounds before any allocation: a corrupt header must not trigger a huge allocation or
   // signed overflow (n <= INT32_MAX makes n * n fit in 64 bits).
   if (flags > 1u) throw IoError(path + ": corrupt header: unknown flags " + std::to_string(flags));
-  if (n < 0 || n > INT32_MAX || nnz < 0 || nnz > n * n || nnz > INT32_MAX || len > (1u << 20))
+  if (n < 0 || n > INT32_MAX || nnz < 0 || nnz > n * n || (version == 1 && nnz > INT32_MAX) ||
+      len > (1u << 20))
     throw IoError(path + ": corrupt header (n " + std::to_string(n) + ", nnz " +
                   std::to_string(nnz) + ", settings length " + std::to_string(len) + ")");
-  const std::int64_t implied = binary_size(n, nnz, len, flags & 1u);
+  const std::int64_t implied = binary_size(version, n, nnz, len, flags & 1u);
   if (implied != file_size)
     throw IoError(path + ": " + (implied > file_size ? "truncated" : "trailing bytes") +
                   ": the header (n " + std::to_string(n) + ", nnz " + std::to_string(nnz) +
@@ -263,8 +293,11 @@ FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t
   FormFactors ff;
   ff.F.resize(n, n);
   ff.F.resizeNonZeros(nnz);
-  r.get(ff.F.outerIndexPtr(), sizeof(std::int32_t) * (n + 1));
-  r.get(ff.F.innerIndexPtr(), sizeof(std::int32_t) * nnz);
+  if (version == 1)
+    r.get_array<std::int32_t>(ff.F.outerIndexPtr(), n + 1);
+  else
+    r.get_array<std::int64_t>(ff.F.outerIndexPtr(), n + 1);
+  r.get_array<std::int32_t>(ff.F.innerIndexPtr(), nnz);
   r.get(ff.F.valuePtr(), sizeof(double) * nnz);
   if (flags & 1u) {
     ff.stderr_F = ff.F;
@@ -360,7 +393,7 @@ SparseF assemble_mm(std::vector<MmEntry>& entries, std::int64_t n, const std::st
   });
   SparseF F(n, n);
   F.resizeNonZeros(static_cast<Eigen::Index>(entries.size()));
-  std::int32_t* outer = F.outerIndexPtr();
+  auto* outer = F.outerIndexPtr();
   std::fill(outer, outer + n + 1, 0);
   for (size_t k = 0; k < entries.size(); ++k) {
     const MmEntry& e = entries[k];
@@ -392,8 +425,7 @@ FormFactors read_matrix_market(std::istream& in, const std::string& path,
   std::int64_t rows = 0, cols = 0, nnz = 0;
   const bool parsed = tok.size() == 3 && parse_integer(tok[0], rows).empty() &&
                       parse_integer(tok[1], cols).empty() && parse_integer(tok[2], nnz).empty();
-  if (!parsed || rows != cols || rows < 0 || rows > INT32_MAX || nnz < 0 || nnz > rows * rows ||
-      nnz > INT32_MAX)
+  if (!parsed || rows != cols || rows < 0 || rows > INT32_MAX || nnz < 0 || nnz > rows * rows)
     throw IoError(lines.where() + ": malformed size line (expected 'N N NNZ', a square matrix)");
   if (nnz > (file_size + 1) / kMinEntryBytes)
     throw IoError(lines.where() + ": truncated: the size line promises " + std::to_string(nnz) +
@@ -518,8 +550,8 @@ void write_ff_binary(const std::string& path, const FormFactors& ff, const FormF
         w.put(info.mesh_hash);
         w.put(static_cast<std::uint32_t>(info.settings.size()));
         w.put(info.settings.data(), info.settings.size());
-        w.put(ff.F.outerIndexPtr(), sizeof(std::int32_t) * (n + 1));
-        w.put(ff.F.innerIndexPtr(), sizeof(std::int32_t) * nnz);
+        w.put_array<std::int64_t>(ff.F.outerIndexPtr(), n + 1);
+        w.put_array<std::int32_t>(ff.F.innerIndexPtr(), nnz);  // columns < n <= 2^31
         w.put(ff.F.valuePtr(), sizeof(double) * nnz);
         if (err) w.put(ff.stderr_F.valuePtr(), sizeof(double) * nnz);
         const std::uint64_t sum = w.checksum();

@@ -95,7 +95,7 @@ class OperatorPreconditioner {
       ilut_ = std::make_shared<Eigen::IncompleteLUT<double, int>>();
       ilut_->setDroptol(1e-3);  // drops entries below 1e-3 of their row's norm
       ilut_->setFillfactor(1);  // at most the original row count per factor row
-      ilut_->compute(*k);
+      ilut_->compute(Eigen::SparseMatrix<double, Eigen::ColMajor, int>(*k));
       info_ = ilut_->info();
     }
   }

@@ -32,8 +32,8 @@ ChannelReport solve_southwell(const ChannelSystem& system, const SolveOptions& o
   const std::int32_t n = system.size();
   const SparseRowMatrix& F = *system.F;
   const double* values = F.valuePtr();
-  const std::int32_t* inner = F.innerIndexPtr();
-  const std::int32_t* outer = F.outerIndexPtr();
+  const auto* inner = F.innerIndexPtr();
+  const auto* outer = F.outerIndexPtr();
   const Eigen::VectorXd& a = system.area;
   const Eigen::VectorXd& rho = system.rho;
   const double tol_abs = options.tol * system.e_norm;
@@ -89,7 +89,7 @@ ChannelReport solve_southwell(const ChannelSystem& system, const SolveOptions& o
     sq -= r[i] * r[i];
     r[i] = 0.0;
     const double shoot = delta * a[i];
-    for (std::int32_t k = outer[i]; k < outer[i + 1]; ++k) {
+    for (auto k = outer[i]; k < outer[i + 1]; ++k) {
       const std::int32_t j = inner[k];
       if (j == i) continue;  // the self term is in K_ii above
       const double old = r[j];

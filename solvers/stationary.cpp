@@ -60,12 +60,12 @@ namespace {
 double sor_sweep(const ChannelSystem& s, double omega, Eigen::VectorXd& B) {
   const SparseRowMatrix& F = *s.F;
   const double* values = F.valuePtr();
-  const std::int32_t* inner = F.innerIndexPtr();
-  const std::int32_t* outer = F.outerIndexPtr();
+  const auto* inner = F.innerIndexPtr();
+  const auto* outer = F.outerIndexPtr();
   double sq = 0.0;
   for (std::int32_t i = 0; i < s.size(); ++i) {
     double gather = 0.0;
-    for (std::int32_t k = outer[i]; k < outer[i + 1]; ++k) gather += values[k] * B[inner[k]];
+    for (auto k = outer[i]; k < outer[i + 1]; ++k) gather += values[k] * B[inner[k]];
     const double d = 1.0 - s.rho[i] * s.f_diag[i];
     const double r = s.E[i] + s.rho[i] * gather - B[i];  // row i of E - K B, newest values
     sq += r * r;

@@ -11,14 +11,14 @@ void multiply_f(const SparseRowMatrix& F, const Eigen::VectorXd& x, Eigen::Vecto
   const std::int32_t n = static_cast<std::int32_t>(F.rows());
   y.resize(n);
   const double* values = F.valuePtr();
-  const std::int32_t* inner = F.innerIndexPtr();
-  const std::int32_t* outer = F.outerIndexPtr();
+  const auto* inner = F.innerIndexPtr();
+  const auto* outer = F.outerIndexPtr();
   const double* xs = x.data();
   double* ys = y.data();
   auto rows = [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
       double s = 0.0;
-      for (std::int32_t k = outer[i]; k < outer[i + 1]; ++k) s += values[k] * xs[inner[k]];
+      for (auto k = outer[i]; k < outer[i + 1]; ++k) s += values[k] * xs[inner[k]];
       ys[i] = s;
     }
   };

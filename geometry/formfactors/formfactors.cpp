@@ -8,6 +8,7 @@
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "core/timer.hpp"
+#include "geometry/formfactors/assembly.hpp"
 #include "geometry/formfactors/constants.hpp"
 #include "geometry/formfactors/hemicube.hpp"
 #include "geometry/formfactors/pairwise.hpp"
@@ -17,12 +18,11 @@ namespace lambert {
 namespace ff {
 
 
-namespace {
-struct UpperEntry {
-  std::int32_t j;
-  double G;
-};
-}  // namespace
+// Rows are estimated in blocks of about 1/kBlocks of the pairs, in parallel within a block;
+// each block's upper-triangle entries (G_ij, j > i) are then appended in row order to the
+// CSR that becomes F (assembly.hpp), and mirror_upper completes it in place. Staging is one
+// block of rows.
+constexpr std::int64_t kBlocks = 64;
 
 FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& options,
                              const Bvh& bvh, PairEstimator estimator) {
@@ -31,31 +31,42 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
   const std::vector<PatchGeom> geom = patch_geometry(mesh);
   const PairContext ctx{geom, bvh, options.samples, options.seed, kRayOffset * mesh.scale};
   const double plane_eps = kPlaneEps * mesh.scale;
-
-  // Row i holds the pairs (i, j > i); rows are filled in parallel, one row per task.
-  std::vector<std::vector<UpperEntry>> upper(n);
-  std::vector<std::vector<double>> upper_var(options.with_stderr ? n : 0);
-  std::vector<std::int64_t> tested(n, 0), rays(n, 0), unverified(n, 0);
   const std::int64_t total_pairs = static_cast<std::int64_t>(n) * (n - 1) / 2;
+
+  // Room for every pair in both triangles; pages of pairs that do not exchange energy are
+  // never written, so they cost address space only.
+  CsrAppender upper(n, 2 * total_pairs, options.with_stderr);
+  std::vector<std::vector<RowEntry>> rows(n);
+  std::vector<std::int64_t> tested(n, 0), rays(n, 0), unverified(n, 0);
   Progress progress("form factors", options.progress ? total_pairs : 0, "rays");
-  parallel_for(n, 1, options.threads, [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t ii = begin; ii < end; ++ii) {
-      const auto i = static_cast<std::int32_t>(ii);
-      std::int64_t row_rays = 0;
-      for (std::int32_t j = i + 1; j < n; ++j) {
-        if (!can_exchange(geom[i], geom[j], plane_eps)) continue;
-        ++tested[i];
-        const PairEstimate e = estimator(ctx, i, j);
-        row_rays += e.rays;
-        unverified[i] += e.unverified;
-        if (e.G <= 0.0) continue;
-        upper[i].push_back({j, e.G});
-        if (options.with_stderr) upper_var[i].push_back(e.var);
+  const std::int64_t block_pairs = std::max<std::int64_t>(1, total_pairs / kBlocks);
+  for (std::int32_t block_begin = 0; block_begin < n;) {
+    std::int32_t block_end = block_begin;
+    for (std::int64_t pairs = 0; block_end < n && pairs < block_pairs; ++block_end)
+      pairs += n - 1 - block_end;
+    parallel_for(block_end - block_begin, 1, options.threads,
+                 [&](std::int64_t begin, std::int64_t end) {
+      for (std::int64_t r = begin; r < end; ++r) {
+        const auto i = static_cast<std::int32_t>(block_begin + r);
+        std::int64_t row_rays = 0;
+        for (std::int32_t j = i + 1; j < n; ++j) {
+          if (!can_exchange(geom[i], geom[j], plane_eps)) continue;
+          ++tested[i];
+          const PairEstimate e = estimator(ctx, i, j);
+          row_rays += e.rays;
+          unverified[i] += e.unverified;
+          if (e.G > 0.0) rows[i].push_back({j, e.G, e.var});
+        }
+        rays[i] = row_rays;
+        progress.advance(n - 1 - i, row_rays);
       }
-      rays[i] = row_rays;
-      progress.advance(n - 1 - i, row_rays);
+    });
+    for (std::int32_t i = block_begin; i < block_end; ++i) {
+      upper.append_row(rows[i]);
+      std::vector<RowEntry>().swap(rows[i]);  // release the staging as we go
     }
-  });
+    block_begin = block_end;
+  }
   progress.finish();
 
   FormFactors out;
@@ -66,53 +77,10 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
     out.stats.pairs_unverified += unverified[i];
   }
   out.stats.pairs_culled = total_pairs - out.stats.pairs_tested;
-
-  // Assemble CSR directly: row i = lower entries (m < i, from upper[m]) then upper[i].
-  std::vector<std::int32_t> lower_count(n, 0);
-  for (std::int32_t m = 0; m < n; ++m)
-    for (const auto& e : upper[m]) ++lower_count[e.j];
-  std::vector<std::int64_t> row_start(n + 1, 0);
-  for (std::int32_t i = 0; i < n; ++i)
-    row_start[i + 1] = row_start[i] + lower_count[i] + static_cast<std::int64_t>(upper[i].size());
-  const std::int64_t nnz = row_start[n];
-  LAMBERT_CHECK(nnz < INT32_MAX, "too many form factors for 32-bit sparse indices");
-  SparseF F(n, n), S;
-  F.resizeNonZeros(nnz);
-  if (options.with_stderr) {
-    S.resize(n, n);
-    S.resizeNonZeros(nnz);
-  }
-  std::vector<std::int64_t> fill(row_start.begin(), row_start.end() - 1);
-  for (std::int32_t m = 0; m < n; ++m) {  // lower part, in increasing m: sorted
-    for (size_t k = 0; k < upper[m].size(); ++k) {
-      const auto& e = upper[m][k];
-      const std::int64_t at = fill[e.j]++;
-      F.innerIndexPtr()[at] = m;
-      F.valuePtr()[at] = e.G / geom[e.j].area;
-      if (options.with_stderr) {
-        S.innerIndexPtr()[at] = m;
-        S.valuePtr()[at] = std::sqrt(upper_var[m][k]) / geom[e.j].area;
-      }
-    }
-  }
-  for (std::int32_t i = 0; i < n; ++i) {
-    for (size_t k = 0; k < upper[i].size(); ++k) {
-      const std::int64_t at = fill[i]++;
-      F.innerIndexPtr()[at] = upper[i][k].j;
-      F.valuePtr()[at] = upper[i][k].G / geom[i].area;
-      if (options.with_stderr) {
-        S.innerIndexPtr()[at] = upper[i][k].j;
-        S.valuePtr()[at] = std::sqrt(upper_var[i][k]) / geom[i].area;
-      }
-    }
-    std::vector<UpperEntry>().swap(upper[i]);  // release memory as we go
-  }
-  for (std::int32_t i = 0; i <= n; ++i) {
-    F.outerIndexPtr()[i] = static_cast<std::int32_t>(row_start[i]);
-    if (options.with_stderr) S.outerIndexPtr()[i] = static_cast<std::int32_t>(row_start[i]);
-  }
-  out.F = std::move(F);
-  if (options.with_stderr) out.stderr_F = std::move(S);
+  upper.finish(out.F, out.stderr_F);
+  std::vector<double> area(n);
+  for (std::int32_t i = 0; i < n; ++i) area[i] = geom[i].area;
+  mirror_upper(out.F, options.with_stderr ? &out.stderr_F : nullptr, area);
   out.stats.seconds = timer.seconds();
   return out;
 }
@@ -129,13 +97,14 @@ struct EstimatorEntry {
 };
 
 // Peak of compute_pairwise for n patches, all n(n-1)/2 pairs exchanging energy (the bound:
-// a closed scene reaches it): the per-row upper lists (16-byte entries, up to 2x capacity
-// while a std::vector grows) live until the CSR F (12 bytes per entry, both triangles) is
-// filled; standard errors add 8-byte variances (2x capacity) and a CSR of the same size.
+// a closed scene reaches it): the CSR F (16 bytes per entry, both triangles), the same again
+// for standard errors, and the staging of one block of rows (a 24-byte RowEntry per pair of
+// the block, about 1/kBlocks of the pairs).
 double pairwise_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
   const double n = static_cast<double>(patches), pairs = n * (n - 1.0) / 2.0;
-  const double per_pair = 2.0 * 16.0 + 2.0 * 12.0 + (o.with_stderr ? 2.0 * 8.0 + 2.0 * 12.0 : 0.0);
-  return pairs * per_pair;
+  const double csr = 2.0 * 16.0 * (o.with_stderr ? 2.0 : 1.0);
+  const double staging = 24.0 * 2.0 / static_cast<double>(ff::kBlocks);  // 2 blocks' worth
+  return pairs * (csr + staging);
 }
 
 // Peak of compute_hemicube: a row holds at most one entry per hemicube pixel (res^2 on the
@@ -183,12 +152,12 @@ void apply_threshold(FormFactors& ff, double threshold) {
     }
   }
   // Mark dropped entries with NaN (never a form factor), then prune them.
-  for (std::int32_t k = 0; k < ff.F.nonZeros(); ++k) {
+  for (std::int64_t k = 0; k < ff.F.nonZeros(); ++k) {
     if (keep[k]) continue;
     ff.F.valuePtr()[k] = std::nan("");
     if (with_err) ff.stderr_F.valuePtr()[k] = std::nan("");
   }
-  auto not_nan = [](std::int32_t, std::int32_t, double v) { return !std::isnan(v); };
+  auto not_nan = [](Eigen::Index, Eigen::Index, double v) { return !std::isnan(v); };
   ff.F.prune(not_nan);
   if (with_err) ff.stderr_F.prune(not_nan);
 }

@@ -7,6 +7,7 @@
 #include <Eigen/SparseCore>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/sparse.hpp"
@@ -43,11 +44,25 @@ struct FormFactorStats {
 };
 
 /// The estimated matrix, optionally with per-entry standard errors (same sparsity).
+/// Moves are cheap: Eigen 3.4's SparseMatrix has no move constructor (std::move copies it),
+/// so FormFactors moves its matrices by swapping.
 struct FormFactors {
   SparseF F;
   SparseF stderr_F;  ///< empty (0 x 0) unless with_stderr
   FormFactorStats stats;
   FormFactorOptions options;  ///< the settings that produced F
+
+  FormFactors() = default;
+  FormFactors(const FormFactors&) = default;
+  FormFactors& operator=(const FormFactors&) = default;
+  FormFactors(FormFactors&& other) noexcept { *this = std::move(other); }
+  FormFactors& operator=(FormFactors&& other) noexcept {
+    F.swap(other.F);
+    stderr_F.swap(other.stderr_F);
+    stats = other.stats;
+    options = std::move(other.options);
+    return *this;
+  }
 };
 
 /// Names of the available estimators ("mc", "hybrid", ...).

@@ -365,25 +365,24 @@ FormFactors compute_hemicube(const PatchMesh& mesh, const FormFactorOptions& opt
   }
   out.stats.pairs_culled = static_cast<std::int64_t>(n) * (n - 1) / 2 - out.stats.pairs_tested;
   if (hemicube_stats) hemicube_stats->pixels = total_pixels;
-  LAMBERT_CHECK(nnz < INT32_MAX, "too many form factors for 32-bit sparse indices");
   SparseF F(n, n);
   F.resizeNonZeros(nnz);
   std::int64_t at = 0;
   for (std::int32_t i = 0; i < n; ++i) {
-    F.outerIndexPtr()[i] = static_cast<std::int32_t>(at);
+    F.outerIndexPtr()[i] = at;
     for (const RowEntry& e : rows[i]) {
       F.innerIndexPtr()[at] = e.j;
       F.valuePtr()[at++] = e.f;
     }
     std::vector<RowEntry>().swap(rows[i]);  // release memory as we go
   }
-  F.outerIndexPtr()[n] = static_cast<std::int32_t>(at);
+  F.outerIndexPtr()[n] = at;
   if (options.symmetrize) {
     std::vector<double> areas(n);
     for (std::int32_t i = 0; i < n; ++i) areas[i] = geom[i].area;
     F = symmetrize_factors(F, areas);
   }
-  out.F = std::move(F);
+  out.F.swap(F);  // Eigen 3.4 sparse matrices have no move: std::move would copy
   out.stats.seconds = timer.seconds();
   return out;
 }

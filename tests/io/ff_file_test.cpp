@@ -9,6 +9,7 @@
 
 #include "common/temp_dir.hpp"
 #include "core/error.hpp"
+#include "core/sampling.hpp"
 #include "geometry/analytic.hpp"
 
 namespace lambert {
@@ -29,7 +30,7 @@ struct Fixture {
 void expect_same(const SparseF& a, const SparseF& b) {
   ASSERT_EQ(a.rows(), b.rows());
   ASSERT_EQ(a.nonZeros(), b.nonZeros());
-  for (std::int32_t k = 0; k < a.nonZeros(); ++k) {
+  for (std::int64_t k = 0; k < a.nonZeros(); ++k) {
     ASSERT_EQ(a.innerIndexPtr()[k], b.innerIndexPtr()[k]);
     // %.17g round-trips a double exactly; the binary format stores the bits.
     ASSERT_EQ(a.valuePtr()[k], b.valuePtr()[k]);
@@ -334,6 +335,72 @@ TEST(FormFactorFile, MatrixMarketWithBadEntriesIsRefusedNamingTheLine) {
   }
   // Blank lines (a final newline, CRLF) are fine.
   EXPECT_NO_THROW(read_form_factors(dir.write("ok.mtx", head + "3 3 2\r\n1 2 0.5\r\n\r\n2 1 0.5\r\n\n"), kHash, 3));
+}
+
+}  // namespace lambert
+
+namespace lambert {
+namespace {
+
+// The file checksum (ff_file.cpp's Checksum), recomputed here to forge a version-1 file: a
+// chain over 8-byte words, restarted word alignment at each field the writer puts.
+std::uint64_t file_checksum(const std::string& bytes, const std::vector<size_t>& fields) {
+  std::uint64_t h = 0x6C616D62657274ull;
+  size_t at = 0;
+  for (const size_t size : fields) {
+    std::uint64_t word = 0;
+    size_t k = 0;
+    for (; k + 8 <= size; k += 8) {
+      std::memcpy(&word, bytes.data() + at + k, 8);
+      h = mix64(h ^ word);
+    }
+    word = 0;
+    if (k < size) {
+      std::memcpy(&word, bytes.data() + at + k, size - k);
+      h = mix64(h ^ word ^ (size - k));
+    }
+    at += size;
+  }
+  return h;
+}
+
+}  // namespace
+
+// Version 2 widened the row starts to 64 bits (nnz beyond 2^31); files written before, with
+// 32-bit row starts, must still load, to the same matrix.
+TEST(FormFactorFile, VersionOneFilesStillLoad) {
+  Fixture f;
+  testing::TempDir dir;
+  write_ff_binary(dir.file("F.bin"), f.ff, f.info);
+  const std::string v2 = bytes_of(dir.file("F.bin"));
+  std::uint32_t version = 0, len = 0;
+  std::memcpy(&version, &v2[8], 4);
+  ASSERT_EQ(version, 2u);
+  std::memcpy(&len, &v2[40], 4);
+  const size_t starts = 44 + len, n = static_cast<size_t>(f.mesh.size());
+  std::string v1 = v2.substr(0, starts);
+  const std::uint32_t one = 1;
+  std::memcpy(&v1[8], &one, 4);
+  for (size_t i = 0; i <= n; ++i) {
+    std::int64_t s = 0;
+    std::memcpy(&s, &v2[starts + 8 * i], 8);
+    const auto s32 = static_cast<std::int32_t>(s);
+    v1.append(reinterpret_cast<const char*>(&s32), 4);
+  }
+  v1.append(v2, starts + 8 * (n + 1), v2.size() - 8 - (starts + 8 * (n + 1)));
+  const size_t nnz = static_cast<size_t>(f.ff.F.nonZeros());
+  const std::uint64_t sum = file_checksum(
+      v1, {8, 4, 4, 8, 8, 8, 4, len, 4 * (n + 1), 4 * nnz, 8 * nnz, 8 * nnz});
+  v1.append(reinterpret_cast<const char*>(&sum), 8);
+  std::ofstream(dir.file("v1.bin"), std::ios::binary) << v1;
+  const FormFactors back = read_form_factors(dir.file("v1.bin"), f.info.mesh_hash, f.mesh.size());
+  expect_same(f.ff.F, back.F);
+  expect_same(f.ff.stderr_F, back.stderr_F);
+  // An unknown version is refused by number.
+  std::string v9 = v2;
+  v9[8] = 9;
+  std::ofstream(dir.file("v9.bin"), std::ios::binary) << v9;
+  EXPECT_TRUE(has(refusal<IoError>(dir.file("v9.bin"), f.mesh.size()), "version 9"));
 }
 
 }  // namespace lambert
