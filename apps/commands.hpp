@@ -31,6 +31,7 @@ struct FormFactorsOptions {
   bool with_stderr = false;
   bool by_surface = false;
   std::vector<double> point, normal;  ///< sensor point and normal (3 each) or empty
+  std::string precision = "double";   ///< --ff-precision: "double" or "float" (saved values)
 };
 /// Registers `formfactors` on the app.
 CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts);

@@ -116,6 +116,10 @@ CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts) {
   cmd->add_option("--report", opts.report, "Diagnostics JSON (default: OUTPUT with .report.json)")
       ->check(output_file_check());
   cmd->add_flag("--stderr", opts.with_stderr, "Also estimate and save per-entry standard errors (binary format)");
+  cmd->add_option("--ff-precision", opts.precision,
+                  "Saved values: double (exact) or float (half the value bytes, relative "
+                  "rounding <= 6e-8)")
+      ->check(CLI::IsMember({"double", "float"}));
   auto* by = cmd->add_flag("--by-surface", opts.by_surface, "Write the surface-to-surface view-factor table as JSON");
   auto* pt = cmd->add_option("--point", opts.point, "Sensor point X,Y,Z (differential area)")
                  ->delimiter(',')
@@ -165,12 +169,14 @@ int run_formfactors(const FormFactorsOptions& opts) {
   print_diagnostics(scene, ff, d);
   const std::string settings = settings_string(ff.options, scene);
   const std::string ext = fs::path(opts.output).extension().string();
+  const ValuePrecision precision =
+      opts.precision == "float" ? ValuePrecision::Float : ValuePrecision::Double;
   if (opts.by_surface) {
     write_json_file(opts.output, surface_json(surface_factors(scene.mesh, ff)));
   } else if (ext == ".mtx") {
-    write_matrix_market(opts.output, ff.F, {mesh_hash(scene.mesh), settings});
+    write_matrix_market(opts.output, ff.F, {mesh_hash(scene.mesh), settings}, precision);
   } else {
-    write_ff_binary(opts.output, ff, {mesh_hash(scene.mesh), settings});
+    write_ff_binary(opts.output, ff, {mesh_hash(scene.mesh), settings}, precision);
   }
   log_info("wrote " + opts.output);
   write_json_file(report, diagnostics_json(scene, ff, d, settings));

@@ -23,11 +23,12 @@ namespace {
 
 // Binary layout (little-endian), version 2:
 //   char[8]  magic "LMBRTFF\0"
-//   u32      version (2)          u32 flags (bit 0: standard errors follow the values)
+//   u32      version (2)          u32 flags (bit 0: standard errors follow the values;
+//                                            bit 1: values and errors are f32, not f64)
 //   i64      n                    i64 nnz
 //   u64      mesh hash            u32 settings length, then that many bytes (UTF-8)
 //   i64[n+1] row starts           i32[nnz] column indices       f64[nnz] values
-//   f64[nnz] standard errors (if flag bit 0)
+//   f64[nnz] standard errors (if flag bit 0)                      (f32 for both if bit 1)
 //   u64      checksum: mix64 chain over every byte above (detects truncation/corruption)
 // Version 1 (read, never written) is the same with i32 row starts, so nnz < 2^31.
 constexpr char kMagic[8] = {'L', 'M', 'B', 'R', 'T', 'F', 'F', '\0'};
@@ -186,7 +187,13 @@ std::string bad_value(double v, std::int64_t i, std::int64_t j, bool is_stderr) 
 }
 
 // Row sums against 1: Σ_j F_ij ≤ 1 + kRowSumRounding + the file's stated error (row_sum_rule).
-void check_row_sums(const FormFactors& ff, const std::string& settings, const std::string& path) {
+// `value_rounding`: the relative rounding of each stored value (0 for f64 values, which
+// kRowSumRounding covers; 2^-24 for f32), so a sum of n rounded values may exceed the
+// exact one by value_rounding times itself; `row_rounding` (text files): per row, the sum
+// of the half units in the last digit of its values as written.
+void check_row_sums(const FormFactors& ff, const std::string& settings, const std::string& path,
+                    double value_rounding = 0.0,
+                    const std::vector<double>* row_rounding = nullptr) {
   const RowSumRule rule = row_sum_rule(ff, settings);
   for (std::int32_t i = 0; rule.check && i < ff.F.outerSize(); ++i) {
     double sum = 0, err = 0;
@@ -195,7 +202,8 @@ void check_row_sums(const FormFactors& ff, const std::string& settings, const st
       sum += ff.F.valuePtr()[k];
       if (rule.with_errors) err += ff.stderr_F.valuePtr()[k];
     }
-    const double allowed = 1.0 + kRowSumRounding + kRowSumErrors * err;
+    const double allowed = 1.0 + kRowSumRounding + kRowSumErrors * err + value_rounding * sum +
+                           (row_rounding ? (*row_rounding)[i] : 0.0);
     if (sum > allowed)
       throw SceneError(path + ": row of patch " + std::to_string(i) + " sums to " +
                        value_text(sum) + ", above 1 by more than its stated error (allowed " +
@@ -246,14 +254,17 @@ std::int64_t stream_size(std::istream& in, const std::string& path) {
 }
 
 constexpr std::int64_t kBinaryHeaderBytes = 8 + 4 + 4 + 8 + 8 + 8 + 4;
+constexpr std::uint32_t kWithErrors = 1u, kFloatValues = 2u;  // header flags
+constexpr double kFloatRounding = 0x1p-24;  // relative rounding of a double stored as f32
 
 // The byte count a binary F file with this header has: header, settings, row starts,
 // columns, values (and standard errors), checksum. Fits in 64 bits for n < 2^31, nnz <= n^2.
 std::int64_t binary_size(std::uint32_t version, std::int64_t n, std::int64_t nnz,
-                         std::uint32_t len, bool with_err) {
+                         std::uint32_t len, std::uint32_t flags) {
   const std::int64_t row_start_bytes = version == 1 ? 4 : 8;
-  return kBinaryHeaderBytes + len + row_start_bytes * (n + 1) + (4 + 8) * nnz +
-         (with_err ? 8 * nnz : 0) + 8;
+  const std::int64_t value_bytes = flags & kFloatValues ? 4 : 8;
+  return kBinaryHeaderBytes + len + row_start_bytes * (n + 1) + (4 + value_bytes) * nnz +
+         (flags & kWithErrors ? value_bytes * nnz : 0) + 8;
 }
 
 FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t expected_hash,
@@ -276,12 +287,14 @@ FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t
   const auto len = r.get<std::uint32_t>();
   // Bounds before any allocation: a corrupt header must not trigger a huge allocation or
   // signed overflow (n <= INT32_MAX makes n * n fit in 64 bits).
-  if (flags > 1u) throw IoError(path + ": corrupt header: unknown flags " + std::to_string(flags));
+  const std::uint32_t known = version == 1 ? kWithErrors : kWithErrors | kFloatValues;
+  if (flags & ~known)
+    throw IoError(path + ": corrupt header: unknown flags " + std::to_string(flags));
   if (n < 0 || n > INT32_MAX || nnz < 0 || nnz > n * n || (version == 1 && nnz > INT32_MAX) ||
       len > (1u << 20))
     throw IoError(path + ": corrupt header (n " + std::to_string(n) + ", nnz " +
                   std::to_string(nnz) + ", settings length " + std::to_string(len) + ")");
-  const std::int64_t implied = binary_size(version, n, nnz, len, flags & 1u);
+  const std::int64_t implied = binary_size(version, n, nnz, len, flags);
   if (implied != file_size)
     throw IoError(path + ": " + (implied > file_size ? "truncated" : "trailing bytes") +
                   ": the header (n " + std::to_string(n) + ", nnz " + std::to_string(nnz) +
@@ -298,16 +311,23 @@ FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t
   else
     r.get_array<std::int64_t>(ff.F.outerIndexPtr(), n + 1);
   r.get_array<std::int32_t>(ff.F.innerIndexPtr(), nnz);
-  r.get(ff.F.valuePtr(), sizeof(double) * nnz);
-  if (flags & 1u) {
+  const bool f32 = flags & kFloatValues;
+  if (f32)
+    r.get_array<float>(ff.F.valuePtr(), nnz);
+  else
+    r.get(ff.F.valuePtr(), sizeof(double) * nnz);
+  if (flags & kWithErrors) {
     ff.stderr_F = ff.F;
-    r.get(ff.stderr_F.valuePtr(), sizeof(double) * nnz);
+    if (f32)
+      r.get_array<float>(ff.stderr_F.valuePtr(), nnz);
+    else
+      r.get(ff.stderr_F.valuePtr(), sizeof(double) * nnz);
   }
   const std::uint64_t computed = r.checksum();
   const auto stored = r.get<std::uint64_t>();
   if (stored != computed) throw IoError(path + ": form-factor file is corrupt (checksum mismatch)");
   check_binary_entries(ff, path);
-  check_row_sums(ff, settings, path);
+  check_row_sums(ff, settings, path, f32 ? kFloatRounding : 0.0);
   if (info) *info = {hash, settings};
   return ff;
 }
@@ -320,7 +340,26 @@ struct MmEntry {
   std::int32_t i, j;  // 0-based
   double v;
   int line;
+  double half_ulp;  // half a unit in the last decimal digit written: the text's rounding
 };
+
+// Half a unit in the last digit of a decimal number as written ("0.1234" -> 5e-5,
+// "1.5e-3" -> 5e-5, "3" -> 0.5), so a sum of written values is within the sum of these of
+// the values before they were written.
+double half_unit_in_last_digit(std::string_view text) {
+  const size_t e = text.find_first_of("eE");
+  const std::string_view mantissa = text.substr(0, e);
+  const size_t dot = mantissa.find('.');
+  const int decimals = dot == std::string_view::npos ? 0 : static_cast<int>(mantissa.size() - dot - 1);
+  long exponent = 0;
+  if (e != std::string_view::npos) {
+    const std::string_view ex = text.substr(e + 1);
+    const bool plus = !ex.empty() && ex[0] == '+';
+    std::from_chars(ex.data() + plus, ex.data() + ex.size(), exponent);
+  }
+  exponent = std::clamp<long>(exponent - decimals, -400, 400);
+  return 0.5 * std::pow(10.0, static_cast<double>(exponent));
+}
 
 bool equal_ignoring_case(std::string_view a, std::string_view b) {
   if (a.size() != b.size()) return false;
@@ -382,12 +421,15 @@ MmEntry parse_mm_entry(const LineReader& lines, std::string_view line, std::int6
                      ") out of range [1, " + std::to_string(n) + "]");
   why = bad_value(v, i, j, false);
   if (!why.empty()) throw SceneError(lines.where() + ": " + why);
-  return {static_cast<std::int32_t>(i - 1), static_cast<std::int32_t>(j - 1), v, lines.line_number()};
+  return {static_cast<std::int32_t>(i - 1), static_cast<std::int32_t>(j - 1), v, lines.line_number(),
+          half_unit_in_last_digit(tok[2])};
 }
 
 // F from entries sorted by (row, column), refusing a repeated entry (Matrix Market would
-// sum them; a form-factor file never has any).
-SparseF assemble_mm(std::vector<MmEntry>& entries, std::int64_t n, const std::string& path) {
+// sum them; a form-factor file never has any). `rounding` gets each row's sum of half_ulp.
+SparseF assemble_mm(std::vector<MmEntry>& entries, std::int64_t n, const std::string& path,
+                    std::vector<double>& rounding) {
+  rounding.assign(static_cast<size_t>(n), 0.0);
   std::sort(entries.begin(), entries.end(), [](const MmEntry& a, const MmEntry& b) {
     return a.i != b.i ? a.i < b.i : a.j != b.j ? a.j < b.j : a.line < b.line;
   });
@@ -404,6 +446,7 @@ SparseF assemble_mm(std::vector<MmEntry>& entries, std::int64_t n, const std::st
     ++outer[e.i + 1];
     F.innerIndexPtr()[k] = e.j;
     F.valuePtr()[k] = e.v;
+    rounding[e.i] += e.half_ulp;
   }
   for (std::int64_t i = 0; i < n; ++i) outer[i + 1] += outer[i];
   return F;
@@ -445,8 +488,9 @@ FormFactors read_matrix_market(std::istream& in, const std::string& path,
     throw IoError(path + ": truncated: " + std::to_string(entries.size()) + " of " +
                   std::to_string(nnz) + " entries");
   FormFactors ff;
-  ff.F = assemble_mm(entries, rows, path);
-  check_row_sums(ff, meta.settings, path);
+  std::vector<double> rounding;
+  ff.F = assemble_mm(entries, rows, path, rounding);
+  check_row_sums(ff, meta.settings, path, 0.0, &rounding);
   if (info) *info = meta;
   return ff;
 }
@@ -513,7 +557,11 @@ bool parse_ff_settings(const std::string& text, FormFactorOptions& options) {
   return true;
 }
 
-void write_matrix_market(const std::string& path, const SparseF& F, const FormFactorFileInfo& info) {
+void write_matrix_market(const std::string& path, const SparseF& F, const FormFactorFileInfo& info,
+                         ValuePrecision precision) {
+  // %.17g round-trips a double; float precision writes 9 significant digits (a float's
+  // worth), whose rounding the reader allows for in row sums (half_unit_in_last_digit).
+  const bool f32 = precision == ValuePrecision::Float;
   write_stream_atomically(path, [&](std::ostream& out) {
     char buf[96];
     out << "%%MatrixMarket matrix coordinate real general\n";
@@ -524,14 +572,21 @@ void write_matrix_market(const std::string& path, const SparseF& F, const FormFa
     out << F.rows() << ' ' << F.cols() << ' ' << F.nonZeros() << '\n';
     for (std::int32_t i = 0; i < F.outerSize(); ++i) {
       for (SparseF::InnerIterator it(F, i); it; ++it) {
-        std::snprintf(buf, sizeof buf, "%d %d %.17g\n", i + 1, static_cast<int>(it.col()) + 1, it.value());
+        if (f32)
+          std::snprintf(buf, sizeof buf, "%d %d %.9g\n", i + 1, static_cast<int>(it.col()) + 1,
+                        it.value());
+        else
+          std::snprintf(buf, sizeof buf, "%d %d %.17g\n", i + 1, static_cast<int>(it.col()) + 1,
+                        it.value());
         out << buf;
       }
     }
   });
 }
 
-void write_ff_binary(const std::string& path, const FormFactors& ff, const FormFactorFileInfo& info) {
+void write_ff_binary(const std::string& path, const FormFactors& ff, const FormFactorFileInfo& info,
+                     ValuePrecision precision) {
+  const bool f32 = precision == ValuePrecision::Float;
   LAMBERT_CHECK(ff.F.isCompressed(), "F must be compressed");
   if (!kHostIsLittleEndian)
     throw IoError(path + ": binary form-factor files are little-endian and this host is not: "
@@ -544,7 +599,7 @@ void write_ff_binary(const std::string& path, const FormFactors& ff, const FormF
         const bool err = ff.stderr_F.nonZeros() == nnz && nnz > 0;
         w.put(kMagic, 8);
         w.put(kVersion);
-        w.put(static_cast<std::uint32_t>(err ? 1u : 0u));
+        w.put(static_cast<std::uint32_t>((err ? kWithErrors : 0u) | (f32 ? kFloatValues : 0u)));
         w.put(n);
         w.put(nnz);
         w.put(info.mesh_hash);
@@ -552,8 +607,13 @@ void write_ff_binary(const std::string& path, const FormFactors& ff, const FormF
         w.put(info.settings.data(), info.settings.size());
         w.put_array<std::int64_t>(ff.F.outerIndexPtr(), n + 1);
         w.put_array<std::int32_t>(ff.F.innerIndexPtr(), nnz);  // columns < n <= 2^31
-        w.put(ff.F.valuePtr(), sizeof(double) * nnz);
-        if (err) w.put(ff.stderr_F.valuePtr(), sizeof(double) * nnz);
+        if (f32) {
+          w.put_array<float>(ff.F.valuePtr(), nnz);
+          if (err) w.put_array<float>(ff.stderr_F.valuePtr(), nnz);
+        } else {
+          w.put(ff.F.valuePtr(), sizeof(double) * nnz);
+          if (err) w.put(ff.stderr_F.valuePtr(), sizeof(double) * nnz);
+        }
         const std::uint64_t sum = w.checksum();
         out.write(reinterpret_cast<const char*>(&sum), sizeof sum);
       },

@@ -29,12 +29,21 @@ std::string format_ff_settings(const FormFactorOptions& options);
 /// hemicube only; the other estimators ignore them).
 bool parse_ff_settings(const std::string& text, FormFactorOptions& options);
 
+/// How saved values are stored: Double (exact), or Float (--ff-precision float: half the
+/// value bytes; each value and error rounded to the nearest float, a relative error of at
+/// most 2^-24 = 6e-8, far below the statistical error of any estimate, and row sums by at
+/// most 6e-8 of themselves). Reading always gives doubles.
+enum class ValuePrecision { Double, Float };
+
 /// Writes F in Matrix Market coordinate real general format (1-based), atomically. The
-/// header comments carry the mesh hash and the settings.
-void write_matrix_market(const std::string& path, const SparseF& F, const FormFactorFileInfo& info);
+/// header comments carry the mesh hash and the settings. Float writes 9 significant digits
+/// (relative rounding <= 5e-9).
+void write_matrix_market(const std::string& path, const SparseF& F, const FormFactorFileInfo& info,
+                         ValuePrecision precision = ValuePrecision::Double);
 
 /// Writes F (and its standard errors when present) in lambert's binary format, atomically.
-void write_ff_binary(const std::string& path, const FormFactors& ff, const FormFactorFileInfo& info);
+void write_ff_binary(const std::string& path, const FormFactors& ff, const FormFactorFileInfo& info,
+                     ValuePrecision precision = ValuePrecision::Double);
 
 /// Reads a saved F (binary or Matrix Market, by content) and checks that it was made from
 /// the same meshed scene: throws SceneError naming the file if the hash or size differ or

@@ -404,3 +404,58 @@ TEST(FormFactorFile, VersionOneFilesStillLoad) {
 }
 
 }  // namespace lambert
+
+namespace lambert {
+
+// --ff-precision float: every value and error comes back as the nearest float (relative
+// change <= 2^-24), the header says so, and the value arrays take half the bytes.
+TEST(FormFactorFile, FloatPrecisionStoresTheNearestFloats) {
+  Fixture f;
+  testing::TempDir dir;
+  write_ff_binary(dir.file("d.bin"), f.ff, f.info);
+  write_ff_binary(dir.file("f.bin"), f.ff, f.info, ValuePrecision::Float);
+  const FormFactors back = read_form_factors(dir.file("f.bin"), f.info.mesh_hash, f.mesh.size());
+  ASSERT_EQ(back.F.nonZeros(), f.ff.F.nonZeros());
+  ASSERT_EQ(back.stderr_F.nonZeros(), f.ff.F.nonZeros());
+  for (std::int64_t k = 0; k < f.ff.F.nonZeros(); ++k) {
+    ASSERT_EQ(back.F.innerIndexPtr()[k], f.ff.F.innerIndexPtr()[k]);
+    EXPECT_EQ(back.F.valuePtr()[k], static_cast<double>(static_cast<float>(f.ff.F.valuePtr()[k])));
+    EXPECT_LE(std::abs(back.F.valuePtr()[k] - f.ff.F.valuePtr()[k]), 0x1p-24 * f.ff.F.valuePtr()[k]);
+    EXPECT_EQ(back.stderr_F.valuePtr()[k],
+              static_cast<double>(static_cast<float>(f.ff.stderr_F.valuePtr()[k])));
+  }
+  const auto nnz = static_cast<std::int64_t>(f.ff.F.nonZeros());
+  EXPECT_EQ(static_cast<std::int64_t>(bytes_of(dir.file("d.bin")).size() -
+                                      bytes_of(dir.file("f.bin")).size()),
+            2 * 4 * nnz);  // values and errors: 8 -> 4 bytes each
+  // Matrix Market with float precision: 9 significant digits, a relative change of at most
+  // 5e-9; the reader allows row sums that rounding (a 4-sample F of the unit cube has rows
+  // just above 1).
+  write_matrix_market(dir.file("f.mtx"), f.ff.F, f.info, ValuePrecision::Float);
+  const FormFactors mm = read_form_factors(dir.file("f.mtx"), f.info.mesh_hash, f.mesh.size());
+  for (std::int64_t k = 0; k < f.ff.F.nonZeros(); ++k)
+    EXPECT_LE(std::abs(mm.F.valuePtr()[k] - f.ff.F.valuePtr()[k]), 5e-9 * f.ff.F.valuePtr()[k]);
+}
+
+}  // namespace lambert
+
+namespace lambert {
+
+// A foreign Matrix Market file written with 6 significant digits (View3D-style output):
+// its row sums may exceed 1 by the rounding of the digits written, and no more.
+TEST(FormFactorFile, TextRowSumsAllowTheRoundingOfTheDigitsWritten) {
+  testing::TempDir dir;
+  const auto mm = [&](const std::string& a, const std::string& b) {
+    const std::string path = dir.file("v.mtx");
+    std::ofstream(path) << "%%MatrixMarket matrix coordinate real general\n3 3 2\n1 2 " << a
+                        << "\n1 3 " << b << "\n";
+    return path;
+  };
+  // 0.500001 + 0.500000 = 1 + 1e-6: within the two half units of 5e-7 each.
+  EXPECT_NO_THROW(read_form_factors(mm("0.500001", "0.500000"), 0, -1));
+  EXPECT_NO_THROW(read_form_factors(mm("5.00001e-1", "5e-1"), 0, -1));  // 5e-7 + 5e-2 allowed
+  // 0.500002 + 0.500000 = 1 + 2e-6 is above 1 + 1e-6 + 1e-9.
+  EXPECT_THROW(read_form_factors(mm("0.500002", "0.500000"), 0, -1), SceneError);
+}
+
+}  // namespace lambert
