@@ -9,16 +9,13 @@
 // Usage: formfactors_bench [--quick] [--sizes 2000,10000,30000] [--samples K] [-j N]
 // Medians over repeats are quoted; the machine is shared, so compare ratios.
 
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <string>
 #include <vector>
 
+#include "bench/child.hpp"
 #include "core/log.hpp"
 #include "core/parallel.hpp"
 #include "core/sampling.hpp"
@@ -88,27 +85,16 @@ struct ChildResult {
 
 // Runs one fill in a forked child and returns its time and peak RSS.
 ChildResult fill_in_child(std::int64_t patches, const FormFactorOptions& o) {
-  int fd[2];
-  if (pipe(fd) != 0) return {};
-  const pid_t pid = fork();
-  if (pid == 0) {
-    close(fd[0]);
-    const PatchMesh mesh = cornell(patches);
-    const FormFactors ff = compute_form_factors(mesh, o);
-    ChildResult r{ff.stats.seconds, static_cast<double>(ff.stats.rays),
-                  static_cast<double>(ff.F.nonZeros()), mesh.size(), 0};
-    if (write(fd[1], &r, sizeof r) != sizeof r) _exit(1);
-    _exit(0);
-  }
-  close(fd[1]);
-  ChildResult r;
-  const bool ok = read(fd[0], &r, sizeof r) == sizeof r;
-  close(fd[0]);
-  int status = 0;
-  struct rusage ru;
-  wait4(pid, &status, 0, &ru);
-  if (!ok) return {};
-  r.max_rss_kb = ru.ru_maxrss;
+  long rss = 0;
+  ChildResult r = run_in_child<ChildResult>(
+      [&] {
+        const PatchMesh mesh = cornell(patches);
+        const FormFactors ff = compute_form_factors(mesh, o);
+        return ChildResult{ff.stats.seconds, static_cast<double>(ff.stats.rays),
+                           static_cast<double>(ff.F.nonZeros()), mesh.size(), 0};
+      },
+      rss);
+  r.max_rss_kb = rss;
   return r;
 }
 

@@ -11,10 +11,6 @@
 // Usage: scale_bench [--sizes 10000,30000,100000] [--rays K] [-j N] [--scenes cornell,room]
 // The machine is shared: compare ratios, and rerun for medians.
 
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -22,6 +18,7 @@
 #include <vector>
 
 #include "apps/problem.hpp"
+#include "bench/child.hpp"
 #include "core/log.hpp"
 #include "core/parallel.hpp"
 #include "core/sampling.hpp"
@@ -207,24 +204,9 @@ CaseResult run_case(const std::string& scene_name, std::int64_t target, int rays
 }
 
 CaseResult in_child(const std::string& scene, std::int64_t target, int rays, int threads) {
-  int fd[2];
-  if (pipe(fd) != 0) return {};
-  const pid_t pid = fork();
-  if (pid == 0) {
-    close(fd[0]);
-    const CaseResult r = run_case(scene, target, rays, threads);
-    if (write(fd[1], &r, sizeof r) != sizeof r) _exit(1);
-    _exit(0);
-  }
-  close(fd[1]);
-  CaseResult r;
-  const bool ok = read(fd[0], &r, sizeof r) == sizeof r;
-  close(fd[0]);
-  int status = 0;
-  struct rusage ru;
-  wait4(pid, &status, 0, &ru);
-  if (!ok) return {};
-  r.max_rss_kb = ru.ru_maxrss;
+  long rss = 0;
+  CaseResult r = run_in_child<CaseResult>([&] { return run_case(scene, target, rays, threads); }, rss);
+  r.max_rss_kb = rss;
   return r;
 }
 
