@@ -77,15 +77,20 @@ class Preconditioner {
     kind_ = name == "none" ? Kind::None : name == "ilut" ? Kind::Ilut : Kind::Diagonal;
     if (kind_ == Kind::Diagonal) inverse_diagonal_ = a.diagonal.cwiseInverse();
     if (kind_ == Kind::Ilut) {
-      const SparseRowMatrix k = assemble_k(sys, "the ilut preconditioner");
-      // Eigen's IncompleteLUT keeps 32-bit indices here (its own factor storage).
-      if (k.nonZeros() > std::numeric_limits<int>::max())
-        throw UsageError("the ilut preconditioner supports at most 2^31 entries of K; use "
-                         "--preconditioner diagonal");
+      // Eigen's IncompleteLUT works in 32-bit indices (its own factor storage and AMD
+      // ordering), so K is handed over as a 32-bit column-major copy, whatever F's index.
+      Eigen::SparseMatrix<double, Eigen::ColMajor, int> k32;
+      {
+        const SparseRowMatrix k = assemble_k(sys, "the ilut preconditioner");
+        if (static_cast<std::int64_t>(k.nonZeros()) > std::numeric_limits<int>::max())
+          throw UsageError("the ilut preconditioner supports at most 2^31 - 1 entries of K; "
+                           "use --preconditioner diagonal");
+        k32 = k;
+      }
       ilut_ = std::make_unique<Eigen::IncompleteLUT<double, int>>();
       ilut_->setDroptol(1e-3);  // drops entries below 1e-3 of their row's norm
       ilut_->setFillfactor(1);  // at most the original row count per factor row
-      ilut_->compute(k);
+      ilut_->compute(k32);
       return ilut_->info() == Eigen::Success;
     }
     return true;
