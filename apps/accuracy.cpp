@@ -179,7 +179,6 @@ std::vector<SurfaceRadiosity> solve_surfaces(const PatchMesh& mesh, const Sparse
   SolveOptions so;
   so.tol = kSolveTol;
   so.threads = threads;
-  so.record_history = false;
   const RadiositySolution sol = solve_radiosity(problem, so);
   if (sol.status != SolveStatus::Converged)
     log_warn(std::string("accuracy: radiosity solve ended with status ") + to_string(sol.status));

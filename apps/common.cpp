@@ -17,6 +17,7 @@
 #include "core/log.hpp"
 #include "core/memory.hpp"
 #include "io/obj_loader.hpp"
+#include "solvers/radiosity.hpp"
 
 namespace lambert {
 namespace {
@@ -83,9 +84,9 @@ std::string probe_directory(const std::filesystem::path& dir) {
   return "";
 }
 
-// The memory limit of a job in bytes: --max-memory, $LAMBERT_MAX_MEMORY or MemAvailable,
-// with where it came from; nullopt = no check.
-std::optional<std::pair<double, std::string>> memory_limit(const std::string& option) {
+}  // namespace
+
+std::optional<MemoryLimit> job_memory_limit(const std::string& option) {
   std::string text = option, from = "--max-memory";
   if (text.empty()) {
     const char* env = std::getenv("LAMBERT_MAX_MEMORY");
@@ -97,15 +98,13 @@ std::optional<std::pair<double, std::string>> memory_limit(const std::string& op
   if (text.empty()) {
     const auto available = available_memory_bytes();
     if (!available) return std::nullopt;
-    return std::make_pair(*available, std::string("MemAvailable"));
+    return MemoryLimit{*available, "MemAvailable"};
   }
   const auto bytes = parse_size(text);
   if (!bytes) throw UsageError(from + ": '" + text + "' is not a size such as 512M or 8G");
   if (*bytes == 0) return std::nullopt;
-  return std::make_pair(*bytes, from + " " + text);
+  return MemoryLimit{*bytes, from + " " + text};
 }
-
-}  // namespace
 
 CLI::Validator finite_number(double lo, double hi, bool open_low) {
   const std::string range =
@@ -168,15 +167,24 @@ void check_job_files(const std::vector<NamedFile>& inputs, const std::vector<Nam
 }
 
 void check_job_memory(std::int64_t patches, const JobPlan& plan) {
-  const auto limit = memory_limit(plan.max_memory);
+  const auto limit = job_memory_limit(plan.max_memory);
   if (!limit) return;
   const double mesh = mesh_peak_bytes(patches);
   const double ff = plan.ff ? form_factor_peak_bytes(patches, *plan.ff) : 0.0;
-  if (mesh + ff <= limit->first) return;
-  throw UsageError("this job needs about " + format_bytes(mesh + ff) + " (" +
+  // direct's factorisation at the all-pairs bound (nnz = N^2: a dense LU); for a loaded F its
+  // real nnz is checked by the solver once the file is read.
+  const bool direct = plan.direct && plan.ff && patches <= std::numeric_limits<std::int32_t>::max();
+  const auto n = static_cast<std::int32_t>(direct ? patches : 0);
+  const std::int64_t all_pairs = static_cast<std::int64_t>(n) * n;
+  const std::string why = direct ? direct_refusal(n, all_pairs, limit->bytes, limit->source) : "";
+  if (!why.empty()) throw UsageError(why);
+  const double lu = direct ? direct_memory_bytes(n, all_pairs) : 0.0;
+  if (mesh + ff + lu <= limit->bytes) return;
+  throw UsageError("this job needs about " + format_bytes(mesh + ff + lu) + " (" +
                    std::to_string(patches) + " patches: mesh " + format_bytes(mesh) +
                    (plan.ff ? ", form factors " + format_bytes(ff) + " at the all-pairs bound" : "") +
-                   ") but the limit is " + format_bytes(limit->first) + " (" + limit->second +
+                   (direct ? ", direct's LU " + format_bytes(lu) : "") +
+                   ") but the limit is " + format_bytes(limit->bytes) + " (" + limit->source +
                    "): use fewer --patches or a larger --max-edge (--threshold does not lower the "
                    "peak), or set --max-memory / LAMBERT_MAX_MEMORY (0 = no check)");
 }

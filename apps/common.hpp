@@ -89,7 +89,20 @@ struct JobPlan {
   std::vector<NamedFile> outputs;  ///< every file the command may write
   std::optional<FormFactorOptions> ff;  ///< F that will be computed here (none: loaded or unused)
   std::string max_memory;          ///< RunArgs::max_memory
+  bool direct = false;  ///< the job solves with `direct`: its factorisation is counted (for a
+                        ///< computed F, at the all-pairs bound: a dense LU of N patches)
 };
+
+/// The memory a job may use, and where that limit comes from ("--max-memory 512M",
+/// "LAMBERT_MAX_MEMORY 1G" or "MemAvailable").
+struct MemoryLimit {
+  double bytes = 0.0;
+  std::string source;
+};
+
+/// The job's limit: --max-memory (`max_memory`), else $LAMBERT_MAX_MEMORY, else MemAvailable;
+/// nullopt for "0" or where none is known. Throws UsageError for a malformed size.
+std::optional<MemoryLimit> job_memory_limit(const std::string& max_memory);
 
 /// A plan with the run's --max-memory and nothing else.
 JobPlan job_plan(const RunArgs& run);
@@ -100,8 +113,10 @@ JobPlan job_plan(const RunArgs& run);
 void check_job_files(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs);
 
 /// Refuses (UsageError) a job whose estimated peak memory (mesh_peak_bytes, and
-/// form_factor_peak_bytes for plan.ff) exceeds the limit: --max-memory, else
-/// $LAMBERT_MAX_MEMORY, else MemAvailable (no check where none is known; "0" = no check).
+/// form_factor_peak_bytes for plan.ff, and direct_memory_bytes at the all-pairs bound for
+/// plan.direct with plan.ff) exceeds the limit: --max-memory, else $LAMBERT_MAX_MEMORY, else
+/// MemAvailable (no check where none is known; "0" = no check). When direct's factorisation
+/// alone is above the limit, the message is direct_refusal's.
 void check_job_memory(std::int64_t patches, const JobPlan& plan);
 
 /// Loads the scene (or the built-in Cornell box) with the loading options.

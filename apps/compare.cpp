@@ -18,12 +18,74 @@ namespace {
 // One solver's row of the comparison (channels aggregated).
 struct CompareRow {
   std::string solver;
+  std::string skipped;  ///< why the solver was not run ("" = it ran)
   RadiositySolution solution;
   int iterations = 0;        ///< summed over channels
   std::int64_t matvecs = 0;  ///< summed over channels
   double residual = 0.0;     ///< worst channel
-  double max_diff = 0.0;     ///< max_i,c |B - B_direct|
+  double max_diff = 0.0;     ///< max_i,c |B - B_reference|
 };
+
+// The solution max_diff is measured against, and its name in reports.
+struct Reference {
+  Eigen::MatrixX3d B;
+  std::string name;
+};
+
+// Tolerance of the iterative reference when direct is skipped: 100x tighter than the
+// compared solvers', but not below 1e-14, where the residual of an N ~ 1e5 system is at its
+// rounding floor (N eps ~ 2e-11 per row sum in the worst case, ~sqrt(N) eps ~ 1e-13 typical).
+double reference_tol(double tol) { return std::max(tol * 1e-2, 1e-14); }
+
+CompareRow run_row(const RadiosityProblem& problem, SolveOptions so, const std::string& name) {
+  so.solver = name;
+  log_info("compare: running " + name);
+  CompareRow row;
+  row.solver = name;
+  row.solution = solve_radiosity(problem, so);
+  for (const auto& ch : row.solution.channels) {
+    row.iterations += ch.iterations;
+    row.matvecs += ch.matvecs;
+    row.residual = std::max(row.residual, ch.residual);
+  }
+  return row;
+}
+
+// direct from the rows, or an extra direct solve; when direct is refused (`skip` says why),
+// gauss-seidel at reference_tol, or, should it not converge, the converged row with the
+// smallest residual.
+Reference find_reference(const RadiosityProblem& problem, const SolveOptions& so,
+                         const std::vector<CompareRow>& rows, const std::string& skip) {
+  for (const auto& r : rows)
+    if (r.solver == "direct" && r.skipped.empty()) return {r.solution.B, "direct"};
+  if (skip.empty()) {
+    log_info("compare: running direct for the reference solution");
+    SolveOptions o = so;
+    o.solver = "direct";
+    return {solve_radiosity(problem, o).B, "direct"};
+  }
+  SolveOptions o = so;
+  o.solver = "gauss-seidel";
+  o.tol = reference_tol(so.tol);
+  std::ostringstream name;
+  name << "gauss-seidel at tol " << o.tol;
+  log_info("compare: direct is skipped; running " + name.str() + " for the reference solution");
+  const RadiositySolution gs = solve_radiosity(problem, o);
+  if (gs.status == SolveStatus::Converged) return {gs.B, name.str()};
+  const CompareRow* best = nullptr;
+  for (const auto& r : rows)
+    if (r.skipped.empty() && r.solution.status == SolveStatus::Converged &&
+        (best == nullptr || r.residual < best->residual))
+      best = &r;
+  if (best == nullptr) {
+    log_warn("compare: no solver converged; max_diff is against " + name.str() +
+             ", which did not converge either");
+    return {gs.B, name.str() + " (not converged)"};
+  }
+  log_warn("compare: " + name.str() + " did not converge; the reference is " + best->solver +
+           ", the converged solver with the smallest residual");
+  return {best->solution.B, best->solver};
+}
 
 // The channel the plot shows: the one with the most emitted power.
 int plot_channel(const RadiosityProblem& p) {
@@ -33,13 +95,19 @@ int plot_channel(const RadiosityProblem& p) {
   return best;
 }
 
-void write_table_csv(const std::string& path, const std::vector<CompareRow>& rows) {
+void write_table_csv(const std::string& path, const std::vector<CompareRow>& rows,
+                     const std::string& reference) {
   write_stream_atomically(path, [&](std::ostream& out) {
-    out << "solver,status,iterations,matvecs,seconds,residual,max_diff_direct\n";
-    for (const auto& r : rows)
+    out << "solver,status,iterations,matvecs,seconds,residual,max_diff,reference\n";
+    for (const auto& r : rows) {
+      if (!r.skipped.empty()) {
+        out << r.solver << ",skipped,,,,,," << csv_field(r.skipped) << '\n';
+        continue;
+      }
       out << r.solver << ',' << to_string(r.solution.status) << ',' << r.iterations << ','
           << r.matvecs << ',' << csv_number(r.solution.seconds) << ',' << csv_number(r.residual)
-          << ',' << csv_number(r.max_diff) << '\n';
+          << ',' << csv_number(r.max_diff) << ',' << csv_field(reference) << '\n';
+    }
   });
 }
 
@@ -47,7 +115,7 @@ void write_history_csv(const std::string& path, const std::vector<CompareRow>& r
   write_stream_atomically(path, [&](std::ostream& out) {
     out << "solver,channel,iteration,seconds,residual\n";
     for (const auto& r : rows)
-      for (int c = 0; c < 3; ++c) {
+      for (int c = 0; c < 3 && r.skipped.empty(); ++c) {
         const ChannelReport& ch = r.solution.channels[c];
         for (size_t k = 0; k < ch.residual_history.size(); ++k)
           out << r.solver << ',' << channel_name(c) << ',' << ch.history_iteration[k] << ','
@@ -70,6 +138,7 @@ std::vector<Plot> convergence_plots(const std::vector<CompareRow>& rows, int c, 
   by_time.x_label = "seconds";
   by_iteration.y_label = by_time.y_label = "||E - K B|| / ||E||";
   for (const auto& r : rows) {
+    if (!r.skipped.empty()) continue;
     const ChannelReport& rep = r.solution.channels[c];
     PlotSeries it{r.solver, {}, rep.residual_history};
     it.x.assign(rep.history_iteration.begin(), rep.history_iteration.end());
@@ -120,49 +189,45 @@ int run_compare(const CompareOptions& opts) {
       unique_names.push_back(n);
   names = unique_names;
 
+  SolveOptions so = opts.solve;
+  so.threads = opts.run.threads;
+  set_memory_limit(so, opts.run.max_memory);
+  // direct above the job's memory limit is skipped, not refused: the others still compare.
+  const std::string skip = direct_refusal(problem.F->size(), problem.F->entries(),
+                                          so.memory_limit, so.memory_limit_source);
   std::vector<CompareRow> rows;
   for (const auto& name : names) {
-    SolveOptions so = opts.solve;
-    so.solver = name;
-    so.threads = opts.run.threads;
-    log_info("compare: running " + name);
-    CompareRow row;
-    row.solver = name;
-    row.solution = solve_radiosity(problem, so);
-    for (const auto& ch : row.solution.channels) {
-      row.iterations += ch.iterations;
-      row.matvecs += ch.matvecs;
-      row.residual = std::max(row.residual, ch.residual);
+    if (name == "direct" && !skip.empty()) {
+      log_warn("compare: skipping " + skip);
+      CompareRow row;
+      row.solver = name;
+      row.skipped = skip;
+      rows.push_back(std::move(row));
+      continue;
     }
-    rows.push_back(std::move(row));
+    rows.push_back(run_row(problem, so, name));
   }
-  // The reference: `direct` from the list, or an extra direct solve.
-  Eigen::MatrixX3d reference;
-  const auto direct = std::find_if(rows.begin(), rows.end(),
-                                   [](const CompareRow& r) { return r.solver == "direct"; });
-  if (direct != rows.end()) {
-    reference = direct->solution.B;
-  } else {
-    SolveOptions so = opts.solve;
-    so.solver = "direct";
-    so.threads = opts.run.threads;
-    log_info("compare: running direct for the reference solution");
-    reference = solve_radiosity(problem, so).B;
-  }
-  for (auto& r : rows) r.max_diff = (r.solution.B - reference).cwiseAbs().maxCoeff();
+  const Reference reference = find_reference(problem, so, rows, skip);
+  for (auto& r : rows)
+    if (r.skipped.empty()) r.max_diff = (r.solution.B - reference.B).cwiseAbs().maxCoeff();
 
   std::printf("%d patches, %lld form factors, tol %g, max-iter %d\n", loaded.mesh.size(),
               static_cast<long long>(ff.F.nonZeros()), opts.solve.tol, opts.solve.max_iterations);
   std::printf("%-13s %-15s %10s %10s %10s %12s %15s\n", "solver", "status", "iterations",
-              "mat-vecs", "time (s)", "residual", "max |B-direct|");
+              "mat-vecs", "time (s)", "residual", "max |B-ref|");
   bool all_converged = true;
   for (const auto& r : rows) {
+    if (!r.skipped.empty()) {
+      std::printf("%-13s %-15s (%s)\n", r.solver.c_str(), "skipped", r.skipped.c_str());
+      continue;
+    }
     std::printf("%-13s %-15s %10d %10lld %10.4f %12.3e %15.3e\n", r.solver.c_str(),
                 to_string(r.solution.status), r.iterations, static_cast<long long>(r.matvecs),
                 r.solution.seconds, r.residual, r.max_diff);
     all_converged = all_converged && r.solution.status == SolveStatus::Converged;
   }
-  write_table_csv(table, rows);
+  std::printf("reference for max |B-ref|: %s\n", reference.name.c_str());
+  write_table_csv(table, rows, reference.name);
   write_history_csv(history, rows);
   const auto plots = convergence_plots(rows, plot_channel(problem), opts.solve.tol);
   write_plots_svg(svg, plots);

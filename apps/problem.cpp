@@ -13,7 +13,7 @@ RadiosityProblem make_problem(const PatchMesh& mesh, const SparseRowMatrix& F) {
                      std::to_string(F.cols()) + " but the mesh has " + std::to_string(n) +
                      " patches");
   RadiosityProblem p;
-  p.F = &F;
+  p.F = std::make_shared<CsrOperator>(F);
   p.rho.resize(n, 3);
   p.emission.resize(n, 3);
   p.area.resize(n);

@@ -11,7 +11,7 @@
 
 namespace lambert {
 
-/// RadiosityProblem for `mesh` pointing at F (which must outlive it). Throws SceneError if
+/// RadiosityProblem for `mesh` with a CsrOperator over F (which must outlive it). Throws SceneError if
 /// F's size does not match the mesh.
 RadiosityProblem make_problem(const PatchMesh& mesh, const SparseRowMatrix& F);
 

@@ -66,7 +66,10 @@ int run_render(const RenderOptions& opts) {
   JobPlan plan = job_plan(opts.run);
   plan.outputs = {{"-o", opts.output}, {"--png", png}, {"--vertex-exr", opts.vertex_exr},
                   {"--ply", opts.ply}};
-  if (opts.radiosity.empty()) plan_form_factors(plan, opts.ff, opts.run);
+  if (opts.radiosity.empty()) {
+    plan_form_factors(plan, opts.ff, opts.run);
+    plan.direct = opts.solver.solver == "direct";
+  }
   else plan.inputs.push_back({"--radiosity", opts.radiosity});
   const LoadedScene loaded = load_scene(opts.scene, plan);
   const Camera camera = make_camera(loaded.scene, opts.camera);

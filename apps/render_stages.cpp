@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "apps/problem.hpp"
+#include "apps/solve_args.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
@@ -96,6 +97,7 @@ void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOpti
   check_closed_lossless(scene.mesh, F);
   SolveOptions so = solver;
   so.threads = run.threads;
+  set_memory_limit(so, run.max_memory);
   r.solution = solve_radiosity(problem, so);
   r.solve_seconds = solve_timer.seconds();
   r.B = r.solution.B;

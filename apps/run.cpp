@@ -207,6 +207,7 @@ int run_run(const RunOptions& opts) {
   plan.outputs = {{"-o", paths.image_exr}, {"-o", paths.png}, {"-o", paths.vertex_exr},
                   {"-o", paths.ply},       {"-o", report_path}};
   plan_form_factors(plan, opts.ff, opts.run);
+  plan.direct = opts.solver.solver == "direct";
   const LoadedScene loaded = load_scene(opts.scene, plan);
   const Camera camera = make_camera(loaded.scene, opts.camera);
   t.load = timer.seconds();

@@ -70,6 +70,7 @@ int run_solve(const SolveCommandOptions& opts) {
   JobPlan plan = job_plan(opts.run);
   plan.outputs = {{"-o", opts.output}, {"the summary", summary_path(opts.output)}};
   plan_form_factors(plan, opts.ff, opts.run);
+  plan.direct = opts.solve.solver == "direct";
   const LoadedScene loaded = load_scene(opts.scene, plan);
   const double load_seconds = total.seconds();
   const Timer ff_timer;
@@ -80,6 +81,7 @@ int run_solve(const SolveCommandOptions& opts) {
   check_closed_lossless(loaded.mesh, ff);
   SolveOptions so = opts.solve;
   so.threads = opts.run.threads;
+  set_memory_limit(so, opts.run.max_memory);
   const RadiositySolution sol = solve_radiosity(problem, so);
 
   const std::string json_path = summary_path(opts.output);

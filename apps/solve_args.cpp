@@ -29,6 +29,12 @@ void add_solve_options(CLI::App* cmd, SolveOptions& o, bool with_solver) {
   cmd->add_flag("--ambient", o.ambient, "southwell: add the ambient term (display estimate)");
 }
 
+void set_memory_limit(SolveOptions& o, const std::string& max_memory) {
+  const auto limit = job_memory_limit(max_memory);
+  o.memory_limit = limit ? limit->bytes : 0.0;
+  o.memory_limit_source = limit ? limit->source : "";
+}
+
 const char* channel_name(int channel) {
   static const char* kNames[] = {"R", "G", "B"};
   return kNames[channel];

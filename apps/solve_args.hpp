@@ -13,6 +13,10 @@ namespace lambert {
 /// `with_solver`) bound to `options`.
 void add_solve_options(CLI::App* cmd, SolveOptions& options, bool with_solver);
 
+/// Sets options.memory_limit / memory_limit_source from the job's limit (job_memory_limit of
+/// --max-memory), so that `direct` refuses a factorisation above it.
+void set_memory_limit(SolveOptions& options, const std::string& max_memory);
+
 /// "R", "G" or "B".
 const char* channel_name(int channel);
 

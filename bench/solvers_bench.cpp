@@ -107,7 +107,6 @@ int main(int argc, char** argv) {
     o.tol = 1e-15;
     o.max_iterations = kIterations;
     o.threads = threads;
-    o.record_history = false;
     std::vector<double> per;
     for (int rep = 0; rep < 3; ++rep) {
       const lambert::RadiositySolution s = lambert::solve_radiosity(problem, o);
@@ -136,7 +135,6 @@ int main(int argc, char** argv) {
     o.solver = name;
     o.tol = 1e-8;
     o.threads = threads;
-    o.record_history = false;
     const lambert::RadiositySolution s = lambert::solve_radiosity(problem, o);
     int its = 0;
     long long mv = 0;

@@ -26,12 +26,16 @@ const SolverEntry kSolvers[] = {
     {"southwell",
      "Southwell / progressive refinement: shoot from the largest unshot power (Cohen 1988)",
      solve_southwell},
-    {"bicgstab", "Eigen BiCGSTAB, matrix-free, --preconditioner none|diagonal|ilut",
+    {"bicgstab", "BiCGSTAB through the transport operator, --preconditioner none|diagonal|ilut",
      solve_bicgstab},
-    {"gmres", "Eigen GMRES(m) (unsupported module), --restart m, --preconditioner", solve_gmres},
-    {"cg", "Eigen conjugate gradient on the symmetric system diag(A/rho) K (needs reciprocal F)",
+    {"gmres", "restarted GMRES(m), right-preconditioned, --restart m, --preconditioner",
+     solve_gmres},
+    {"cg", "conjugate gradient on the symmetric system diag(A/rho) K (needs reciprocal F)",
      solve_cg},
-    {"direct", "Eigen SparseLU (dense LU when F is over 10% full): the reference", solve_direct},
+    {"direct",
+     "Eigen SparseLU (dense LU when F is over 10% full): the reference; refused above the "
+     "job's memory limit",
+     solve_direct},
 };
 
 const SolverEntry& find_solver(const std::string& name) {
@@ -55,6 +59,20 @@ void validate_options(const SolveOptions& o) {
   if (o.restart < 1) throw UsageError("--restart must be at least 1");
   if (o.solver == "cg" && o.preconditioner == "ilut")
     throw UsageError("cg needs a symmetric preconditioner: use --preconditioner none or diagonal");
+}
+
+// Refuses what the operator cannot do before any channel starts: the methods that factorise
+// the assembled matrix on a matrix-free operator, and direct above the memory limit.
+void check_applicable(const RadiosityProblem& p, const SolveOptions& o) {
+  const bool uses_ilut =
+      (o.solver == "bicgstab" || o.solver == "gmres") && o.preconditioner == "ilut";
+  if ((o.solver == "direct" || uses_ilut) && p.F->matrix() == nullptr)
+    throw UsageError(matrix_free_refusal(uses_ilut ? "the ilut preconditioner" : "direct"));
+  if (o.solver == "direct") {
+    const std::string why =
+        direct_refusal(p.F->size(), p.F->entries(), o.memory_limit, o.memory_limit_source);
+    if (!why.empty()) throw UsageError(why);
+  }
 }
 
 int severity(SolveStatus s) {
@@ -88,11 +106,11 @@ std::vector<std::string> solver_names() {
 }
 
 void validate_problem(const RadiosityProblem& p) {
-  if (p.F == nullptr) throw UsageError("radiosity problem without a form-factor matrix");
+  if (p.F == nullptr) throw UsageError("radiosity problem without a form-factor operator");
   const Eigen::Index n = p.area.size();
-  if (p.F->rows() != n || p.F->cols() != n || p.rho.rows() != n || p.emission.rows() != n)
-    throw UsageError("radiosity problem sizes disagree: F " + std::to_string(p.F->rows()) + "x" +
-                     std::to_string(p.F->cols()) + ", " + std::to_string(n) + " areas, " +
+  if (p.F->size() != n || p.rho.rows() != n || p.emission.rows() != n)
+    throw UsageError("radiosity problem sizes disagree: F " + std::to_string(p.F->size()) + "x" +
+                     std::to_string(p.F->size()) + ", " + std::to_string(n) + " areas, " +
                      std::to_string(p.rho.rows()) + " rho rows, " +
                      std::to_string(p.emission.rows()) + " emission rows");
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -123,14 +141,15 @@ double relative_residual(const RadiosityProblem& problem, const Eigen::MatrixX3d
 // the residual part (zero for an exact solution) and the non-reciprocity part: the second
 // sum is sum_ij (A_j F_ji - A_i F_ij) B_j after relabelling its first half, zero when
 // A_i F_ij = A_j F_ji. Both parts are computed from their definitions (not as differences),
-// so each carries only the rounding of its own sums. Cost: one product with F.
+// so each carries only the rounding of its own sums. Cost: one product with F and one pass
+// for its row sums, O(nnz); no entry is looked up by (row, column).
 EnergyBalance energy_balance(const RadiosityProblem& problem, const Eigen::MatrixX3d& B,
                              int channel) {
-  const SparseRowMatrix& F = *problem.F;
+  const TransportOperator& F = *problem.F;
   const Eigen::VectorXd b = B.col(channel);
   Eigen::VectorXd h;
-  multiply_f(F, b, h, 1);
-  const Eigen::VectorXd row_sum = F * Eigen::VectorXd::Ones(F.cols());
+  F.apply(b, h, 1);
+  const Eigen::VectorXd row_sum = F.row_sums();
   const Eigen::VectorXd& a = problem.area;
   const Eigen::VectorXd rho = problem.rho.col(channel);
   const Eigen::VectorXd e_col = problem.emission.col(channel);
@@ -149,6 +168,7 @@ RadiositySolution solve_radiosity(const RadiosityProblem& problem, const SolveOp
   const SolverEntry& entry = find_solver(options.solver);
   validate_options(options);
   validate_problem(problem);
+  check_applicable(problem, options);
   const Timer timer;
   const Eigen::Index n = problem.area.size();
   RadiositySolution sol;

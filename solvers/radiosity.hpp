@@ -5,10 +5,12 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/sparse.hpp"
+#include "solvers/operator.hpp"
 
 namespace lambert {
 
@@ -18,9 +20,12 @@ enum class SolveStatus { Converged, MaxIterations, NumericalIssue };
 /// "converged", "max-iterations" or "numerical-issue".
 const char* to_string(SolveStatus status);
 
-/// The problem: one shared F and per-patch, per-channel rho and E, and patch areas.
+/// The problem: one shared transport operator F and per-patch, per-channel rho and E, and
+/// patch areas.
 struct RadiosityProblem {
-  const SparseRowMatrix* F = nullptr;  ///< N x N form factors (row i: F_ij)
+  /// N x N form factors (row i: F_ij), e.g. a CsrOperator over an assembled F (which must
+  /// outlive the problem).
+  std::shared_ptr<const TransportOperator> F;
   Eigen::MatrixX3d rho;                ///< N x 3 reflectance, each in [0, 1]
   Eigen::MatrixX3d emission;           ///< N x 3 emitted radiosity E (W/m^2)
   Eigen::VectorXd area;                ///< N patch areas
@@ -37,7 +42,10 @@ struct SolveOptions {
   bool ambient = false;                     ///< southwell: add the ambient term for display
   int threads = 1;                          ///< threads for F x products (Gauss-Seidel/SOR/
                                             ///< Southwell sweeps are sequential); 0 = all cores
-  bool record_history = true;               ///< Krylov solvers: replay runs for the history
+  /// Bytes the job may use (0 = no limit): direct refuses a factorisation above it.
+  double memory_limit = 0.0;
+  /// Where memory_limit comes from, for messages (e.g. "--max-memory 512M").
+  std::string memory_limit_source;
 };
 
 /// Per-channel solver report.
@@ -103,8 +111,18 @@ EnergyBalance energy_balance(const RadiosityProblem& problem, const Eigen::Matri
 /// UsageError naming what is wrong.
 void validate_problem(const RadiosityProblem& problem);
 
+/// Peak bytes of `direct` on an N-patch F with `nnz` entries: the assembled K plus a dense
+/// LU (8 N^2) above 10% fill, else the SparseLU estimate (see direct.cpp).
+double direct_memory_bytes(std::int32_t n, std::int64_t nnz);
+
+/// The one-line refusal of `direct` when direct_memory_bytes exceeds `limit` bytes ("" when
+/// it fits or limit is 0); `source` names where the limit comes from.
+std::string direct_refusal(std::int32_t n, std::int64_t nnz, double limit,
+                           const std::string& source);
+
 /// Solves every channel with the chosen solver. Throws UsageError for an unknown solver or
-/// a solver that does not apply (e.g. cg with rho = 0 somewhere).
+/// a solver that does not apply (cg with ilut; direct or ilut on a matrix-free operator;
+/// direct above options.memory_limit).
 RadiositySolution solve_radiosity(const RadiosityProblem& problem, const SolveOptions& options);
 
 }  // namespace lambert

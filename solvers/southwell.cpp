@@ -6,7 +6,11 @@
 // delta = r_i / K_ii to B_i, zeroes r_i and distributes it: r_j += rho_j F_ji delta for every
 // patch j that i sees (j receives A_i F_ij delta / A_j = F_ji delta per unit area). F is stored
 // by rows, so column i comes from row i by reciprocity, F_ji = A_i F_ij / A_j: no transposed
-// copy of F is made. Cost per shot: O(nnz of row i) plus O(N) for the argmax scan.
+// copy of F is made (the loop below is visit_column_by_reciprocity, operator.hpp, written out
+// so that each r_j keeps its historical rounding: rho_j F_ij (delta A_i) / A_j).
+// The shooter: an indexed max-heap on |r_j| A_j (max_heap.hpp), updated for i and every j a
+// shot touches, so the pick is the argmax scan's (first maximum: lowest index among ties)
+// without scanning. Cost per shot: O(nnz of row i * log N).
 //
 // Reciprocity: when F is not exactly reciprocal (Monte Carlo estimates without
 // --symmetrize), the shots solve the system of the reciprocal F' instead. The true residual
@@ -22,6 +26,7 @@
 
 #include <cmath>
 
+#include "solvers/max_heap.hpp"
 #include "solvers/system.hpp"
 
 namespace lambert {
@@ -30,10 +35,7 @@ ChannelReport solve_southwell(const ChannelSystem& system, const SolveOptions& o
                               Eigen::VectorXd& B) {
   ChannelReport report;
   const std::int32_t n = system.size();
-  const SparseRowMatrix& F = *system.F;
-  const double* values = F.valuePtr();
-  const auto* inner = F.innerIndexPtr();
-  const auto* outer = F.outerIndexPtr();
+  const TransportOperator& F = *system.F;
   const Eigen::VectorXd& a = system.area;
   const Eigen::VectorXd& rho = system.rho;
   const double tol_abs = options.tol * system.e_norm;
@@ -42,6 +44,7 @@ ChannelReport solve_southwell(const ChannelSystem& system, const SolveOptions& o
   double sq = r.squaredNorm();  // ||r||^2, updated per shot, recomputed per sweep
   record(report, 0, 1.0, 0.0);
   const Timer timer;
+  IndexedMaxHeap unshot(r.cwiseAbs().cwiseProduct(a));  // unshot power |r_j| A_j
   std::int64_t touched = 0;   // F entries read by shots
   std::int64_t products = 0;  // true-residual products
   int refinements = 0;
@@ -61,7 +64,7 @@ ChannelReport solve_southwell(const ChannelSystem& system, const SolveOptions& o
       if (sq <= tol_abs * tol_abs) {
         ++products;
         Eigen::VectorXd kb;
-        multiply_f(F, B, kb, system.threads);
+        F.apply(B, kb, system.threads);
         const Eigen::VectorXd truth = system.E - B + rho.cwiseProduct(kb);
         if (truth.norm() <= tol_abs) {
           report.status = SolveStatus::Converged;
@@ -70,38 +73,35 @@ ChannelReport solve_southwell(const ChannelSystem& system, const SolveOptions& o
         // F is not reciprocal: continue from the true residual (see above).
         r = truth;
         sq = r.squaredNorm();
+        unshot.reset(r.cwiseAbs().cwiseProduct(a));
         ++refinements;
       }
       if (shot >= max_shots) break;
     }
     // Shoot from the patch with the largest unshot power.
-    std::int32_t i = 0;
-    double best = -1.0;
-    for (std::int32_t j = 0; j < n; ++j) {
-      const double power = std::abs(r[j]) * a[j];
-      if (power > best) {
-        best = power;
-        i = j;
-      }
-    }
+    const std::int32_t i = unshot.top();
     const double delta = r[i] / (1.0 - rho[i] * system.f_diag[i]);
     B[i] += delta;
     sq -= r[i] * r[i];
     r[i] = 0.0;
+    unshot.update(i, 0.0);
     const double shoot = delta * a[i];
-    for (auto k = outer[i]; k < outer[i + 1]; ++k) {
-      const std::int32_t j = inner[k];
+    // r_j += rho_j F_ji delta with F_ji = A_i F_ij / A_j (reciprocity).
+    const TransportOperator::RowSpan row = F.row(i);
+    for (std::int64_t k = 0; k < row.count; ++k) {
+      const auto j = static_cast<std::int32_t>(row.cols[k]);
       if (j == i) continue;  // the self term is in K_ii above
       const double old = r[j];
-      r[j] += rho[j] * values[k] * shoot / a[j];  // rho_j F_ji delta, F_ji = A_i F_ij / A_j
+      r[j] += rho[j] * row.values[k] * shoot / a[j];
       sq += r[j] * r[j] - old * old;
+      unshot.update(j, std::abs(r[j]) * a[j]);
     }
-    touched += outer[i + 1] - outer[i];
+    touched += row.count;
     ++shot;
   }
   report.iterations = static_cast<int>((shot + n - 1) / n);
   report.seconds = timer.seconds();
-  const std::int64_t nnz = std::max<std::int64_t>(1, F.nonZeros());
+  const std::int64_t nnz = std::max<std::int64_t>(1, F.entries());
   system.matvecs += (touched + nnz - 1) / nnz + products;
   report.residual = system.relative_residual_uncounted(B);
   if (report.history_iteration.back() != report.iterations || shot % n != 0)

@@ -14,7 +14,8 @@
 // Gauss-Seidel/SOR accumulate the "sweep residual" sum_i (d_i (g_i - B_i_old))^2, row i's
 // residual at the moment it is updated; the history records it. When it reaches tol the
 // true residual of the iterate is computed (one extra product) and decides.
-// Thread safety: sequential sweeps (Jacobi's product may use options.threads).
+// Thread safety: sequential sweeps (Jacobi's product may use options.threads). Rows come
+// from the transport operator (one call per row, the entries looped over in place).
 
 #include <algorithm>
 #include <cmath>
@@ -58,14 +59,11 @@ namespace {
 
 // One in-place SOR sweep (omega = 1: Gauss-Seidel); returns the sweep residual norm.
 double sor_sweep(const ChannelSystem& s, double omega, Eigen::VectorXd& B) {
-  const SparseRowMatrix& F = *s.F;
-  const double* values = F.valuePtr();
-  const auto* inner = F.innerIndexPtr();
-  const auto* outer = F.outerIndexPtr();
   double sq = 0.0;
   for (std::int32_t i = 0; i < s.size(); ++i) {
+    const TransportOperator::RowSpan row = s.F->row(i);
     double gather = 0.0;
-    for (auto k = outer[i]; k < outer[i + 1]; ++k) gather += values[k] * B[inner[k]];
+    for (std::int64_t k = 0; k < row.count; ++k) gather += row.values[k] * B[row.cols[k]];
     const double d = 1.0 - s.rho[i] * s.f_diag[i];
     const double r = s.E[i] + s.rho[i] * gather - B[i];  // row i of E - K B, newest values
     sq += r * r;

@@ -1,46 +1,22 @@
 #include "solvers/system.hpp"
 
-#include <algorithm>
-
-#include "core/parallel.hpp"
+#include "core/error.hpp"
 
 namespace lambert {
 
-void multiply_f(const SparseRowMatrix& F, const Eigen::VectorXd& x, Eigen::VectorXd& y,
-                int threads) {
-  const std::int32_t n = static_cast<std::int32_t>(F.rows());
-  y.resize(n);
-  const double* values = F.valuePtr();
-  const auto* inner = F.innerIndexPtr();
-  const auto* outer = F.outerIndexPtr();
-  const double* xs = x.data();
-  double* ys = y.data();
-  auto rows = [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t i = begin; i < end; ++i) {
-      double s = 0.0;
-      for (auto k = outer[i]; k < outer[i + 1]; ++k) s += values[k] * xs[inner[k]];
-      ys[i] = s;
-    }
-  };
-  // Threads only pay off when there is enough work per product (thread start ~50 us).
-  constexpr std::int64_t kMinNonZerosPerThread = 1 << 18;
-  const int workers = resolve_threads(threads);
-  if (workers <= 1 || F.nonZeros() < kMinNonZerosPerThread * 2) {
-    rows(0, n);
-  } else {
-    parallel_for(n, std::max<std::int64_t>(64, n / (8 * workers)), workers, rows);
-  }
+void ChannelSystem::apply_f(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  F->apply(x, y, threads);
+  ++matvecs;
 }
 
 void ChannelSystem::apply_k(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
-  multiply_f(*F, x, y, threads);
-  ++matvecs;
+  apply_f(x, y);
   y = x - rho.cwiseProduct(y);
 }
 
 double ChannelSystem::relative_residual_uncounted(const Eigen::VectorXd& B) const {
   Eigen::VectorXd fb;
-  multiply_f(*F, B, fb, threads);
+  F->apply(B, fb, threads);
   const double r = (E - B + rho.cwiseProduct(fb)).norm();
   return e_norm > 0.0 ? r / e_norm : r;
 }
@@ -52,7 +28,7 @@ double ChannelSystem::relative_residual(const Eigen::VectorXd& B) const {
 
 ChannelSystem make_channel_system(const RadiosityProblem& problem, int channel, int threads) {
   ChannelSystem s;
-  s.F = problem.F;
+  s.F = problem.F.get();
   s.rho = problem.rho.col(channel);
   s.E = problem.emission.col(channel);
   const double e_max = s.E.cwiseAbs().maxCoeff();
@@ -67,13 +43,40 @@ ChannelSystem make_channel_system(const RadiosityProblem& problem, int channel, 
   return s;
 }
 
-SparseRowMatrix assemble_k(const ChannelSystem& system) {
-  SparseRowMatrix K = -(system.rho.asDiagonal() * (*system.F));
+std::string matrix_free_refusal(const std::string& who) {
+  return who +
+         " needs an assembled form-factor matrix; this transport operator is matrix-free: "
+         "choose an iterative solver (and --preconditioner none or diagonal)";
+}
+
+SparseRowMatrix assemble_k(const ChannelSystem& system, const char* who) {
+  const SparseRowMatrix* F = system.F->matrix();
+  if (F == nullptr) throw UsageError(matrix_free_refusal(who));
+  SparseRowMatrix K = -(system.rho.asDiagonal() * (*F));
   SparseRowMatrix I(system.size(), system.size());
   I.setIdentity();
   K += I;
   K.makeCompressed();
   return K;
+}
+
+void record_thinned(ChannelReport& report, int& stride, int iteration, double residual,
+                    double seconds, bool force) {
+  if (!force && iteration % stride != 0) return;
+  if (static_cast<int>(report.history_iteration.size()) >= kMaxHistoryPoints) {
+    // Keep point 0 and every other point after it; future points at twice the stride.
+    auto thin = [](auto& v) {
+      size_t out = 1;
+      for (size_t k = 2; k < v.size(); k += 2) v[out++] = v[k];
+      v.resize(out);
+    };
+    thin(report.history_iteration);
+    thin(report.residual_history);
+    thin(report.time_history);
+    stride *= 2;
+    if (!force && iteration % stride != 0) return;
+  }
+  record(report, iteration, residual, seconds);
 }
 
 }  // namespace lambert

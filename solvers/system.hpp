@@ -1,6 +1,7 @@
 #pragma once
-// One colour channel of the radiosity system, K = I - diag(rho) F, applied matrix-free on the
-// shared F, and the pieces every solver shares (residual, history). Internal to solvers/.
+// One colour channel of the radiosity system, K = I - diag(rho) F, applied through the shared
+// transport operator F, and the pieces every solver shares (residual, history). Internal to
+// solvers/.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -12,15 +13,9 @@
 
 namespace lambert {
 
-/// y = F x for a row-major F, rows split over `threads` (1 = serial).
-/// Cost O(nnz(F)); bandwidth-bound (12 bytes of F per entry plus gathers of x).
-/// Thread safety: reads F and x, writes y only.
-void multiply_f(const SparseRowMatrix& F, const Eigen::VectorXd& x, Eigen::VectorXd& y,
-                int threads);
-
 /// One channel c: K = I - diag(rho) F with the shared F; counts the products it performs.
 struct ChannelSystem {
-  const SparseRowMatrix* F = nullptr;
+  const TransportOperator* F = nullptr;
   Eigen::VectorXd rho;     ///< rho_c per patch
   /// E_c per patch divided by e_scale: K B = E is linear, so the solvers work on a system
   /// whose emission is at most 1 and B is multiplied back by e_scale. Unscaled, ||E||_2
@@ -34,11 +29,13 @@ struct ChannelSystem {
   mutable std::int64_t matvecs = 0;  ///< products with F performed so far
 
   std::int32_t size() const { return static_cast<std::int32_t>(E.size()); }
+  /// y = F x with the system's threads; one counted product.
+  void apply_f(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
   /// y = K x = x - rho .* (F x); one counted product.
   void apply_k(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
   /// ||E - K B||_2 / ||E||_2 (the one stopping rule); one counted product.
   double relative_residual(const Eigen::VectorXd& B) const;
-  /// The same, without counting (for history replays and reports outside the timing).
+  /// The same, without counting (for reports outside the timing).
   double relative_residual_uncounted(const Eigen::VectorXd& B) const;
 };
 
@@ -75,7 +72,21 @@ ChannelReport solve_cg(const ChannelSystem& system, const SolveOptions& options,
 ChannelReport solve_direct(const ChannelSystem& system, const SolveOptions& options,
                            Eigen::VectorXd& B);  ///< direct (SparseLU)
 
-/// K = I - diag(rho) F assembled (one channel at a time; for direct and ILUT only).
-SparseRowMatrix assemble_k(const ChannelSystem& system);
+/// The refusal of `who` (direct, ILUT) on an operator without an assembled matrix.
+std::string matrix_free_refusal(const std::string& who);
+
+/// K = I - diag(rho) F assembled (one channel at a time; for direct and ILUT only). Throws
+/// UsageError naming `who` when the operator has no assembled matrix.
+SparseRowMatrix assemble_k(const ChannelSystem& system, const char* who);
+
+/// Appends history point k unless the history holds kMaxHistoryPoints already, in which case
+/// every other point (all but the first) is dropped first and the stride doubles: at most
+/// kMaxHistoryPoints points, evenly spaced over the iterations, first and last kept (the
+/// caller records the last one with `force`). `stride` is the caller's state, starting at 1.
+void record_thinned(ChannelReport& report, int& stride, int iteration, double residual,
+                    double seconds, bool force = false);
+
+/// Bound of record_thinned (a plot needs no more; memory stays O(1) in max-iter).
+constexpr int kMaxHistoryPoints = 1000;
 
 }  // namespace lambert

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <utility>
 
@@ -272,12 +273,61 @@ TEST(CompareCommand, WritesTableHistoriesAndPlots) {
   ASSERT_EQ(run(with_fast({"compare", "--solvers", "jacobi,cg,direct", "-o", out})), kExitOk);
   const auto table = read_lines(dir.file("compare_table.csv"));
   ASSERT_EQ(table.size(), 4u);
-  EXPECT_EQ(table[0], "solver,status,iterations,matvecs,seconds,residual,max_diff_direct");
+  EXPECT_EQ(table[0], "solver,status,iterations,matvecs,seconds,residual,max_diff,reference");
   EXPECT_EQ(table[2].rfind("cg,converged,", 0), 0u);
+  EXPECT_EQ(table[3].substr(table[3].rfind(',') + 1), "direct");
   const auto history = read_lines(dir.file("compare_history.csv"));
   EXPECT_GT(history.size(), 10u);
   EXPECT_NE(slurp(dir.file("compare_convergence.svg")).find("jacobi"), std::string::npos);
   EXPECT_GT(std::filesystem::file_size(dir.file("compare_convergence.png")), 1000u);
+}
+
+// 150 patches: a dense LU needs 8 * 150^2 = 180 KB (the Cornell box's F is ~50% full, the
+// dense path) plus K, the mesh ~75 KB (mesh_peak_bytes). 150K lets the mesh through and not
+// direct, at the plan stage (computed F: the all-pairs bound) and in the solver (loaded F).
+const std::string kBelowDirect = "150K";
+
+TEST(SolveCommand, DirectAboveTheMemoryLimitIsAUsageError) {
+  testing::TempDir dir;
+  const std::string ff = dir.file("F.bin");
+  ASSERT_EQ(run({"formfactors", "-q", "--patches", "150", "--samples", "2", "-o", ff}), kExitOk);
+  for (const std::vector<std::string>& source :
+       {std::vector<std::string>{"--patches", "150", "--samples", "2"},
+        std::vector<std::string>{"--patches", "150", "--ff", ff}}) {
+    std::vector<std::string> args = {"solve", "-q", "--solver", "direct", "--max-memory",
+                                     kBelowDirect, "-o", dir.file("B.csv")};
+    args.insert(args.end(), source.begin(), source.end());
+    ::testing::internal::CaptureStderr();
+    EXPECT_EQ(run(args), kExitUsage) << source.back();
+    const std::string err = ::testing::internal::GetCapturedStderr();
+    EXPECT_NE(err.find("direct: a dense LU of"), std::string::npos) << err;
+    EXPECT_NE(err.find("(--max-memory 150K)"), std::string::npos) << err;
+    EXPECT_NE(err.find("raise it with --max-memory or LAMBERT_MAX_MEMORY"), std::string::npos)
+        << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;  // one line
+    EXPECT_FALSE(std::filesystem::exists(dir.file("B.csv"))) << source.back();
+  }
+}
+
+TEST(CompareCommand, SkipsDirectAboveTheMemoryLimitAndSaysSo) {
+  testing::TempDir dir;
+  const std::string ff = dir.file("F.bin");
+  ASSERT_EQ(run({"formfactors", "-q", "--patches", "150", "--samples", "2", "-o", ff}), kExitOk);
+  const std::string out = dir.path().string() + "/";
+  ::testing::internal::CaptureStdout();
+  ASSERT_EQ(run({"compare", "-q", "--patches", "150", "--ff", ff, "--solvers", "jacobi,direct", "--max-memory",
+                 kBelowDirect, "-o", out}),
+            kExitOk);
+  const std::string stdout_text = ::testing::internal::GetCapturedStdout();
+  EXPECT_NE(stdout_text.find("reference for max |B-ref|: gauss-seidel at tol 1e-10"),
+            std::string::npos)
+      << stdout_text;
+  const auto table = read_lines(dir.file("compare_table.csv"));
+  ASSERT_EQ(table.size(), 3u);
+  EXPECT_EQ(table[1].rfind("jacobi,converged,", 0), 0u);
+  EXPECT_NE(table[1].find(",gauss-seidel at tol 1e-10"), std::string::npos) << table[1];
+  EXPECT_EQ(table[2].rfind("direct,skipped,,,,,,", 0), 0u) << table[2];
+  EXPECT_NE(table[2].find("direct: a dense LU of"), std::string::npos) << table[2];
 }
 
 TEST(SolversCommand, ListsEverySolver) {

@@ -6,10 +6,15 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "core/error.hpp"
 #include "core/sampling.hpp"
+#include "solvers/max_heap.hpp"
+#include "solvers/operator.hpp"
+#include "solvers/system.hpp"
 
 namespace lambert {
 namespace {
@@ -53,7 +58,7 @@ void make_enclosure(OwnedProblem& o, int n, std::uint64_t seed) {
   }
   const Eigen::MatrixXd G = d.asDiagonal() * W * d.asDiagonal();
   o.F = f_from_exchange(0.5 * (G + G.transpose()), area);
-  o.p.F = &o.F;
+  o.p.F = std::make_shared<CsrOperator>(o.F);
   o.p.area = area;
 }
 
@@ -67,7 +72,7 @@ void make_open(OwnedProblem& o, int n, std::uint64_t seed, double zero_rho_fract
   const double max_row = (area.cwiseInverse().asDiagonal() * G).rowwise().sum().maxCoeff();
   G *= 0.95 / max_row;
   o.F = f_from_exchange(G, area);
-  o.p.F = &o.F;
+  o.p.F = std::make_shared<CsrOperator>(o.F);
   o.p.area = area;
   o.p.rho.resize(n, 3);
   o.p.emission = Eigen::MatrixX3d::Zero(n, 3);
@@ -102,7 +107,6 @@ SolveOptions options_for(const std::string& solver, double tol) {
   o.tol = tol;
   o.max_iterations = 100000;
   o.omega = 1.2;
-  o.record_history = false;
   return o;
 }
 
@@ -185,7 +189,7 @@ TEST(SolveRadiosity, TwoFacingPatchesMatchClosedForm) {
   Eigen::MatrixXd F(2, 2);
   F << 0.0, f12, f21, 0.0;
   o.F = F.sparseView();
-  o.p.F = &o.F;
+  o.p.F = std::make_shared<CsrOperator>(o.F);
   o.p.area = Eigen::Vector2d(a1, a2);
   o.p.rho.resize(2, 3);
   o.p.rho << 0.5, 0.7, 0.0, 0.8, 0.3, 0.9;
@@ -238,7 +242,6 @@ TEST(SolveRadiosity, ReportedResidualIsTheTrueResidual) {
   make_open(o, 120, 5, 0.1);
   for (const auto& name : solver_names()) {
     SolveOptions opt = options_for(name, 1e-8);
-    opt.record_history = true;
     const RadiositySolution s = solve_radiosity(o.p, opt);
     for (int c = 0; c < 3; ++c) {
       const ChannelReport& r = s.channels[c];
@@ -459,6 +462,200 @@ TEST(SolveRadiosity, InvalidRequestsAreUsageErrors) {
   EXPECT_THROW(solve_radiosity(o.p, bad), UsageError);
   o.p.rho(0, 0) = 1.2;  // rho = 1 is a lossless patch, allowed; above 1 is not physical
   EXPECT_THROW(solve_radiosity(o.p, options_for("direct", 1e-8)), UsageError);
+}
+
+// The same F without its assembled matrix: what a matrix-free (e.g. hierarchical) operator
+// looks like to the solvers.
+class MatrixFreeOperator final : public TransportOperator {
+ public:
+  explicit MatrixFreeOperator(const SparseRowMatrix& F) : csr_(F) {}
+  std::int32_t size() const override { return csr_.size(); }
+  std::int64_t entries() const override { return csr_.entries(); }
+  void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y, int threads) const override {
+    csr_.apply(x, y, threads);
+  }
+  RowSpan row(std::int32_t i) const override { return csr_.row(i); }
+  Eigen::VectorXd diagonal() const override { return csr_.diagonal(); }
+  Eigen::VectorXd row_sums() const override { return csr_.row_sums(); }
+
+ private:
+  CsrOperator csr_;
+};
+
+TEST(TransportOperator, MatrixFreeOperatorSolvesAndRefusesFactorisations) {
+  OwnedProblem o;
+  make_open(o, 120, 21, 0.1);
+  RadiosityProblem free = o.p;
+  free.F = std::make_shared<MatrixFreeOperator>(o.F);
+  for (const auto& name : kIterative) {
+    const RadiositySolution a = solve_radiosity(o.p, options_for(name, 1e-9));
+    const RadiositySolution b = solve_radiosity(free, options_for(name, 1e-9));
+    EXPECT_EQ(b.status, SolveStatus::Converged) << name;
+    // The same arithmetic through the same rows: bitwise equal.
+    EXPECT_EQ(a.B, b.B) << name;
+  }
+  EXPECT_THROW(solve_radiosity(free, options_for("direct", 1e-9)), UsageError);
+  SolveOptions ilut = options_for("gmres", 1e-9);
+  ilut.preconditioner = "ilut";
+  EXPECT_THROW(solve_radiosity(free, ilut), UsageError);
+}
+
+TEST(TransportOperator, ProductIsBitwiseIndependentOfThreads) {
+  // 1000^2 * 0.6 = 600,000 entries: above the 2^19 at which apply() starts threads.
+  const int n = 1000;
+  OwnedProblem o;
+  Rng rng(5);
+  o.p.area.resize(n);
+  for (int i = 0; i < n; ++i) o.p.area[i] = 0.5 + rng.uniform();
+  o.F = f_from_exchange(random_exchange(n, 0.6, 4), o.p.area);
+  ASSERT_GT(o.F.nonZeros(), std::int64_t{1} << 19);
+  const CsrOperator F(o.F);
+  Eigen::VectorXd x(n);
+  for (int i = 0; i < n; ++i) x[i] = rng.uniform();
+  Eigen::VectorXd y1, y4;
+  F.apply(x, y1, 1);
+  F.apply(x, y4, 4);
+  EXPECT_EQ(y1, y4);
+  // Row sums and the column through reciprocity from the rows.
+  const Eigen::VectorXd sums = F.row_sums();
+  const Eigen::VectorXd ref = o.F * Eigen::VectorXd::Ones(n);
+  EXPECT_EQ(sums, ref);  // both sum each row serially in storage order
+  double worst = 0.0;
+  visit_column_by_reciprocity(F, o.p.area, 7, [&](std::int32_t j, double f_j7) {
+    // F = G / A with G symmetric: F_j7 = G_7j / A_j, recomputed as F_7j A_7 / A_j: within
+    // 4 eps relative (a division, a multiplication, a division and the stored rounding).
+    worst = std::max(worst, std::abs(f_j7 - o.F.coeff(j, 7)) / o.F.coeff(j, 7));
+  });
+  EXPECT_LE(worst, 4.0 * std::numeric_limits<double>::epsilon());
+}
+
+TEST(SouthwellHeap, TopIsTheFirstMaximumOfAScanUnderUpdates) {
+  // Keys drawn from a few values (many ties), some NaN; the scan of southwell before the
+  // heap: best = -1, first j with key > best.
+  const int n = 37;
+  Rng rng(3);
+  auto draw = [&] {
+    const double u = rng.uniform();
+    return u < 0.05 ? std::nan("") : std::floor(u * 5.0) * 0.25;
+  };
+  Eigen::VectorXd keys(n);
+  for (int j = 0; j < n; ++j) keys[j] = draw();
+  IndexedMaxHeap heap(keys);
+  auto scan = [&] {
+    std::int32_t i = 0;
+    double best = -1.0;
+    for (std::int32_t j = 0; j < n; ++j)
+      if (keys[j] > best) best = keys[j], i = j;
+    return i;
+  };
+  for (int step = 0; step < 5000; ++step) {
+    ASSERT_EQ(heap.top(), scan()) << "step " << step;
+    const auto j = static_cast<std::int32_t>(rng.uniform() * n);
+    keys[j] = step % 97 == 0 ? std::nan("") : draw();
+    heap.update(j, keys[j]);
+  }
+  keys.setConstant(std::nan(""));
+  heap.reset(keys);
+  EXPECT_EQ(heap.top(), 0);  // every key NaN: the scan's default
+}
+
+// Southwell's shots with the O(N) argmax scan, written out as the solver did before the heap:
+// N shots from B = 0, r = E, the same arithmetic in the same order.
+Eigen::VectorXd brute_force_shots(const OwnedProblem& o, int c, std::int64_t shots) {
+  const std::int32_t n = static_cast<std::int32_t>(o.p.area.size());
+  const double e_max = o.p.emission.col(c).maxCoeff();
+  const Eigen::VectorXd a = o.p.area, rho = o.p.rho.col(c), diag = o.F.diagonal();
+  Eigen::VectorXd r = o.p.emission.col(c) / e_max, B = Eigen::VectorXd::Zero(n);
+  for (std::int64_t s = 0; s < shots; ++s) {
+    std::int32_t i = 0;
+    double best = -1.0;
+    for (std::int32_t j = 0; j < n; ++j)
+      if (std::abs(r[j]) * a[j] > best) best = std::abs(r[j]) * a[j], i = j;
+    const double delta = r[i] / (1.0 - rho[i] * diag[i]);
+    B[i] += delta;
+    r[i] = 0.0;
+    const double shoot = delta * a[i];
+    for (SparseRowMatrix::InnerIterator it(o.F, i); it; ++it)
+      if (it.col() != i) r[it.col()] += rho[it.col()] * it.value() * shoot / a[it.col()];
+  }
+  return B * e_max;
+}
+
+TEST(SolveRadiosity, SouthwellShootsFromTheArgmaxOfUnshotPower) {
+  OwnedProblem o;
+  make_open(o, 90, 17, 0.1);
+  // Ties: equal areas and equal emission make many unshot powers equal at the start, so the
+  // lowest-index rule is exercised.
+  o.p.area.head(30).setConstant(1.0);
+  for (int i = 0; i < 30; ++i) o.p.emission.row(i).setConstant(i % 3 == 0 ? 2.0 : 0.0);
+  SolveOptions opt = options_for("southwell", 1e-15);  // not reached in N shots
+  opt.max_iterations = 1;                              // exactly N shots
+  const RadiositySolution s = solve_radiosity(o.p, opt);
+  for (int c = 0; c < 3; ++c) {
+    ASSERT_EQ(s.channels[c].status, SolveStatus::MaxIterations) << c;
+    // Same shooters in the same order, same arithmetic: bitwise equal.
+    EXPECT_EQ(s.B.col(c), brute_force_shots(o, c, 90)) << c;
+  }
+}
+
+TEST(SolveRadiosity, KrylovHistoryHasEveryIterationWithRealTimes) {
+  OwnedProblem o;
+  make_open(o, 150, 23, 0.1);
+  for (const std::string name : {"bicgstab", "gmres", "cg"}) {
+    const RadiositySolution s = solve_radiosity(o.p, options_for(name, 1e-10));
+    for (int c = 0; c < 3; ++c) {
+      const ChannelReport& r = s.channels[c];
+      ASSERT_EQ(r.status, SolveStatus::Converged) << name;
+      // Point 0 (the guess) and one point per iteration, well below the thinning bound.
+      ASSERT_EQ(r.history_iteration.size(), static_cast<size_t>(r.iterations) + 1) << name;
+      for (int k = 0; k <= r.iterations; ++k) EXPECT_EQ(r.history_iteration[k], k) << name;
+      EXPECT_TRUE(std::is_sorted(r.time_history.begin(), r.time_history.end())) << name;
+      EXPECT_LE(r.time_history.back(), r.seconds) << name;
+      EXPECT_EQ(r.residual_history.back(), r.residual) << name;  // the true residual
+    }
+  }
+}
+
+TEST(SolverHistory, ThinningKeepsAtMostTheBoundEvenlySpaced) {
+  ChannelReport report;
+  int stride = 1;
+  record(report, 0, 1.0, 0.0);
+  const int last = 123457;
+  for (int k = 1; k <= last; ++k) record_thinned(report, stride, k, 1.0 / k, k * 1e-6, k == last);
+  EXPECT_LE(report.history_iteration.size(), static_cast<size_t>(kMaxHistoryPoints) + 1);
+  EXPECT_GE(report.history_iteration.size(), static_cast<size_t>(kMaxHistoryPoints) / 4);
+  EXPECT_EQ(report.history_iteration.front(), 0);
+  EXPECT_EQ(report.history_iteration.back(), last);
+  EXPECT_TRUE(std::is_sorted(report.history_iteration.begin(), report.history_iteration.end()));
+  // Each point keeps its own values (iteration k was recorded with residual 1/k, time k us).
+  for (size_t p = 1; p < report.history_iteration.size(); ++p) {
+    const int k = report.history_iteration[p];
+    EXPECT_EQ(report.residual_history[p], 1.0 / k);
+    EXPECT_EQ(report.time_history[p], k * 1e-6);
+  }
+}
+
+TEST(SolveRadiosity, DirectRefusesAFactorisationAboveTheMemoryLimit) {
+  OwnedProblem o;
+  make_enclosure(o, 200, 6);  // ~60% full: the dense path
+  o.p.rho = Eigen::MatrixX3d::Constant(200, 3, 0.5);
+  o.p.emission = Eigen::MatrixX3d::Constant(200, 3, 1.0);
+  const double need = direct_memory_bytes(200, o.F.nonZeros());
+  EXPECT_GE(need, 8.0 * 200 * 200);  // the dense LU alone
+  SolveOptions opt = options_for("direct", 1e-10);
+  opt.memory_limit = 0.5 * need;
+  opt.memory_limit_source = "--max-memory test";
+  try {
+    solve_radiosity(o.p, opt);
+    ADD_FAILURE() << "direct ran above its memory limit";
+  } catch (const UsageError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("direct: a dense LU of 200 patches needs"), std::string::npos) << what;
+    EXPECT_NE(what.find("--max-memory or LAMBERT_MAX_MEMORY"), std::string::npos) << what;
+  }
+  opt.memory_limit = 2.0 * need;
+  EXPECT_EQ(solve_radiosity(o.p, opt).status, SolveStatus::Converged);
+  EXPECT_EQ(direct_refusal(200, o.F.nonZeros(), 0.0, ""), "");  // 0 = no limit
 }
 
 }  // namespace
