@@ -447,7 +447,7 @@ int run_accuracy(const AccuracyOptions& opts) {
     o.estimator = spec.estimator;
     if (spec.estimator == "hemicube") o.hemicube_resolution = spec.value;
     else o.samples = spec.value;
-    o.symmetrize = spec.symmetrize;
+    o.reciprocity = spec.symmetrize ? "average" : "none";
     AccuracyRow row;
     row.estimator = spec_name(spec);
     row.setting = spec_setting(spec);

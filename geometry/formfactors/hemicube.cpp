@@ -313,17 +313,6 @@ HemicubeDeltas hemicube_deltas(int resolution) {
   return d;
 }
 
-SparseF symmetrize_factors(const SparseF& F, const std::vector<double>& areas) {
-  const auto n = static_cast<Eigen::Index>(areas.size());
-  LAMBERT_CHECK(F.rows() == n && F.cols() == n, "symmetrize: F does not match the areas");
-  const Eigen::Map<const Eigen::VectorXd> a(areas.data(), n);
-  const SparseF G = a.asDiagonal() * F;
-  const SparseF Gt = G.transpose();
-  SparseF out = a.cwiseInverse().asDiagonal() * (0.5 * (G + Gt));
-  out.makeCompressed();
-  return out;
-}
-
 FormFactors compute_hemicube(const PatchMesh& mesh, const FormFactorOptions& options,
                              HemicubeStats* hemicube_stats) {
   if (options.hemicube_resolution < 2)
@@ -365,24 +354,20 @@ FormFactors compute_hemicube(const PatchMesh& mesh, const FormFactorOptions& opt
   }
   out.stats.pairs_culled = static_cast<std::int64_t>(n) * (n - 1) / 2 - out.stats.pairs_tested;
   if (hemicube_stats) hemicube_stats->pixels = total_pixels;
-  LAMBERT_CHECK(nnz < INT32_MAX, "too many form factors for 32-bit sparse indices");
+  LAMBERT_CHECK(nnz <= std::numeric_limits<SparseF::StorageIndex>::max(),
+                "too many form factors for the sparse index type");
   SparseF F(n, n);
   F.resizeNonZeros(nnz);
   std::int64_t at = 0;
   for (std::int32_t i = 0; i < n; ++i) {
-    F.outerIndexPtr()[i] = static_cast<std::int32_t>(at);
+    F.outerIndexPtr()[i] = static_cast<SparseF::StorageIndex>(at);
     for (const RowEntry& e : rows[i]) {
       F.innerIndexPtr()[at] = e.j;
       F.valuePtr()[at++] = e.f;
     }
     std::vector<RowEntry>().swap(rows[i]);  // release memory as we go
   }
-  F.outerIndexPtr()[n] = static_cast<std::int32_t>(at);
-  if (options.symmetrize) {
-    std::vector<double> areas(n);
-    for (std::int32_t i = 0; i < n; ++i) areas[i] = geom[i].area;
-    F = symmetrize_factors(F, areas);
-  }
+  F.outerIndexPtr()[n] = static_cast<SparseF::StorageIndex>(at);
   out.F = std::move(F);
   out.stats.seconds = timer.seconds();
   return out;

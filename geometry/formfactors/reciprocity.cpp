@@ -1,0 +1,92 @@
+// Reciprocity averaging: see reciprocity.hpp for the equations and the row-sum fix.
+
+#include "geometry/formfactors/reciprocity.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "core/error.hpp"
+
+namespace lambert::ff {
+namespace {
+
+using Index = SparseF::StorageIndex;
+
+// (diag(a) M + (diag(a) M)^T) / 2 with M = F, or for standard errors the root of
+// ((diag(a) S)² + ((diag(a) S)^T)²) / 4; both have the union of M's and M^T's patterns.
+SparseF average_G(const SparseF& M, const Eigen::VectorXd& a, bool squares) {
+  SparseF G = a.asDiagonal() * M;
+  if (squares) G = G.unaryExpr([](double v) { return v * v; });  // same pattern
+  const SparseF Gt = G.transpose();
+  SparseF H = (G + Gt) * (squares ? 0.25 : 0.5);
+  if (squares)
+    for (std::int64_t k = 0; k < H.nonZeros(); ++k) H.valuePtr()[k] = std::sqrt(H.valuePtr()[k]);
+  H.makeCompressed();
+  return H;
+}
+
+}  // namespace
+
+void average_reciprocal(SparseF& F, SparseF* stderr_F, const std::vector<double>& areas,
+                        FormFactorStats& stats) {
+  const auto n = static_cast<Eigen::Index>(areas.size());
+  LAMBERT_CHECK(F.rows() == n && F.cols() == n, "reciprocity: F does not match the areas");
+  F.makeCompressed();
+  const Eigen::Map<const Eigen::VectorXd> a(areas.data(), n);
+  SparseF H = average_G(F, a, false);
+  const bool with_err = stderr_F && stderr_F->nonZeros() == F.nonZeros() && F.nonZeros() > 0;
+  SparseF E;
+  if (with_err) {
+    stderr_F->makeCompressed();
+    E = average_G(*stderr_F, a, true);
+    LAMBERT_CHECK(E.nonZeros() == H.nonZeros(), "reciprocity: stderr pattern differs from F");
+  }
+
+  // Row sums of the averaged F and the per-row scale s_i.
+  std::vector<double> scale(n, 1.0);
+  const Index* outer = H.outerIndexPtr();
+  const Index* col = H.innerIndexPtr();
+  double* val = H.valuePtr();
+  stats.reciprocity_max_row_sum = 0.0;
+  stats.reciprocity_rows_scaled = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    double sum = 0.0;
+    for (std::int64_t k = outer[i]; k < outer[i + 1]; ++k) sum += val[k];
+    sum /= a[i];
+    stats.reciprocity_max_row_sum = std::max(stats.reciprocity_max_row_sum, sum);
+    if (sum > 1.0 + kRowSumSlack) {
+      scale[i] = 1.0 / sum;
+      ++stats.reciprocity_rows_scaled;
+    }
+  }
+
+  // Scale pairs by min(s_i, s_j), compare with the old G (a merged sweep of the sorted rows
+  // of H and F: F's pattern is a subset of H's), and divide by A_i.
+  const Index* fo = F.outerIndexPtr();
+  const Index* fc = F.innerIndexPtr();
+  const double* fv = F.valuePtr();
+  double changed = 0.0, total = 0.0, max_rel = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    std::int64_t f = fo[i];
+    for (std::int64_t k = outer[i]; k < outer[i + 1]; ++k) {
+      const Index j = col[k];
+      const double s = std::min(scale[i], scale[j]);
+      val[k] *= s;
+      double old_g = 0.0;
+      while (f < fo[i + 1] && fc[f] < j) ++f;
+      if (f < fo[i + 1] && fc[f] == j) old_g = a[i] * fv[f];
+      changed += std::abs(val[k] - old_g);
+      total += old_g;
+      if (old_g > 0.0) max_rel = std::max(max_rel, std::abs(val[k] - old_g) / old_g);
+      val[k] /= a[i];
+      if (with_err) E.valuePtr()[k] *= s / a[i];
+    }
+  }
+  stats.reciprocity_max_relative_change = max_rel;
+  stats.reciprocity_mean_relative_change = total > 0.0 ? changed / total : 0.0;
+  F = std::move(H);
+  if (with_err) *stderr_F = std::move(E);
+}
+
+}  // namespace lambert::ff
