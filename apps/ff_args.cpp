@@ -166,13 +166,22 @@ Json ff_settings_json(const FormFactorOptions& o, const std::string& loaded_from
           {"estimator_requested",
            o.estimator_requested.empty() ? Json() : Json(o.estimator_requested)},
           {"samples", known(o.samples)},
-          {"rays", known(o.rays)},
+          {"rays_per_patch", known(o.rays)},  // "rays" is the traced count in reports
           {"seed", known(o.seed)},
           {"threshold", known(o.threshold)},
           {"hemicube_resolution", known(o.hemicube_resolution)},
           {"reciprocity", known(o.reciprocity)},
           {"symmetrize", known(o.reciprocity == "average")},
           {"loaded_from", loaded_from}};
+}
+
+Json reciprocity_json(const FormFactors& ff) {
+  const FormFactorStats& st = ff.stats;
+  return {{"applied", ff.options.reciprocity == "average"},
+          {"max_relative_change", st.reciprocity_max_relative_change},
+          {"mean_relative_change", st.reciprocity_mean_relative_change},
+          {"rows_scaled", st.reciprocity_rows_scaled},
+          {"max_row_sum_before", st.reciprocity_max_row_sum}};
 }
 
 std::string ff_settings_text(const FormFactorOptions& o, const std::string& loaded_from) {

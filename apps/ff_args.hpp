@@ -64,10 +64,14 @@ void warn_about_lighting(const PatchMesh& mesh, const SparseF& F);
 void check_closed_lossless(const PatchMesh& mesh, const FormFactors& ff, bool solving = true);
 
 /// The settings that made F, for reports: {estimator (the resolved one),
-/// estimator_requested ("auto" or null), samples, rays, seed, threshold,
+/// estimator_requested ("auto" or null), samples, rays_per_patch (--rays), seed, threshold,
 /// hemicube_resolution, reciprocity, symmetrize (reciprocity == average), loaded_from} (""
 /// when computed here), every setting null when unknown (see obtain_form_factors).
 Json ff_settings_json(const FormFactorOptions& options, const std::string& loaded_from);
+
+/// What reciprocity averaging changed (FormFactorStats' reciprocity_* members): {applied,
+/// max_relative_change, mean_relative_change, rows_scaled, max_row_sum_before}.
+Json reciprocity_json(const FormFactors& ff);
 
 /// The same as one line of key=value text for image and PLY metadata: "[ff=FILE ]" followed
 /// by format_ff_settings(), or "settings=unknown".
