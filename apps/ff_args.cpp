@@ -127,11 +127,13 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
   }
   std::string recip;
   if (ff.options.reciprocity == "average") {
-    char buf[160];
+    char buf[200];
     std::snprintf(buf, sizeof buf,
-                  ", reciprocity averaged (change max %.3g, mean %.3g; %lld rows scaled to 1)",
+                  ", reciprocity averaged (change max %.3g, mean %.3g; balanced in %d sweeps; "
+                  "%lld rows capped at 1)",
                   ff.stats.reciprocity_max_relative_change,
                   ff.stats.reciprocity_mean_relative_change,
+                  ff.stats.reciprocity_balance_iterations,
                   static_cast<long long>(ff.stats.reciprocity_rows_scaled));
     recip = buf;
   }
@@ -181,6 +183,7 @@ Json reciprocity_json(const FormFactors& ff) {
           {"max_relative_change", st.reciprocity_max_relative_change},
           {"mean_relative_change", st.reciprocity_mean_relative_change},
           {"rows_scaled", st.reciprocity_rows_scaled},
+          {"balance_iterations", st.reciprocity_balance_iterations},
           {"max_row_sum_before", st.reciprocity_max_row_sum}};
 }
 

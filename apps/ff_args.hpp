@@ -70,7 +70,8 @@ void check_closed_lossless(const PatchMesh& mesh, const FormFactors& ff, bool so
 Json ff_settings_json(const FormFactorOptions& options, const std::string& loaded_from);
 
 /// What reciprocity averaging changed (FormFactorStats' reciprocity_* members): {applied,
-/// max_relative_change, mean_relative_change, rows_scaled, max_row_sum_before}.
+/// max_relative_change, mean_relative_change, rows_scaled, balance_iterations,
+/// max_row_sum_before}.
 Json reciprocity_json(const FormFactors& ff);
 
 /// The same as one line of key=value text for image and PLY metadata: "[ff=FILE ]" followed

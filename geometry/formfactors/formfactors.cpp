@@ -294,7 +294,8 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
     std::vector<double> areas(mesh.patches.size());
     for (size_t i = 0; i < areas.size(); ++i) areas[i] = mesh.patches[i].area;
     out.F.makeCompressed();
-    ff::average_reciprocal(out.F, o.with_stderr ? &out.stderr_F : nullptr, areas, out.stats);
+    ff::average_reciprocal(out.F, o.with_stderr ? &out.stderr_F : nullptr, areas, out.stats,
+                          o.threads);
     out.stats.seconds += timer.seconds();
   }
   apply_threshold(out, o.threshold);

@@ -53,9 +53,11 @@ struct FormFactorStats {
   /// mean Σ|G' - G| / ΣG over all entries.
   double reciprocity_max_relative_change = 0.0;
   double reciprocity_mean_relative_change = 0.0;
-  /// Rows whose averaged sum exceeded 1 and were scaled down, and the largest such sum.
+  /// Rows still above 1 after balancing, scaled down by the cap, and the largest row sum
+  /// before the cap; balancing sweeps made.
   std::int64_t reciprocity_rows_scaled = 0;
   double reciprocity_max_row_sum = 0.0;
+  int reciprocity_balance_iterations = 0;
 };
 
 /// The estimated matrix, optionally with per-entry standard errors (same sparsity).

@@ -90,19 +90,15 @@ TEST(FormFactorGather, EnclosedCubeRowsSumToOne) {
     EXPECT_LE(s, 1.0 + 1e-12) << "row " << i;
     EXPECT_GE(s, 1.0 - 2.0 / kRays) << "row " << i;
   }
-  // Averaged: the row sums are no longer exact, but within 4 σ of 1 (σ² = Σ stderr², the
-  // entries' errors being independent across rows and negatively correlated within one,
-  // so this overstates the row's error) and never above 1 (the row-sum fix).
+  // Averaged: balancing restores every row's own sum (reciprocity.hpp), here 1, to its
+  // tolerance 1e-12 plus the rounding of the row sum; the plain mean would miss it by the
+  // column's noise (±2 % at this K).
   const FormFactors avg = gather(mesh, kRays, 1, "average");
   for (Eigen::Index i = 0; i < mesh.size(); ++i) {
-    double s = 0.0, var = 0.0;
-    for (SparseF::InnerIterator it(avg.F, i), st(avg.stderr_F, i); it; ++it, ++st) {
-      s += it.value();
-      var += st.value() * st.value();
-    }
-    EXPECT_LE(s, 1.0 + 1e-12) << "row " << i;
-    EXPECT_NEAR(s, 1.0, 4 * std::sqrt(var)) << "row " << i;
+    const double s = row_sum(avg.F, i), raw = row_sum(ff.F, i);
+    EXPECT_NEAR(s, std::min(raw, 1.0), 1e-11) << "row " << i;
   }
+  EXPECT_EQ(avg.stats.reciprocity_rows_scaled, 0);  // nothing left for the cap
 }
 
 TEST(FormFactorGather, ErrorFallsAtLeastLikeOneOverSqrtRays) {
@@ -151,9 +147,10 @@ TEST(FormFactorGather, BacksAndMissesCountForNothing) {
 
 TEST(Reciprocity, AveragingIsReciprocalAndKeepsRowSumsAtMostOne) {
   // A small patch 0 (area 0.01) under a big one (area 4): F_01 = 0.95 and an overestimated
-  // F_10 = 0.01 (true 0.0024). The mean G = (0.0095 + 0.04) / 2 gives F_01 = 2.475 > 1;
-  // the fix scales that pair to F_01 = 1. Patch 2 (area 1) sees only patch 1, one-sided:
-  // its mirror is created.
+  // F_10 = 0.01 (true 0.0024). The plain mean G = (0.0095 + 0.04) / 2 would give
+  // F_01 = 2.475 > 1. Patch 2 (area 1) sees only patch 1, one-sided: its mirror is created.
+  // The pattern (0 - 1 - 2, a chain) cannot be balanced exactly (A_0 t_0 + A_2 t_2 would
+  // have to equal A_1 t_1), so the cap has the last word.
   const std::vector<double> areas = {0.01, 4.0, 1.0};
   SparseF F(3, 3), S(3, 3);
   F.insert(0, 1) = 0.95;
@@ -168,29 +165,40 @@ TEST(Reciprocity, AveragingIsReciprocalAndKeepsRowSumsAtMostOne) {
   ff::average_reciprocal(F, &S, areas, stats);
   ASSERT_EQ(F.nonZeros(), 4);
   ASSERT_EQ(S.nonZeros(), 4);
+  EXPECT_GT(F.coeff(1, 2), 0.0);  // the mirror
   for (int i = 0; i < 3; ++i) {
     EXPECT_LE(row_sum(F, i), 1.0 + 1e-15) << i;  // rounding of one division
-    for (SparseF::InnerIterator it(F, i); it; ++it) {
+    for (SparseF::InnerIterator it(F, i), st(S, i); it; ++it, ++st) {
       const double gij = areas[i] * it.value(), gji = areas[it.col()] * F.coeff(it.col(), i);
       EXPECT_NEAR(gij, gji, 4e-16 * gij);  // the same G divided and multiplied: 2 ulps
+      EXPECT_TRUE(std::isfinite(st.value()) && st.value() > 0.0);
+      // Errors follow their entries: A_i s_ij = A_j s_ji too.
+      EXPECT_NEAR(areas[i] * st.value(), areas[it.col()] * S.coeff(it.col(), i),
+                  4e-16 * areas[i] * st.value());
     }
   }
-  EXPECT_DOUBLE_EQ(F.coeff(0, 1), 1.0);
-  EXPECT_EQ(stats.reciprocity_rows_scaled, 1);
-  EXPECT_NEAR(stats.reciprocity_max_row_sum, 2.475, 1e-12);
-  // Pair (2, 1): G = 0.4 / 2 on both sides, untouched by the scaling.
-  EXPECT_DOUBLE_EQ(F.coeff(2, 1), 0.2);
-  EXPECT_DOUBLE_EQ(F.coeff(1, 2), 0.2 / 4.0);
-  // Its error: sqrt((1 · 0.03)² + 0²) / 2 / A_i.
-  EXPECT_DOUBLE_EQ(S.coeff(2, 1), 0.015);
-  EXPECT_DOUBLE_EQ(S.coeff(1, 2), 0.015 / 4.0);
-  // Pair (0, 1) scaled by s = 1 / 2.475: sqrt((0.01·0.01)² + (4·0.002)²) / 2 · s / 0.01.
-  EXPECT_NEAR(S.coeff(0, 1), std::hypot(1e-4, 8e-3) / 2 / 2.475 / 0.01, 1e-14);
-  // G-weighted mean change: Σ|ΔG| / ΣG over the entries.
-  const double g01 = 0.01 / 1.0, dg01 = std::abs(g01 - 0.0095), dg10 = std::abs(g01 - 0.04);
-  const double mean = (dg01 + dg10 + 0.2 + 0.2) / (0.0095 + 0.04 + 0.4);
-  EXPECT_NEAR(stats.reciprocity_mean_relative_change, mean, 1e-12);
-  EXPECT_NEAR(stats.reciprocity_max_relative_change, 0.75, 1e-12);  // |0.01 - 0.04| / 0.04
+  EXPECT_GT(stats.reciprocity_mean_relative_change, 0.0);
+  EXPECT_GT(stats.reciprocity_max_relative_change, 0.0);  // (the mean also counts created mirrors)
+}
+
+TEST(Reciprocity, BalancedPairKeepsTheMeanAndCombinesTheErrors) {
+  // Equal areas, F_01 = F_10 = 0.5: the mean is already balanced (d = 1), so the values
+  // stay and the errors combine as sqrt(s_01² + s_10²) / 2.
+  const std::vector<double> areas = {1.0, 1.0};
+  SparseF F(2, 2), S(2, 2);
+  F.insert(0, 1) = 0.5;
+  F.insert(1, 0) = 0.5;
+  S.insert(0, 1) = 0.1;
+  S.insert(1, 0) = 0.2;
+  F.makeCompressed();
+  S.makeCompressed();
+  FormFactorStats stats;
+  ff::average_reciprocal(F, &S, areas, stats);
+  EXPECT_EQ(F.coeff(0, 1), 0.5);
+  EXPECT_EQ(F.coeff(1, 0), 0.5);
+  EXPECT_DOUBLE_EQ(S.coeff(0, 1), std::hypot(0.1, 0.2) / 2);
+  EXPECT_EQ(stats.reciprocity_mean_relative_change, 0.0);
+  EXPECT_EQ(stats.reciprocity_rows_scaled, 0);
 }
 
 TEST(Reciprocity, TinyPatchUnderABigOneStaysBelowOne) {
