@@ -40,9 +40,10 @@ struct FormFactorOptions {
 
 /// What a computation did (for diagnostics and reports).
 struct FormFactorStats {
-  std::int64_t pairs_tested = 0;  ///< unordered pairs that can exchange energy
-  std::int64_t pairs_culled = 0;  ///< unordered pairs facing away from each other
-  std::int64_t rays = 0;          ///< occlusion rays traced
+  /// Unordered pairs that can exchange energy (gather: that at least one ray connected)
+  std::int64_t pairs_tested = 0;
+  std::int64_t pairs_culled = 0;  ///< the other unordered pairs (facing away; gather: unseen)
+  std::int64_t rays = 0;          ///< rays traced (occlusion; gather: closest-hit, N·K)
   /// Pairs whose visibility could not be sampled as designed (hybrid: no ray could be
   /// traced, so the unoccluded value was kept; or a kernel-sampling rejection gave up):
   /// reported and warned about, expected 0.
