@@ -97,6 +97,34 @@ std::vector<std::string> unused_count_options(const FormFactorArgs& args,
   return out;
 }
 
+namespace {
+
+// "form factors: auto picked gather (N patches >= T)", and a warning per count option the
+// picked estimator ignores.
+void log_auto_pick(const FormFactors& ff, const FormFactorArgs& args, std::int32_t patches) {
+  if (ff.options.estimator_requested != "auto") return;
+  log_info("form factors: auto picked " + ff.options.estimator + " (" + std::to_string(patches) +
+           " patches " + (ff.options.estimator == "gather" ? ">= " : "< ") +
+           std::to_string(kAutoGatherPatches) + ")");
+  for (const std::string& opt : unused_count_options(args, ff.options.estimator))
+    log_warn(opt + " is ignored: --estimator auto picked " + ff.options.estimator);
+}
+
+// ", reciprocity averaged (...)" for the summary line, or "".
+std::string reciprocity_summary(const FormFactors& ff) {
+  if (ff.options.reciprocity != "average") return "";
+  char buf[200];
+  std::snprintf(buf, sizeof buf,
+                ", reciprocity averaged (change max %.3g, mean %.3g; balanced in %d sweeps; "
+                "%lld rows capped at 1)",
+                ff.stats.reciprocity_max_relative_change, ff.stats.reciprocity_mean_relative_change,
+                ff.stats.reciprocity_balance_iterations,
+                static_cast<long long>(ff.stats.reciprocity_rows_scaled));
+  return buf;
+}
+
+}  // namespace
+
 FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& args,
                                 const RunArgs& run, bool with_stderr) {
   if (!args.ff_file.empty()) {
@@ -117,30 +145,11 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
   FormFactorOptions o = make_ff_options(args, run);
   o.with_stderr = with_stderr;
   FormFactors ff = compute_form_factors(scene.mesh, o, &scene_bvh(scene, run.threads));
-  if (ff.options.estimator_requested == "auto") {
-    log_info("form factors: auto picked " + ff.options.estimator + " (" +
-             std::to_string(scene.mesh.size()) + " patches " +
-             (ff.options.estimator == "gather" ? ">= " : "< ") +
-             std::to_string(kAutoGatherPatches) + ")");
-    for (const std::string& opt : unused_count_options(args, ff.options.estimator))
-      log_warn(opt + " is ignored: --estimator auto picked " + ff.options.estimator);
-  }
-  std::string recip;
-  if (ff.options.reciprocity == "average") {
-    char buf[200];
-    std::snprintf(buf, sizeof buf,
-                  ", reciprocity averaged (change max %.3g, mean %.3g; balanced in %d sweeps; "
-                  "%lld rows capped at 1)",
-                  ff.stats.reciprocity_max_relative_change,
-                  ff.stats.reciprocity_mean_relative_change,
-                  ff.stats.reciprocity_balance_iterations,
-                  static_cast<long long>(ff.stats.reciprocity_rows_scaled));
-    recip = buf;
-  }
+  log_auto_pick(ff, args, scene.mesh.size());
   log_info("form factors: " + std::to_string(scene.mesh.size()) + " patches, " +
            format_si(static_cast<double>(ff.F.nonZeros())) + " entries, " +
            format_si(static_cast<double>(ff.stats.rays)) + " rays in " +
-           format_duration(ff.stats.seconds) + recip);
+           format_duration(ff.stats.seconds) + reciprocity_summary(ff));
   if (ff.stats.pairs_unverified > 0)
     log_warn(std::to_string(ff.stats.pairs_unverified) +
              " patch pairs could not have their visibility sampled as designed (no ray could be "
