@@ -225,6 +225,8 @@ std::vector<RunSpec> run_specs(const AccuracyOptions& opts) {
       for (int k : opts.mc_samples) out.push_back({f, k, false});
     if (f == "hybrid")
       for (int k : opts.hybrid_samples) out.push_back({f, k, false});
+    if (f == "gather")
+      for (int k : opts.gather_rays) out.push_back({f, k, false});
     if (f == "hemicube")
       for (int r : opts.hemicube_res) {
         out.push_back({f, r, false});
@@ -236,7 +238,8 @@ std::vector<RunSpec> run_specs(const AccuracyOptions& opts) {
 
 std::string spec_name(const RunSpec& s) { return s.symmetrize ? s.estimator + "-sym" : s.estimator; }
 std::string spec_setting(const RunSpec& s) {
-  return (s.estimator == "hemicube" ? "N=" : "k=") + std::to_string(s.value);
+  return (s.estimator == "hemicube" ? "N=" : s.estimator == "gather" ? "K=" : "k=") +
+         std::to_string(s.value);
 }
 
 void write_table_csv(const std::string& path, const Study& study, const std::vector<AccuracyRow>& rows) {
@@ -351,9 +354,10 @@ CLI::App* add_accuracy_command(CLI::App& app, AccuracyOptions& opts) {
   add_scene_options(cmd, opts.scene);
   cmd->add_option("--case", opts.analytic_case, "Built-in analytic case instead of SCENE")
       ->check(CLI::IsMember({"parallel_squares", "perpendicular_squares", "unit_cube", "coaxial_disks"}));
-  cmd->add_option("--estimators", opts.estimators, "Estimator families to run (default: all)")
+  cmd->add_option("--estimators", opts.estimators,
+                  "Estimator families to run (default: mc, hybrid, hemicube; gather on request)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"mc", "hybrid", "hemicube"}));
+      ->check(CLI::IsMember(form_factor_estimators()));
   cmd->add_option("--mc-samples", opts.mc_samples, "Sample counts for mc")
       ->delimiter(',')
       ->check(CLI::Range(1, 1 << 20))
@@ -361,6 +365,10 @@ CLI::App* add_accuracy_command(CLI::App& app, AccuracyOptions& opts) {
   cmd->add_option("--hybrid-samples", opts.hybrid_samples, "Sample counts for hybrid")
       ->delimiter(',')
       ->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
+  cmd->add_option("--gather-rays", opts.gather_rays, "Rays per patch for gather")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 1 << 24))
       ->capture_default_str();
   cmd->add_option("--hemicube-res", opts.hemicube_res, "Resolutions for hemicube")
       ->delimiter(',')
@@ -445,8 +453,10 @@ int run_accuracy(const AccuracyOptions& opts) {
     FormFactorOptions o = base;
     o.estimator = spec.estimator;
     if (spec.estimator == "hemicube") o.hemicube_resolution = spec.value;
+    else if (spec.estimator == "gather") o.rays = spec.value;
     else o.samples = spec.value;
-    o.symmetrize = spec.symmetrize;
+    // gather keeps its default (averaged); the hemicube rows say which they are.
+    o.reciprocity = spec.symmetrize ? "average" : spec.estimator == "gather" ? "auto" : "none";
     AccuracyRow row;
     row.estimator = spec_name(spec);
     row.setting = spec_setting(spec);

@@ -114,9 +114,10 @@ struct AccuracyOptions {
   SceneArgs scene;
   RunArgs run;
   std::string analytic_case;  ///< --case: a built-in analytic case instead of SCENE
-  std::vector<std::string> estimators;  ///< families to run; empty = mc, hybrid, hemicube
+  std::vector<std::string> estimators;  ///< families to run; empty = mc, hybrid, hemicube (gather on request)
   std::vector<int> mc_samples{4, 16, 64};
   std::vector<int> hybrid_samples{4, 16, 64};
+  std::vector<int> gather_rays{256, 1024, 4096};  ///< --estimators gather
   std::vector<int> hemicube_res{32, 64, 128, 256};
   bool symmetrize = false;       ///< also run each hemicube resolution symmetrized
   int reference_samples = 1024;  ///< hybrid reference for scenes without a closed form

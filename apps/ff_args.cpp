@@ -1,5 +1,7 @@
 #include "apps/ff_args.hpp"
 
+#include <cstdio>
+
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
@@ -10,12 +12,22 @@ namespace lambert {
 
 void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load) {
   std::vector<CLI::Option*> compute_only;
-  compute_only.push_back(cmd->add_option("--estimator", args.estimator, "Form-factor estimator")
-                             ->check(CLI::IsMember(form_factor_estimators()))
-                             ->capture_default_str());
   compute_only.push_back(
-      cmd->add_option("--samples", args.samples, "Sample pairs (rays) per patch pair")
+      cmd->add_option("--estimator", args.estimator,
+                      "Form-factor estimator (auto: hybrid below " +
+                          std::to_string(kAutoGatherPatches) + " patches, gather from there)")
+          ->check(CLI::IsMember(form_factor_estimator_choices()))
+          ->capture_default_str());
+  compute_only.push_back(
+      cmd->add_option("--samples", args.samples,
+                      "Sample pairs (rays) per patch pair (pair estimators mc, hybrid)")
           ->check(CLI::Range(1, 1 << 20))
+          ->each([&args](const std::string&) { args.samples_given = true; })
+          ->capture_default_str());
+  compute_only.push_back(
+      cmd->add_option("--rays", args.rays, "Rays per patch (estimator gather)")
+          ->check(CLI::Range(1, 1 << 24))
+          ->each([&args](const std::string&) { args.rays_given = true; })
           ->capture_default_str());
   compute_only.push_back(
       cmd->add_option("--threshold", args.threshold, "Drop form factors below this value")
@@ -24,9 +36,16 @@ void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load) {
                                          "Hemicube top-face resolution (estimator hemicube)")
                              ->check(CLI::Range(4, 8192))
                              ->capture_default_str());
+  CLI::Option* reciprocity =
+      cmd->add_option("--reciprocity", args.reciprocity,
+                      "Replace A_i F_ij and A_j F_ji by their mean: none, average, or auto "
+                      "(average for gather, none for the others)")
+          ->check(CLI::IsMember({"auto", "none", "average"}))
+          ->capture_default_str();
+  compute_only.push_back(reciprocity);
   compute_only.push_back(
-      cmd->add_flag("--symmetrize", args.symmetrize,
-                    "Average A_i F_ij and A_j F_ji (for non-reciprocal estimators)"));
+      cmd->add_flag("--symmetrize", args.symmetrize, "Alias of --reciprocity average")
+          ->excludes(reciprocity));
   if (!with_load) return;
   CLI::Option* ff = cmd->add_option(
       "--ff", args.ff_file,
@@ -51,14 +70,60 @@ FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run
   FormFactorOptions o;
   o.estimator = args.estimator;
   o.samples = args.samples;
+  o.rays = args.rays;
   o.seed = run.seed;
   o.threads = run.threads;
   o.threshold = args.threshold;
   o.hemicube_resolution = args.hemicube_resolution;
-  o.symmetrize = args.symmetrize;
+  o.reciprocity = args.symmetrize ? "average" : args.reciprocity;
   o.progress = !run.quiet;
+  if (args.estimator != "auto") {
+    const std::vector<std::string> unused = unused_count_options(args, args.estimator);
+    if (!unused.empty())
+      throw UsageError(unused.front() + " does not apply to --estimator " + args.estimator +
+                       " (--samples is per patch pair for mc and hybrid, --rays per patch for "
+                       "gather)");
+  }
   return o;
 }
+
+std::vector<std::string> unused_count_options(const FormFactorArgs& args,
+                                              const std::string& estimator) {
+  const std::string used = estimator_count_option(estimator);
+  std::vector<std::string> out;
+  if (args.rays_given && used != "rays") out.push_back("--rays");
+  // The hemicube has ignored --samples since it existed; only gather refuses it.
+  if (args.samples_given && used == "rays") out.push_back("--samples");
+  return out;
+}
+
+namespace {
+
+// "form factors: auto picked gather (N patches >= T)", and a warning per count option the
+// picked estimator ignores.
+void log_auto_pick(const FormFactors& ff, const FormFactorArgs& args, std::int32_t patches) {
+  if (ff.options.estimator_requested != "auto") return;
+  log_info("form factors: auto picked " + ff.options.estimator + " (" + std::to_string(patches) +
+           " patches " + (ff.options.estimator == "gather" ? ">= " : "< ") +
+           std::to_string(kAutoGatherPatches) + ")");
+  for (const std::string& opt : unused_count_options(args, ff.options.estimator))
+    log_warn(opt + " is ignored: --estimator auto picked " + ff.options.estimator);
+}
+
+// ", reciprocity averaged (...)" for the summary line, or "".
+std::string reciprocity_summary(const FormFactors& ff) {
+  if (ff.options.reciprocity != "average") return "";
+  char buf[200];
+  std::snprintf(buf, sizeof buf,
+                ", reciprocity averaged (change max %.3g, mean %.3g; balanced in %d sweeps; "
+                "%lld rows capped at 1)",
+                ff.stats.reciprocity_max_relative_change, ff.stats.reciprocity_mean_relative_change,
+                ff.stats.reciprocity_balance_iterations,
+                static_cast<long long>(ff.stats.reciprocity_rows_scaled));
+  return buf;
+}
+
+}  // namespace
 
 FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& args,
                                 const RunArgs& run, bool with_stderr) {
@@ -80,10 +145,11 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
   FormFactorOptions o = make_ff_options(args, run);
   o.with_stderr = with_stderr;
   FormFactors ff = compute_form_factors(scene.mesh, o, &scene_bvh(scene, run.threads));
+  log_auto_pick(ff, args, scene.mesh.size());
   log_info("form factors: " + std::to_string(scene.mesh.size()) + " patches, " +
            format_si(static_cast<double>(ff.F.nonZeros())) + " entries, " +
            format_si(static_cast<double>(ff.stats.rays)) + " rays in " +
-           format_duration(ff.stats.seconds));
+           format_duration(ff.stats.seconds) + reciprocity_summary(ff));
   if (ff.stats.pairs_unverified > 0)
     log_warn(std::to_string(ff.stats.pairs_unverified) +
              " patch pairs could not have their visibility sampled as designed (no ray could be "
@@ -108,12 +174,26 @@ void check_closed_lossless(const PatchMesh& mesh, const FormFactors& ff, bool so
 Json ff_settings_json(const FormFactorOptions& o, const std::string& loaded_from) {
   const auto known = [&](Json v) { return o.estimator.empty() ? Json() : v; };
   return {{"estimator", known(o.estimator)},
+          {"estimator_requested",
+           o.estimator_requested.empty() ? Json() : Json(o.estimator_requested)},
           {"samples", known(o.samples)},
+          {"rays_per_patch", known(o.rays)},  // "rays" is the traced count in reports
           {"seed", known(o.seed)},
           {"threshold", known(o.threshold)},
           {"hemicube_resolution", known(o.hemicube_resolution)},
-          {"symmetrize", known(o.symmetrize)},
+          {"reciprocity", known(o.reciprocity)},
+          {"symmetrize", known(o.reciprocity == "average")},
           {"loaded_from", loaded_from}};
+}
+
+Json reciprocity_json(const FormFactors& ff) {
+  const FormFactorStats& st = ff.stats;
+  return {{"applied", ff.options.reciprocity == "average"},
+          {"max_relative_change", st.reciprocity_max_relative_change},
+          {"mean_relative_change", st.reciprocity_mean_relative_change},
+          {"rows_scaled", st.reciprocity_rows_scaled},
+          {"balance_iterations", st.reciprocity_balance_iterations},
+          {"max_row_sum_before", st.reciprocity_max_row_sum}};
 }
 
 std::string ff_settings_text(const FormFactorOptions& o, const std::string& loaded_from) {

@@ -11,19 +11,24 @@
 
 namespace lambert {
 
-/// --estimator, --samples, --threshold, --hemicube-res, --symmetrize, --ff.
+/// --estimator, --samples, --rays, --threshold, --hemicube-res, --reciprocity,
+/// --symmetrize, --ff.
 struct FormFactorArgs {
-  std::string estimator = "hybrid";
+  std::string estimator = "auto";
   int samples = 32;
+  int rays = 1024;
   double threshold = 0.0;
   int hemicube_resolution = 128;
-  bool symmetrize = false;
+  std::string reciprocity = "auto";
+  bool symmetrize = false;     ///< alias of --reciprocity average
+  bool samples_given = false;  ///< --samples was on the command line
+  bool rays_given = false;     ///< --rays was on the command line
   std::string ff_file;  ///< load F from this file instead of computing it
 };
 
 /// Adds the form-factor options to a subcommand. `with_load` adds --ff FILE, which excludes
-/// the options that only steer a computation (--estimator, --samples, --threshold,
-/// --hemicube-res, --symmetrize): given together, they are a usage error.
+/// the options that only steer a computation (--estimator, --samples, --rays, --threshold,
+/// --hemicube-res, --reciprocity, --symmetrize): given together, they are a usage error.
 void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load = true);
 
 /// Adds F to a job plan: --ff as an input, or the computation's options for the memory
@@ -31,8 +36,15 @@ void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load = true);
 void plan_form_factors(JobPlan& plan, const FormFactorArgs& args, const RunArgs& run,
                        bool with_stderr = false);
 
-/// Builds FormFactorOptions from the arguments.
+/// Builds FormFactorOptions from the arguments ("auto" stays unresolved: it needs the patch
+/// count). Throws UsageError when a named estimator does not read a count that was given
+/// (--rays with a pair estimator or the hemicube, --samples with gather).
 FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run);
+
+/// The count options given on the command line that `estimator` (resolved) ignores, as
+/// option names ("--rays", "--samples"); empty when none.
+std::vector<std::string> unused_count_options(const FormFactorArgs& args,
+                                              const std::string& estimator);
 
 /// Computes F for the scene, or loads --ff (refusing a file made for another mesh), and
 /// logs a one-line summary on stderr. A loaded F's `options` are the settings stored in the
@@ -51,10 +63,16 @@ void warn_about_lighting(const PatchMesh& mesh, const SparseF& F);
 /// with `solving` false (F is only saved) the same message is a warning instead.
 void check_closed_lossless(const PatchMesh& mesh, const FormFactors& ff, bool solving = true);
 
-/// The settings that made F, for reports: {estimator, samples, seed, threshold,
-/// hemicube_resolution, symmetrize, loaded_from} ("" when computed here), every setting null
-/// when unknown (see obtain_form_factors).
+/// The settings that made F, for reports: {estimator (the resolved one),
+/// estimator_requested ("auto" or null), samples, rays_per_patch (--rays), seed, threshold,
+/// hemicube_resolution, reciprocity, symmetrize (reciprocity == average), loaded_from} (""
+/// when computed here), every setting null when unknown (see obtain_form_factors).
 Json ff_settings_json(const FormFactorOptions& options, const std::string& loaded_from);
+
+/// What reciprocity averaging changed (FormFactorStats' reciprocity_* members): {applied,
+/// max_relative_change, mean_relative_change, rows_scaled, balance_iterations,
+/// max_row_sum_before}.
+Json reciprocity_json(const FormFactors& ff);
 
 /// The same as one line of key=value text for image and PLY metadata: "[ff=FILE ]" followed
 /// by format_ff_settings(), or "settings=unknown".

@@ -37,6 +37,8 @@ Json diagnostics_json(const LoadedScene& s, const FormFactors& ff, const FormFac
                      {"row_sum", row_sum(ff.F, i)}});
   return {{"scene", s.scene.source},
           {"settings", settings},
+          {"form_factors", ff_settings_json(ff.options, "")},
+          {"reciprocity_averaging", reciprocity_json(ff)},
           {"patches", d.n},
           {"nnz", d.nnz},
           {"pairs_tested", ff.stats.pairs_tested},

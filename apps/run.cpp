@@ -68,6 +68,9 @@ Json report_json(const Report& rp) {
   ff["entries"] = r.ff_entries;
   ff["pairs_tested"] = r.ff_stats.pairs_tested;
   ff["rays"] = r.ff_stats.rays;
+  ff["reciprocity_max_relative_change"] = r.ff_stats.reciprocity_max_relative_change;
+  ff["reciprocity_mean_relative_change"] = r.ff_stats.reciprocity_mean_relative_change;
+  ff["reciprocity_rows_scaled"] = r.ff_stats.reciprocity_rows_scaled;
 
   Json channels = Json::array();
   for (const auto& c : r.solution.channels)
@@ -214,10 +217,15 @@ int run_run(const RunOptions& opts) {
   log_info("      " + std::to_string(loaded.mesh.size()) + " patches on " +
            std::to_string(loaded.mesh.surface_names.size()) + " surfaces");
 
+  const std::string estimator =
+      opts.ff.estimator == "auto" ? auto_estimator(loaded.mesh.size()) : opts.ff.estimator;
+  const std::string count = estimator_count_option(estimator);
+  const std::string per =
+      count == "rays"      ? ", " + std::to_string(opts.ff.rays) + " rays per patch"
+      : count == "samples" ? ", " + std::to_string(opts.ff.samples) + " samples per pair"
+                           : "";
   stage(2, "form factors (" +
-               (opts.ff.ff_file.empty() ? opts.ff.estimator + ", " +
-                                              std::to_string(opts.ff.samples) + " samples per pair"
-                                        : "from " + opts.ff.ff_file) +
+               (opts.ff.ff_file.empty() ? estimator + per : "from " + opts.ff.ff_file) +
                ")");
   RadiosityResult r;
   timer.reset();

@@ -3,13 +3,16 @@
 //     estimator traces (pre-generated for a random subset of pairs, so only the traversal
 //     is timed), with the same thread count;
 //  2. end-to-end throughput of the full "mc" and "hybrid" fills (sampling, kernels, culling,
-//     matrix assembly included) and the ratio end-to-end / raw;
+//     matrix assembly included) and the ratio end-to-end / raw; the same for "gather"
+//     against raw Embree closest-hit rays from the patches in cosine-distributed directions
+//     (the rays gather traces);
 //  3. time and peak memory of the Cornell box fill at ~2,000, ~10,000 and ~30,000 patches,
 //     each in a forked child so that its peak RSS is its own.
-// Usage: formfactors_bench [--quick] [--sizes 2000,10000,30000] [--samples K] [-j N]
+// Usage: formfactors_bench [--quick] [--sizes 2000,10000,30000] [--samples K] [--rays K] [-j N]
 // Medians over repeats are quoted; the machine is shared, so compare ratios.
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -55,6 +58,38 @@ std::vector<Ray> mc_rays(const PatchMesh& mesh, int samples, std::int64_t pairs)
     }
   }
   return rays;
+}
+
+// `per_patch` rays from uniform points of every patch in cosine-distributed directions
+// (Malley), lifted like gather's.
+std::vector<Ray> gather_rays(const PatchMesh& mesh, int per_patch) {
+  const auto geom = ff::patch_geometry(mesh);
+  std::vector<Ray> rays;
+  Rng rng(54321);
+  const double offset = 1e-6 * mesh.scale;
+  for (const auto& g : geom) {
+    const Eigen::Vector3d t = g.normal.unitOrthogonal(), b = g.normal.cross(t);
+    for (int s = 0; s < per_patch; ++s) {
+      double jac;
+      const Eigen::Vector3d x = ff::sample_patch(g, rng.uniform(), rng.uniform(), jac);
+      const double u = rng.uniform(), phi = 2.0 * M_PI * rng.uniform(), r = std::sqrt(u);
+      const Eigen::Vector3d d =
+          r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(1.0 - u) * g.normal;
+      rays.push_back({(x + offset * g.normal).cast<float>(), d.cast<float>()});
+    }
+  }
+  return rays;
+}
+
+// Rays per second of bvh.intersect (closest hit) over `rays` on `threads` threads.
+double raw_closest_throughput(const Bvh& bvh, const std::vector<Ray>& rays, int threads) {
+  std::vector<std::int32_t> hit(rays.size());
+  Timer t;
+  parallel_for(static_cast<std::int64_t>(rays.size()), 4096, threads,
+               [&](std::int64_t b, std::int64_t e) {
+                 for (auto k = b; k < e; ++k) hit[k] = bvh.intersect(rays[k].org, rays[k].dir).patch;
+               });
+  return static_cast<double>(rays.size()) / t.seconds();
 }
 
 double median(std::vector<double> v) {
@@ -105,11 +140,13 @@ int main(int argc, char** argv) {
   bool quick = false;
   int threads = resolve_threads(0);
   int samples = 16;
+  int gather_k = 1024;
   std::vector<std::int64_t> sizes = {2000, 10000, 30000};
   for (int a = 1; a < argc; ++a) {
     if (!std::strcmp(argv[a], "--quick")) quick = true;
     else if (!std::strcmp(argv[a], "-j") && a + 1 < argc) threads = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--samples") && a + 1 < argc) samples = std::atoi(argv[++a]);
+    else if (!std::strcmp(argv[a], "--rays") && a + 1 < argc) gather_k = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--sizes") && a + 1 < argc) {
       sizes.clear();
       for (char* tok = std::strtok(argv[++a], ","); tok; tok = std::strtok(nullptr, ","))
@@ -142,6 +179,23 @@ int main(int argc, char** argv) {
   std::printf("%-34s %14.2f %8s\n", "raw Embree rtcOccluded1", raw_m / 1e6, "1.00");
   std::printf("%-34s %14.2f %8.2f\n", "end-to-end fill, estimator mc", mc_m / 1e6, mc_m / raw_m);
   std::printf("%-34s %14.2f %8.2f\n", "end-to-end fill, estimator hybrid", hy_m / 1e6, hy_m / raw_m);
+
+  // Gather: closest-hit rays, K per patch.
+  const std::vector<Ray> grays = gather_rays(mesh, gather_k);
+  std::vector<double> raw_closest, e2e_gather;
+  for (int r = 0; r < repeats; ++r) {
+    raw_closest.push_back(raw_closest_throughput(bvh, grays, threads));
+    FormFactorOptions o;
+    o.estimator = "gather";
+    o.rays = gather_k;
+    o.threads = threads;
+    o.progress = false;
+    const FormFactors ff = compute_form_factors(mesh, o);
+    e2e_gather.push_back(ff.stats.rays / ff.stats.seconds);
+  }
+  const double rc_m = median(raw_closest), ga_m = median(e2e_gather);
+  std::printf("%-34s %14.2f %8s\n", "raw Embree rtcIntersect1", rc_m / 1e6, "1.00");
+  std::printf("%-34s %14.2f %8.2f\n", "end-to-end gather (+ averaging)", ga_m / 1e6, ga_m / rc_m);
 
   // 3: time and peak memory per size.
   std::printf("\n%-9s %-9s %8s %10s %12s %10s %12s %12s\n", "target", "patches", "est", "samples",

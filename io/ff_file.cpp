@@ -519,15 +519,20 @@ bool parse_double(const std::string& s, double& v) {
 std::string format_ff_settings(const FormFactorOptions& o) {
   char threshold[32];
   std::snprintf(threshold, sizeof threshold, "%.17g", o.threshold);
+  // symmetrize= stays for readers older than reciprocity= (and is what they parse).
+  const bool average = o.reciprocity == "average";
   return "estimator=" + o.estimator + " samples=" + std::to_string(o.samples) +
-         " seed=" + std::to_string(o.seed) + " threshold=" + threshold +
-         " hemicube_res=" + std::to_string(o.hemicube_resolution) +
-         " symmetrize=" + (o.symmetrize ? "1" : "0");
+         " rays=" + std::to_string(o.rays) + " seed=" + std::to_string(o.seed) +
+         " threshold=" + threshold + " hemicube_res=" + std::to_string(o.hemicube_resolution) +
+         " reciprocity=" + (average ? "average" : "none") + " symmetrize=" + (average ? "1" : "0");
 }
 
 bool parse_ff_settings(const std::string& text, FormFactorOptions& options) {
   FormFactorOptions o = options;
   bool estimator = false, samples = false, seed = false, threshold = false;
+  bool reciprocity = false;  // reciprocity= wins over the older symmetrize=
+  // Files older than these keys were made without averaging (and gather did not exist).
+  o.reciprocity = "none";
   std::istringstream in(text);
   for (std::string pair; in >> pair;) {
     const size_t eq = pair.find('=');
@@ -547,9 +552,16 @@ bool parse_ff_settings(const std::string& text, FormFactorOptions& options) {
     } else if (key == "hemicube_res") {
       if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
       o.hemicube_resolution = static_cast<int>(k);
+    } else if (key == "rays") {
+      if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
+      o.rays = static_cast<int>(k);
     } else if (key == "symmetrize") {
       if (value != "0" && value != "1") return false;
-      o.symmetrize = value == "1";
+      if (!reciprocity) o.reciprocity = value == "1" ? "average" : "none";
+    } else if (key == "reciprocity") {
+      if (value != "none" && value != "average") return false;
+      o.reciprocity = value;
+      reciprocity = true;
     }
   }
   if (!(estimator && samples && seed && threshold)) return false;

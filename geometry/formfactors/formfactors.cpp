@@ -10,8 +10,10 @@
 #include "core/timer.hpp"
 #include "geometry/formfactors/assembly.hpp"
 #include "geometry/formfactors/constants.hpp"
+#include "geometry/formfactors/gather.hpp"
 #include "geometry/formfactors/hemicube.hpp"
 #include "geometry/formfactors/pairwise.hpp"
+#include "geometry/formfactors/reciprocity.hpp"
 
 namespace lambert {
 
@@ -91,10 +93,18 @@ namespace {
 
 struct EstimatorEntry {
   const char* name;
-  bool traces_rays;  ///< needs a BVH and reports replicate standard errors (needs samples >= 4)
+  bool traces_rays;  ///< needs a BVH and reports replicate standard errors (needs count >= 4)
+  const char* count_option;  ///< "samples", "rays" or "" (estimator_count_option)
+  /// "auto" reciprocity averages: gather (noisy one-sided rows; averaging halves the variance
+  /// of a pair and makes F reciprocal). Not the pair estimators (reciprocal by
+  /// construction) nor the hemicube (its non-reciprocity is a result `accuracy` studies).
+  bool auto_average;
   FormFactors (*compute)(const PatchMesh&, const FormFactorOptions&, const Bvh*);
   double (*peak_bytes)(std::int64_t patches, const FormFactorOptions&);
 };
+
+// Bytes of one CSR entry: a value and a column index of the storage index type.
+constexpr double kCsrEntry = sizeof(double) + sizeof(SparseF::StorageIndex);
 
 // Peak of compute_pairwise for n patches, all n(n-1)/2 pairs exchanging energy (the bound:
 // a closed scene reaches it): the CSR F (16 bytes per entry, both triangles), the same again
@@ -109,31 +119,50 @@ double pairwise_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
 
 // Peak of compute_hemicube: a row holds at most one entry per hemicube pixel (res^2 on the
 // top face, 4 x res x ceil(res/2) on the sides) and at most n - 1; rows are kept as 16-byte
-// entries until the CSR F (12 bytes per entry) is filled; --symmetrize builds one more F.
+// entries until the CSR F (12 bytes per entry) is filled; averaging (reciprocity.cpp) builds
+// A F, its transpose, their sum and the result (5 CSR entries per entry).
 double hemicube_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
   const double n = static_cast<double>(patches), res = o.hemicube_resolution;
   const double pixels = res * res + 4.0 * res * std::ceil(res / 2.0);
   const double entries = n * std::min(n - 1.0, pixels);
-  return entries * (16.0 + 12.0 + (o.symmetrize ? 2.0 * 12.0 : 0.0));
+  return entries * (16.0 + 12.0 + (o.reciprocity == "average" ? 5.0 * kCsrEntry : 0.0));
+}
+
+// Peak of compute_gather: a row holds at most min(K, n - 1) entries, kept as 24-byte
+// (j, F, stderr) entries until the CSR F is filled, plus the pattern union for the stats
+// (F^T and F + F^T: 3 CSR entries per entry); per task K 16-byte hits. Averaging builds
+// A F, its transpose, their sum (up to 2 entries per entry) and the result: 5 CSR entries
+// per entry; standard errors double the CSR part.
+double gather_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
+  const double n = static_cast<double>(patches);
+  const double entries = n * std::min(n - 1.0, static_cast<double>(o.rays));
+  const double csr = (o.reciprocity == "average" ? 5.0 : 3.0) * kCsrEntry;
+  return entries * (24.0 + csr * (o.with_stderr ? 2.0 : 1.0)) +
+         static_cast<double>(resolve_threads(o.threads)) * o.rays * 16.0;
 }
 
 const std::vector<EstimatorEntry>& registry() {
   static const std::vector<EstimatorEntry> table = {
-      {"hybrid", true,
+      {"hybrid", true, "samples", false,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
          return ff::compute_pairwise(m, o, *b, ff::estimate_hybrid);
        },
        pairwise_peak_bytes},
-      {"mc", true,
+      {"mc", true, "samples", false,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
          return ff::compute_pairwise(m, o, *b, ff::estimate_mc);
        },
        pairwise_peak_bytes},
-      {"hemicube", false,
+      {"hemicube", false, "", false,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh*) {
          return ff::compute_hemicube(m, o);  // rasterises: no rays
        },
        hemicube_peak_bytes},
+      {"gather", true, "rays", true,
+       [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
+         return ff::compute_gather(m, o, *b);
+       },
+       gather_peak_bytes},
   };
   return table;
 }
@@ -145,9 +174,9 @@ void apply_threshold(FormFactors& ff, double threshold) {
   if (threshold <= 0.0) return;
   const bool with_err = ff.stderr_F.nonZeros() > 0;
   std::vector<char> keep(ff.F.nonZeros());
-  for (std::int32_t i = 0; i < ff.F.rows(); ++i) {
-    for (auto k = ff.F.outerIndexPtr()[i]; k < ff.F.outerIndexPtr()[i + 1]; ++k) {
-      const std::int32_t j = ff.F.innerIndexPtr()[k];
+  for (Eigen::Index i = 0; i < ff.F.rows(); ++i) {
+    for (std::int64_t k = ff.F.outerIndexPtr()[i]; k < ff.F.outerIndexPtr()[i + 1]; ++k) {
+      const Eigen::Index j = ff.F.innerIndexPtr()[k];
       keep[k] = ff.F.valuePtr()[k] >= threshold || ff.F.coeff(j, i) >= threshold;
     }
   }
@@ -162,6 +191,12 @@ void apply_threshold(FormFactors& ff, double threshold) {
   if (with_err) ff.stderr_F.prune(not_nan);
 }
 
+const EstimatorEntry& find_estimator(const std::string& name) {
+  for (const auto& e : registry())
+    if (name == e.name) return e;
+  throw UsageError("unknown form-factor estimator '" + name + "'");
+}
+
 }  // namespace
 
 std::vector<std::string> form_factor_estimators() {
@@ -170,33 +205,70 @@ std::vector<std::string> form_factor_estimators() {
   return names;
 }
 
+std::vector<std::string> form_factor_estimator_choices() {
+  std::vector<std::string> names = form_factor_estimators();
+  names.emplace_back("auto");
+  return names;
+}
+
+std::string auto_estimator(std::int64_t patches) {
+  return patches >= kAutoGatherPatches ? "gather" : "hybrid";
+}
+
+std::string estimator_count_option(const std::string& estimator) {
+  return find_estimator(estimator).count_option;
+}
+
+FormFactorOptions resolve_form_factor_options(const FormFactorOptions& options,
+                                              std::int64_t patches) {
+  FormFactorOptions o = options;
+  if (o.estimator == "auto") {
+    o.estimator = auto_estimator(patches);
+    o.estimator_requested = "auto";
+  }
+  const EstimatorEntry& e = find_estimator(o.estimator);
+  if (o.reciprocity == "auto") o.reciprocity = e.auto_average ? "average" : "none";
+  if (o.reciprocity != "none" && o.reciprocity != "average")
+    throw UsageError("unknown reciprocity mode '" + o.reciprocity + "' (none, average, auto)");
+  return o;
+}
+
 double form_factor_peak_bytes(std::int64_t patches, const FormFactorOptions& options) {
-  for (const auto& e : registry())
-    if (options.estimator == e.name) return e.peak_bytes(patches, options);
-  throw UsageError("unknown form-factor estimator '" + options.estimator + "'");
+  const FormFactorOptions o = resolve_form_factor_options(options, patches);
+  return find_estimator(o.estimator).peak_bytes(patches, o);
 }
 
 FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions& options,
                                  const Bvh* bvh) {
   if (options.samples < 1) throw UsageError("--samples must be at least 1");
+  if (options.rays < 1) throw UsageError("--rays must be at least 1");
   if (mesh.patches.empty()) throw UsageError("the scene has no patches");
-  for (const auto& e : registry()) {
-    if (options.estimator != e.name) continue;
-    // Standard errors come from the spread of independent replicates (replicates.hpp),
-    // which needs at least two of them, and Student's t with so few is wide: ask for four.
-    if (e.traces_rays && options.with_stderr && options.samples < 4)
-      throw UsageError("--stderr needs --samples of at least 4 (standard errors come from "
-                       "independent replicates of the samples)");
-    std::unique_ptr<Bvh> own;
-    if (!bvh && e.traces_rays) {
-      own = std::make_unique<Bvh>(mesh, options.threads);
-      bvh = own.get();
-    }
-    FormFactors out = e.compute(mesh, options, bvh);
-    apply_threshold(out, options.threshold);
-    return out;
+  const FormFactorOptions o = resolve_form_factor_options(options, mesh.size());
+  const EstimatorEntry& e = find_estimator(o.estimator);
+  // Standard errors come from the spread of independent replicates (replicates.hpp),
+  // which needs at least two of them, and Student's t with so few is wide: ask for four.
+  const std::string count = e.count_option;
+  if (e.traces_rays && o.with_stderr && (count == "rays" ? o.rays : o.samples) < 4)
+    throw UsageError("--stderr needs --" + count + " of at least 4 (standard errors come from "
+                     "independent replicates of the " + count + ")");
+  std::unique_ptr<Bvh> own;
+  if (!bvh && e.traces_rays) {
+    own = std::make_unique<Bvh>(mesh, o.threads);
+    bvh = own.get();
   }
-  throw UsageError("unknown form-factor estimator '" + options.estimator + "'");
+  FormFactors out = e.compute(mesh, o, bvh);
+  out.options = o;
+  if (o.reciprocity == "average") {
+    Timer timer;
+    std::vector<double> areas(mesh.patches.size());
+    for (size_t i = 0; i < areas.size(); ++i) areas[i] = mesh.patches[i].area;
+    out.F.makeCompressed();
+    ff::average_reciprocal(out.F, o.with_stderr ? &out.stderr_F : nullptr, areas, out.stats,
+                          o.threads);
+    out.stats.seconds += timer.seconds();
+  }
+  apply_threshold(out, o.threshold);
+  return out;
 }
 
 }  // namespace lambert

@@ -20,27 +20,46 @@ using SparseF = SparseRowMatrix;
 
 /// Settings of one form-factor computation.
 struct FormFactorOptions {
-  std::string estimator = "hybrid";  ///< a name from form_factor_estimators()
-  int samples = 32;                  ///< sample pairs (rays) per patch pair
+  /// A name from form_factor_estimators(), or "auto" (resolve_form_factor_options: hybrid
+  /// below kAutoGatherPatches patches, gather at or above).
+  std::string estimator = "auto";
+  /// What was asked for when `estimator` was resolved from "auto" ("" when it was named).
+  std::string estimator_requested;
+  int samples = 32;                  ///< sample pairs (rays) per patch pair (pair estimators)
+  int rays = 1024;                   ///< rays per patch (estimator "gather")
   std::uint64_t seed = 1;
   int threads = 0;                   ///< 0 = all cores
   double threshold = 0.0;            ///< drop entries with F_ij < threshold (after estimation)
   bool with_stderr = false;          ///< also estimate the standard error of each entry
   int hemicube_resolution = 128;     ///< hemicube top-face resolution (estimator "hemicube")
-  bool symmetrize = false;           ///< average A_i F_ij and A_j F_ji (non-reciprocal estimators)
+  /// "average": replace A_i F_ij and A_j F_ji by their mean (reciprocity.hpp); "none";
+  /// "auto": average for gather, none for the others (the pair estimators are reciprocal by
+  /// construction; the hemicube keeps its historical default, --symmetrize to average).
+  std::string reciprocity = "auto";
   bool progress = true;              ///< draw a progress bar (when stderr is a terminal)
 };
 
 /// What a computation did (for diagnostics and reports).
 struct FormFactorStats {
-  std::int64_t pairs_tested = 0;  ///< unordered pairs that can exchange energy
-  std::int64_t pairs_culled = 0;  ///< unordered pairs facing away from each other
-  std::int64_t rays = 0;          ///< occlusion rays traced
+  /// Unordered pairs that can exchange energy (gather: that at least one ray connected)
+  std::int64_t pairs_tested = 0;
+  std::int64_t pairs_culled = 0;  ///< the other unordered pairs (facing away; gather: unseen)
+  std::int64_t rays = 0;          ///< rays traced (occlusion; gather: closest-hit, N·K)
   /// Pairs whose visibility could not be sampled as designed (hybrid: no ray could be
   /// traced, so the unoccluded value was kept; or a kernel-sampling rejection gave up):
   /// reported and warned about, expected 0.
   std::int64_t pairs_unverified = 0;
   double seconds = 0.0;           ///< wall time of the computation
+  /// Reciprocity averaging (0 when not applied; see reciprocity.hpp): the largest relative
+  /// change |G' - G| / G of an entry that was present (G = A_i F_ij), and the G-weighted
+  /// mean Σ|G' - G| / ΣG over all entries.
+  double reciprocity_max_relative_change = 0.0;
+  double reciprocity_mean_relative_change = 0.0;
+  /// Rows still above 1 after balancing, scaled down by the cap, and the largest row sum
+  /// before the cap; balancing sweeps made.
+  std::int64_t reciprocity_rows_scaled = 0;
+  double reciprocity_max_row_sum = 0.0;
+  int reciprocity_balance_iterations = 0;
 };
 
 /// The estimated matrix, optionally with per-entry standard errors (same sparsity).
@@ -65,12 +84,34 @@ struct FormFactors {
   }
 };
 
-/// Names of the available estimators ("mc", "hybrid", ...).
+/// Names of the available estimators ("mc", "hybrid", ...); "auto" is not one of them.
 std::vector<std::string> form_factor_estimators();
+
+/// The --estimator choices: form_factor_estimators() and "auto".
+std::vector<std::string> form_factor_estimator_choices();
+
+/// `--estimator auto` picks "gather" at or above this many patches and "hybrid" below.
+/// Measured on the Cornell box (2 cores, README "Choosing an estimator"): hybrid's O(N²)
+/// pairs take about a minute at this size, gather's O(N·K) rays about a second.
+constexpr std::int64_t kAutoGatherPatches = 6000;
+
+/// The estimator "auto" stands for at `patches` patches.
+std::string auto_estimator(std::int64_t patches);
+
+/// Which per-count option an estimator reads: "samples" (pair estimators), "rays"
+/// (gather) or "" (hemicube). Throws UsageError for an unknown name (not "auto").
+std::string estimator_count_option(const std::string& estimator);
+
+/// `options` with "auto" resolved for `patches` patches: estimator (estimator_requested
+/// then keeps "auto") and reciprocity ("none" or "average"). Throws UsageError for an
+/// unknown estimator or reciprocity mode.
+FormFactorOptions resolve_form_factor_options(const FormFactorOptions& options,
+                                              std::int64_t patches);
 
 /// Upper bound (bytes) on the memory compute_form_factors needs for `patches` patches with
 /// these options, before any work: the all-pairs estimators from the N(N-1)/2 pair bound, the
-/// hemicube from at most one entry per pixel per row. --threshold prunes only after the
+/// hemicube from at most one entry per pixel per row, gather from at most K entries per row
+/// ("auto" is resolved first). --threshold prunes only after the
 /// estimate, so it does not lower the peak. Throws UsageError for an unknown estimator.
 double form_factor_peak_bytes(std::int64_t patches, const FormFactorOptions& options);
 
@@ -79,7 +120,8 @@ class Bvh;
 /// Computes F for every patch pair of `mesh` with the chosen estimator. Multi-threaded;
 /// for a given seed the result is bitwise identical for any thread count. `bvh` (built over
 /// `mesh`) is used for the visibility rays when given, so that one BVH serves a whole run;
-/// otherwise one is built. Throws UsageError for an unknown estimator or invalid settings.
+/// otherwise one is built. "auto" settings are resolved first (the result's `options`
+/// hold the resolved ones), and reciprocity averaging is applied last. Throws UsageError for an unknown estimator or invalid settings.
 FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions& options,
                                  const Bvh* bvh = nullptr);
 

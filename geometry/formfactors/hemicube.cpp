@@ -313,17 +313,6 @@ HemicubeDeltas hemicube_deltas(int resolution) {
   return d;
 }
 
-SparseF symmetrize_factors(const SparseF& F, const std::vector<double>& areas) {
-  const auto n = static_cast<Eigen::Index>(areas.size());
-  LAMBERT_CHECK(F.rows() == n && F.cols() == n, "symmetrize: F does not match the areas");
-  const Eigen::Map<const Eigen::VectorXd> a(areas.data(), n);
-  const SparseF G = a.asDiagonal() * F;
-  const SparseF Gt = G.transpose();
-  SparseF out = a.cwiseInverse().asDiagonal() * (0.5 * (G + Gt));
-  out.makeCompressed();
-  return out;
-}
-
 FormFactors compute_hemicube(const PatchMesh& mesh, const FormFactorOptions& options,
                              HemicubeStats* hemicube_stats) {
   if (options.hemicube_resolution < 2)
@@ -377,11 +366,6 @@ FormFactors compute_hemicube(const PatchMesh& mesh, const FormFactorOptions& opt
     std::vector<RowEntry>().swap(rows[i]);  // release memory as we go
   }
   F.outerIndexPtr()[n] = at;
-  if (options.symmetrize) {
-    std::vector<double> areas(n);
-    for (std::int32_t i = 0; i < n; ++i) areas[i] = geom[i].area;
-    F = symmetrize_factors(F, areas);
-  }
   out.F.swap(F);  // Eigen 3.4 sparse matrices have no move: std::move would copy
   out.stats.seconds = timer.seconds();
   return out;

@@ -7,8 +7,9 @@
 // four half side faces) and z-buffered, and ΔF_p is the pixel's delta form factor:
 //   top face  (x, y, 1):  ΔF = ΔA / (π (x² + y² + 1)²)
 //   side face (1, y, z):  ΔF = z ΔA / (π (y² + z² + 1)²)   (and the three rotations of it).
-// Not reciprocal: A_i F_ij ≠ A_j F_ji in general; FormFactorOptions::symmetrize replaces
-// both by their mean. Known errors: aliasing (a patch covers a whole number of pixels, so
+// Not reciprocal: A_i F_ij ≠ A_j F_ji in general; `--reciprocity average` (alias
+// `--symmetrize`, applied by compute_form_factors: reciprocity.hpp) replaces both by their
+// mean. Known errors: aliasing (a patch covers a whole number of pixels, so
 // small or distant patches are over- or under-counted, an error that falls as the pixel
 // size 2/N), and the proximity error (the factor is taken from one point, c_i, not averaged
 // over patch i; large for neighbours closer than a few patch diameters, independent of N).
@@ -41,13 +42,10 @@ struct HemicubeStats {
 /// Estimator "hemicube": every row of F from one hemicube at the patch's centroid, lifted
 /// off the patch by a tiny offset and turned about the normal by an angle hashed from
 /// (options.seed, row) so that its aliasing is not aligned with the scene's edges. Rows are independent and run in parallel (per-thread
-/// buffers), so F is bitwise identical for any thread count. Applies options.symmetrize.
+/// buffers), so F is bitwise identical for any thread count. Reciprocity averaging is the
+/// caller's (compute_form_factors).
 /// Cost O(N_patches² + N_patches · resolution²); stats.rays = 0.
 FormFactors compute_hemicube(const PatchMesh& mesh, const FormFactorOptions& options,
                              HemicubeStats* hemicube_stats = nullptr);
-
-/// Reciprocal average of F: G_ij = (A_i F_ij + A_j F_ji) / 2, returns G_ij / A_i
-/// (the union of both sparsity patterns).
-SparseF symmetrize_factors(const SparseF& F, const std::vector<double>& areas);
 
 }  // namespace lambert::ff

@@ -7,6 +7,7 @@
 #include "apps/cli.hpp"
 #include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
+#include "io/ff_file.hpp"
 
 namespace lambert {
 
@@ -113,6 +114,61 @@ TEST(FormFactorsCommand, OutputIntoAMissingDirectoryIsRefusedBeforeAnyWork) {
   EXPECT_EQ(testing::run({"formfactors", "-q", "-o", dir.file("missing/F.bin")}), kExitUsage);
   EXPECT_EQ(testing::run({"solve", "-q", "-o", dir.file("missing/B.csv")}), kExitUsage);
   EXPECT_EQ(testing::run({"render", "-q", "--png", dir.file("missing/x.png")}), kExitUsage);
+}
+
+}  // namespace lambert
+
+namespace lambert {
+
+TEST(FormFactorsCommand, GatherOnTheCornellBoxStoresItsRaysInTheSettings) {
+  testing::TempDir dir;
+  const std::string out = dir.file("F.bin");
+  ASSERT_EQ(run({"formfactors", "-q", "--patches", "200", "--estimator", "gather", "--rays", "64",
+                 "-o", out}),
+            kExitOk);
+  const nlohmann::json report = parse_json_file(dir.file("F.report.json"));
+  FormFactorOptions o;
+  ASSERT_TRUE(parse_ff_settings(report.at("settings").get<std::string>(), o));
+  EXPECT_EQ(o.estimator, "gather");
+  EXPECT_EQ(o.rays, 64);
+  EXPECT_EQ(o.reciprocity, "average");  // auto: gather averages
+  const auto& ff = report.at("form_factors");
+  EXPECT_EQ(ff.at("rays_per_patch").get<int>(), 64);
+  EXPECT_TRUE(ff.at("estimator_requested").is_null());
+  // 200 patches x 64 rays (the mesh has about --patches patches).
+  EXPECT_EQ(report.at("rays").get<std::int64_t>(), 64 * report.at("patches").get<std::int64_t>());
+  EXPECT_TRUE(report.at("reciprocity_averaging").at("applied").get<bool>());
+  EXPECT_LE(report.at("row_sums").at("max").get<double>(), 1.0 + 1e-12);
+}
+
+TEST(FormFactorsCommand, AutoRecordsWhatItPicked) {
+  testing::TempDir dir;
+  const std::string out = dir.file("F.bin");
+  ASSERT_EQ(run({"formfactors", "-q", "--patches", "60", "--samples", "4", "-o", out}), kExitOk);
+  const nlohmann::json report = parse_json_file(dir.file("F.report.json"));
+  const auto& ff = report.at("form_factors");
+  EXPECT_EQ(ff.at("estimator"), "hybrid");  // 60 patches < kAutoGatherPatches
+  EXPECT_EQ(ff.at("estimator_requested"), "auto");
+  FormFactorOptions o;
+  ASSERT_TRUE(parse_ff_settings(report.at("settings").get<std::string>(), o));
+  EXPECT_EQ(o.estimator, "hybrid");  // files store the resolved estimator
+}
+
+TEST(FormFactorsCommand, CountOptionsOfAnotherEstimatorAreUsageErrors) {
+  testing::TempDir dir;
+  const std::string out = dir.file("F.bin");
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(run({"formfactors", "-q", "--patches", "60", "--estimator", "hybrid", "--rays", "64",
+                 "-o", out}),
+            kExitUsage);
+  EXPECT_EQ(run({"formfactors", "-q", "--patches", "60", "--estimator", "gather", "--samples",
+                 "8", "-o", out}),
+            kExitUsage);
+  EXPECT_EQ(run({"formfactors", "-q", "--patches", "60", "--rays", "0", "-o", out}), kExitUsage);
+  EXPECT_EQ(run({"formfactors", "-q", "--patches", "60", "--symmetrize", "--reciprocity", "none",
+                 "-o", out}),
+            kExitUsage);
+  ::testing::internal::GetCapturedStderr();
 }
 
 }  // namespace lambert

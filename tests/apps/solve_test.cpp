@@ -248,6 +248,8 @@ TEST(SolveCommand, OptionsThatOnlySteerAComputationAreRefusedWithFf) {
                                                 {"--samples", "8"},
                                                 {"--threshold", "0.1"},
                                                 {"--hemicube-res", "64"},
+                                                {"--rays", "64"},
+                                                {"--reciprocity", "average"},
                                                 {"--symmetrize"}}) {
     // Outputs that would be accepted, so that only the option clash can refuse the command.
     for (const auto& [command, output] :

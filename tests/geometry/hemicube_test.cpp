@@ -23,7 +23,7 @@ FormFactors hemicube(const PatchMesh& mesh, int resolution, std::uint64_t seed =
   o.hemicube_resolution = resolution;
   o.seed = seed;
   o.threads = threads;
-  o.symmetrize = symmetrize;
+  o.reciprocity = symmetrize ? "average" : "none";
   o.progress = false;
   return compute_form_factors(mesh, o);
 }

@@ -104,7 +104,8 @@ TEST(FormFactorFile, SettingsTextRecoversEverySettingExactly) {
   o.seed = 18446744073709551615ull;  // the largest seed: all 64 bits survive
   o.threshold = 1.0 / 3.0;           // %.17g reads back to the same double
   o.hemicube_resolution = 96;
-  o.symmetrize = true;
+  o.rays = 4321;
+  o.reciprocity = "average";
   FormFactorOptions back;
   ASSERT_TRUE(parse_ff_settings(format_ff_settings(o) + " patches=24 max_edge=0.5", back));
   EXPECT_EQ(back.estimator, "hemicube");
@@ -112,7 +113,16 @@ TEST(FormFactorFile, SettingsTextRecoversEverySettingExactly) {
   EXPECT_EQ(back.seed, o.seed);
   EXPECT_EQ(back.threshold, o.threshold);
   EXPECT_EQ(back.hemicube_resolution, 96);
-  EXPECT_TRUE(back.symmetrize);
+  EXPECT_EQ(back.rays, 4321);
+  EXPECT_EQ(back.reciprocity, "average");
+}
+
+TEST(FormFactorFile, SymmetrizeKeyOfOlderFilesReadsAsReciprocity) {
+  FormFactorOptions o;
+  ASSERT_TRUE(parse_ff_settings(
+      "estimator=hemicube samples=32 seed=1 threshold=0 hemicube_res=64 symmetrize=1", o));
+  EXPECT_EQ(o.reciprocity, "average");
+  EXPECT_EQ(o.rays, FormFactorOptions().rays);  // absent: kept
 }
 
 TEST(FormFactorFile, SettingsOfOlderFilesAreRecoveredAndForeignTextIsRefused) {
@@ -123,7 +133,7 @@ TEST(FormFactorFile, SettingsOfOlderFilesAreRecoveredAndForeignTextIsRefused) {
   EXPECT_EQ(o.estimator, "mc");
   EXPECT_EQ(o.samples, 64);
   EXPECT_EQ(o.seed, 5u);
-  EXPECT_FALSE(o.symmetrize);
+  EXPECT_EQ(o.reciprocity, "none");
   for (const char* foreign :
        {"", "made by hand", "estimator=mc samples=64", "estimator=mc samples=x seed=1 threshold=0",
         "estimator=mc samples=4 seed=-1 threshold=0"}) {

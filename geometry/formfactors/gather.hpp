@@ -1,0 +1,30 @@
+#pragma once
+// Estimator "gather" (internal to geometry/, exposed for its tests and benchmark).
+//
+// The classic ray-traced form factor: from each patch i, K rays leave stratified points x_s
+// on i in cosine-distributed directions ω_s (density cosθ / π), and
+//   F_ij ≈ (1/K) Σ_s w_s [the closest hit of (x_s, ω_s) is the front of patch j],
+//   w_s = J(x_s) / A_i   (the area sampling weight, kernels.hpp's sample_patch: 1 on
+//                         triangles and parallelograms),
+// an unbiased estimate of (1/A_i) ∫_{A_i} ∫_{Ω} V cosθ / π [front of j] dω dA, which is
+// F_ij. Hits on backs, on i itself, and misses (an open scene) count for nothing, so a row
+// sum is the fraction of rays that reach a front. Not reciprocal: see reciprocity.hpp.
+// Rows have at most K entries; cost O(N·K) rays, no all-pairs loop.
+
+#include <cstdint>
+
+#include "geometry/bvh.hpp"
+#include "geometry/formfactors/formfactors.hpp"
+
+namespace lambert::ff {
+
+/// Estimator "gather": options.rays rays per patch, in replicate_count(rays) independently
+/// shifted Kronecker point sets (replicates.hpp) whose spread gives the standard errors.
+/// Rows are computed in parallel into per-row buffers and assembled in row order, so F is
+/// bitwise identical for any thread count. stats.rays = N·K; stats.pairs_tested = the
+/// unordered pairs connected by at least one ray (either way), pairs_culled the rest.
+/// Reciprocity averaging is the caller's (compute_form_factors).
+FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& options,
+                           const Bvh& bvh);
+
+}  // namespace lambert::ff
