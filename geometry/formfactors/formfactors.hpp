@@ -60,6 +60,7 @@ struct FormFactorStats {
   std::int64_t reciprocity_rows_scaled = 0;
   double reciprocity_max_row_sum = 0.0;
   int reciprocity_balance_iterations = 0;
+  double reciprocity_seconds = 0.0;  ///< wall time of the averaging (included in seconds)
 };
 
 /// The estimated matrix, optionally with per-entry standard errors (same sparsity).

@@ -13,7 +13,8 @@
 // An entry no ray hit is absent, with no standard error: its factor is below ~1/K (a
 // patch subtending < 1/K of the cosine-weighted hemisphere is missed with probability
 // (1 − F_ij)^K); the estimate is still unbiased (0 is the most likely value of a small one).
-// Memory per task: K hits (16 bytes); rows are kept as (j, F) until assembled.
+// Memory per thread: K hits (16 bytes) and a dense accumulator of N doubles; rows are
+// staged one block at a time (kGatherBlockRows) and appended to the reserved CSR.
 // Thread safety: rows only write their own slots.
 
 #include "geometry/formfactors/gather.hpp"
@@ -28,6 +29,7 @@
 #include "core/progress.hpp"
 #include "core/sampling.hpp"
 #include "core/timer.hpp"
+#include "geometry/formfactors/assembly.hpp"
 #include "geometry/formfactors/constants.hpp"
 #include "geometry/formfactors/kernels.hpp"
 #include "geometry/formfactors/replicates.hpp"
@@ -35,16 +37,14 @@
 namespace lambert::ff {
 namespace {
 
+// Rows are traced in blocks of this many (in parallel within a block) and appended to the
+// CSR after each block: the staging is one block of rows.
+constexpr std::int32_t kGatherBlockRows = 4096;
+
 struct Hit {
   std::int32_t j;
   std::int32_t rep;
   double w;
-};
-
-struct RowEntry {
-  std::int32_t j;
-  double f;
-  double err;
 };
 
 // An orthonormal frame (t, b, n) for unit n (Duff et al. 2017, branchless).
@@ -57,8 +57,11 @@ void frame(const Eigen::Vector3d& n, Eigen::Vector3d& t, Eigen::Vector3d& b) {
 }
 
 // Traces row i's K rays into `hits` (cleared first).
-void trace_row(const std::vector<PatchGeom>& geom, const Bvh& bvh, std::int32_t i, int K,
-               std::uint64_t seed, double offset, std::vector<Hit>& hits) {
+// `normals`: the patches' normals packed (the front test reads one per hit, at random:
+// 24 bytes apart instead of a whole PatchGeom).
+void trace_row(const std::vector<PatchGeom>& geom, const std::vector<Eigen::Vector3d>& normals,
+               const Bvh& bvh, std::int32_t i, int K, std::uint64_t seed, double offset,
+               std::vector<Hit>& hits) {
   const PatchGeom& g = geom[i];
   Eigen::Vector3d t, b;
   frame(g.normal, t, b);
@@ -77,19 +80,37 @@ void trace_row(const std::vector<PatchGeom>& geom, const Bvh& bvh, std::int32_t 
       const Eigen::Vector3d origin = x + offset * g.normal;
       const RayHit hit = bvh.intersect(origin.cast<float>(), dir.cast<float>());
       if (hit.patch < 0 || hit.patch == i) continue;
-      if (dir.dot(geom[hit.patch].normal) >= 0.0) continue;  // the back of j: absorbed
+      if (dir.dot(normals[hit.patch]) >= 0.0) continue;  // the back of j: absorbed
       hits.push_back({hit.patch, rep, jac / g.area});
     }
   }
 }
 
-// Row i's entries from its hits: F_ij = Σ w / K, the error from the replicate estimates
-// (Σ_{hits in r} w) / k_r.
-void row_from_hits(std::vector<Hit>& hits, int K, bool with_err, std::vector<RowEntry>& row) {
+// Row i's entries from its hits: F_ij = Σ w / K (summed in hit order), and with `with_err`
+// the error from the replicate estimates (Σ_{hits in r} w) / k_r. Without errors the sums
+// go through a dense accumulator over the patches (`acc`, all zero on entry and on return;
+// O(hits + distinct log distinct)); with errors the hits are sorted by patch (stable, so
+// each sum is in the same order and F is bitwise the same either way).
+void row_from_hits(std::vector<Hit>& hits, int K, bool with_err, std::vector<double>& acc,
+                   std::vector<std::int32_t>& touched, std::vector<RowEntry>& row) {
+  row.clear();
+  if (!with_err) {
+    touched.clear();
+    for (const Hit& h : hits) {
+      if (acc[h.j] == 0.0) touched.push_back(h.j);
+      acc[h.j] += h.w;
+    }
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());  // w = 0 hits
+    for (const std::int32_t j : touched) {
+      if (acc[j] > 0.0) row.push_back({j, acc[j] / K, 0.0});
+      acc[j] = 0.0;
+    }
+    return;
+  }
   std::stable_sort(hits.begin(), hits.end(),
                    [](const Hit& a, const Hit& b) { return a.j < b.j; });
   const int R = replicate_count(K);
-  row.clear();
   for (size_t h = 0; h < hits.size();) {
     const std::int32_t j = hits[h].j;
     double per_rep[kReplicates] = {};
@@ -98,13 +119,31 @@ void row_from_hits(std::vector<Hit>& hits, int K, bool with_err, std::vector<Row
       per_rep[hits[h].rep] += hits[h].w;
       sum += hits[h].w;
     }
-    double err = 0.0;
-    if (with_err) {
-      for (int r = 0; r < R; ++r) per_rep[r] /= replicate_size(K, r);
-      err = std::sqrt(replicate_variance(per_rep, R));
-    }
-    row.push_back({j, sum / K, err});
+    for (int r = 0; r < R; ++r) per_rep[r] /= replicate_size(K, r);
+    row.push_back({j, sum / K, std::sqrt(replicate_variance(per_rep, R))});
   }
+}
+
+// Unordered pairs with an entry on at least one side: every upper entry, plus the lower
+// entries whose mirror is absent (binary search in the mirror's sorted row). O(nnz log).
+std::int64_t connected_pairs(const SparseF& F, int threads) {
+  const std::int32_t n = static_cast<std::int32_t>(F.rows());
+  const auto* outer = F.outerIndexPtr();
+  const auto* col = F.innerIndexPtr();
+  std::vector<std::int64_t> per_row(n, 0);
+  parallel_for(n, 1024, threads, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) {
+      std::int64_t count = 0;
+      for (auto k = outer[i]; k < outer[i + 1]; ++k) {
+        const auto j = col[k];
+        if (j > i || !std::binary_search(col + outer[j], col + outer[j + 1], i)) ++count;
+      }
+      per_row[i] = count;
+    }
+  });
+  std::int64_t total = 0;
+  for (const std::int64_t c : per_row) total += c;
+  return total;
 }
 
 }  // namespace
@@ -117,63 +156,49 @@ FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& optio
   const int K = options.rays;
   const std::vector<PatchGeom> geom = patch_geometry(mesh);
   const double offset = kRayOffset * mesh.scale;
+  std::vector<Eigen::Vector3d> normals(n);
+  for (std::int32_t i = 0; i < n; ++i) normals[i] = geom[i].normal;
 
-  std::vector<std::vector<RowEntry>> rows(n);
+  // Rows have at most min(K, n - 1) entries; reciprocity averaging may add each entry's
+  // mirror, in place, so its room is reserved too (address space: see assembly.hpp).
+  const double row_max = std::min<double>(K, n - 1.0);
+  const double room = std::min(static_cast<double>(n) * (n - 1.0),
+                               (options.reciprocity == "average" ? 2.0 : 1.0) * n * row_max);
+  CsrAppender csr(n, static_cast<std::int64_t>(room), options.with_stderr);
+  std::vector<std::vector<RowEntry>> rows(std::min<std::int32_t>(n, kGatherBlockRows));
   Progress progress("gather", options.progress ? n : 0, "rays");
-  // Chunks of 16 rows: a row is K rays (~0.1 ms at K = 1024), so a chunk is a few ms,
-  // large enough to amortise the hit buffer, small enough to balance.
-  parallel_for(n, 16, options.threads, [&](std::int64_t begin, std::int64_t end) {
-    std::vector<Hit> hits;
-    hits.reserve(K);
-    for (std::int64_t ii = begin; ii < end; ++ii) {
-      const auto i = static_cast<std::int32_t>(ii);
-      trace_row(geom, bvh, i, K, options.seed, offset, hits);
-      row_from_hits(hits, K, options.with_stderr, rows[i]);
-      rows[i].shrink_to_fit();
-      progress.advance(1, K);
-    }
-  });
+  for (std::int32_t block = 0; block < n; block += kGatherBlockRows) {
+    const std::int32_t count = std::min(kGatherBlockRows, n - block);
+    // Chunks of 16 rows: a row is K rays (~0.1 ms at K = 1024), so a chunk is a few ms,
+    // large enough to amortise the buffers, small enough to balance.
+    parallel_for(count, 16, options.threads, [&](std::int64_t begin, std::int64_t end) {
+      // Per thread (threads live for one parallel_for): hits and the dense accumulator.
+      thread_local std::vector<Hit> hits;
+      thread_local std::vector<double> acc;
+      thread_local std::vector<std::int32_t> touched;
+      acc.resize(n, 0.0);
+      hits.reserve(K);
+      for (std::int64_t r = begin; r < end; ++r) {
+        const auto i = static_cast<std::int32_t>(block + r);
+        trace_row(geom, normals, bvh, i, K, options.seed, offset, hits);
+        row_from_hits(hits, K, options.with_stderr, acc, touched, rows[r]);
+        progress.advance(1, K);
+      }
+    });
+    for (std::int32_t r = 0; r < count; ++r) csr.append_row(rows[r]);
+  }
   progress.finish();
 
   FormFactors out;
   out.options = options;
-  std::int64_t nnz = 0;
-  for (const auto& r : rows) nnz += static_cast<std::int64_t>(r.size());
-  LAMBERT_CHECK(nnz <= std::numeric_limits<SparseF::StorageIndex>::max(),
-                "too many form factors for the sparse index type");
-  using Index = SparseF::StorageIndex;
-  SparseF F(n, n), S;
-  F.resizeNonZeros(nnz);
-  if (options.with_stderr) {
-    S.resize(n, n);
-    S.resizeNonZeros(nnz);
+  csr.finish(out.F, out.stderr_F);
+  // Averaging makes the pattern symmetric, and then the pairs are nnz / 2 for free
+  // (compute_form_factors counts them there); only an F left as it is needs the search.
+  if (options.reciprocity != "average") {
+    out.stats.pairs_tested = connected_pairs(out.F, options.threads);
+    out.stats.pairs_culled = static_cast<std::int64_t>(n) * (n - 1) / 2 - out.stats.pairs_tested;
   }
-  std::int64_t at = 0;
-  for (std::int32_t i = 0; i < n; ++i) {
-    F.outerIndexPtr()[i] = static_cast<Index>(at);
-    if (options.with_stderr) S.outerIndexPtr()[i] = static_cast<Index>(at);
-    for (const RowEntry& e : rows[i]) {
-      F.innerIndexPtr()[at] = e.j;
-      F.valuePtr()[at] = e.f;
-      if (options.with_stderr) {
-        S.innerIndexPtr()[at] = e.j;
-        S.valuePtr()[at] = e.err;
-      }
-      ++at;
-    }
-    std::vector<RowEntry>().swap(rows[i]);  // release memory as we go
-  }
-  F.outerIndexPtr()[n] = static_cast<Index>(at);
-  if (options.with_stderr) S.outerIndexPtr()[n] = static_cast<Index>(at);
-
-  // Pairs connected either way: the union of F's and F^T's patterns, each pair twice.
-  const SparseF Ft = F.transpose();
-  const SparseF U = F + Ft;
-  out.stats.pairs_tested = U.nonZeros() / 2;
-  out.stats.pairs_culled = static_cast<std::int64_t>(n) * (n - 1) / 2 - out.stats.pairs_tested;
   out.stats.rays = static_cast<std::int64_t>(n) * K;
-  out.F.swap(F);  // swap: Eigen 3.4 sparse matrices have no move (std::move copies)
-  if (options.with_stderr) out.stderr_F.swap(S);
   out.stats.seconds = timer.seconds();
   return out;
 }
