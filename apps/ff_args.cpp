@@ -113,12 +113,13 @@ void log_auto_pick(const FormFactors& ff, const FormFactorArgs& args, std::int32
 // ", reciprocity averaged (...)" for the summary line, or "".
 std::string reciprocity_summary(const FormFactors& ff) {
   if (ff.options.reciprocity != "average") return "";
-  char buf[200];
+  char buf[240];
   std::snprintf(buf, sizeof buf,
-                ", reciprocity averaged (change max %.3g, mean %.3g; balanced in %d sweeps; "
-                "%lld rows capped at 1)",
+                ", reciprocity averaged (change max %.3g, mean %.3g; balanced in %d sweeps, "
+                "pair scale %.4g-%.4g; %lld rows capped at 1)",
                 ff.stats.reciprocity_max_relative_change, ff.stats.reciprocity_mean_relative_change,
-                ff.stats.reciprocity_balance_iterations,
+                ff.stats.reciprocity_balance_iterations, ff.stats.reciprocity_scale_min,
+                ff.stats.reciprocity_scale_max,
                 static_cast<long long>(ff.stats.reciprocity_rows_scaled));
   return buf;
 }
@@ -193,6 +194,8 @@ Json reciprocity_json(const FormFactors& ff) {
           {"mean_relative_change", st.reciprocity_mean_relative_change},
           {"rows_scaled", st.reciprocity_rows_scaled},
           {"balance_iterations", st.reciprocity_balance_iterations},
+          {"scale_min", st.reciprocity_scale_min},
+          {"scale_max", st.reciprocity_scale_max},
           {"max_row_sum_before", st.reciprocity_max_row_sum}};
 }
 

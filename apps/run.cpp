@@ -70,6 +70,8 @@ Json report_json(const Report& rp) {
   ff["rays"] = r.ff_stats.rays;
   ff["reciprocity_max_relative_change"] = r.ff_stats.reciprocity_max_relative_change;
   ff["reciprocity_mean_relative_change"] = r.ff_stats.reciprocity_mean_relative_change;
+  ff["reciprocity_scale_min"] = r.ff_stats.reciprocity_scale_min;
+  ff["reciprocity_scale_max"] = r.ff_stats.reciprocity_scale_max;
   ff["reciprocity_rows_scaled"] = r.ff_stats.reciprocity_rows_scaled;
 
   Json channels = Json::array();

@@ -119,24 +119,26 @@ double pairwise_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
 
 // Peak of compute_hemicube: a row holds at most one entry per hemicube pixel (res^2 on the
 // top face, 4 x res x ceil(res/2) on the sides) and at most n - 1; rows are kept as 16-byte
-// entries until the CSR F (12 bytes per entry) is filled; averaging (reciprocity.cpp) builds
-// A F, its transpose, their sum and the result (5 CSR entries per entry).
+// entries until the CSR F (12 bytes per entry) is filled; averaging (reciprocity.cpp) is in
+// place, but F has no room for the union (up to 2 entries per entry), so its one
+// reallocation holds the old and the new storage: 2 more CSR entries per entry.
 double hemicube_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
   const double n = static_cast<double>(patches), res = o.hemicube_resolution;
   const double pixels = res * res + 4.0 * res * std::ceil(res / 2.0);
   const double entries = n * std::min(n - 1.0, pixels);
-  return entries * (16.0 + 12.0 + (o.reciprocity == "average" ? 5.0 * kCsrEntry : 0.0));
+  return entries * (16.0 + 12.0 + (o.reciprocity == "average" ? 2.0 * kCsrEntry : 0.0));
 }
 
 // Peak of compute_gather: a row holds at most min(K, n - 1) entries, kept as 24-byte
 // (j, F, stderr) entries until the CSR F is filled, plus the pattern union for the stats
 // (F^T and F + F^T: 3 CSR entries per entry); per task K 16-byte hits. Averaging builds
-// A F, its transpose, their sum (up to 2 entries per entry) and the result: 5 CSR entries
-// per entry; standard errors double the CSR part.
+// F in place (reciprocity.cpp): the union holds up to 2 entries per entry, 3 for the
+// moment of its one reallocation when F has no room reserved; at most the stats' 3 CSR
+// entries per entry either way; standard errors double the CSR part.
 double gather_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
   const double n = static_cast<double>(patches);
   const double entries = n * std::min(n - 1.0, static_cast<double>(o.rays));
-  const double csr = (o.reciprocity == "average" ? 5.0 : 3.0) * kCsrEntry;
+  const double csr = 3.0 * kCsrEntry;
   return entries * (24.0 + csr * (o.with_stderr ? 2.0 : 1.0)) +
          static_cast<double>(resolve_threads(o.threads)) * o.rays * 16.0;
 }

@@ -50,11 +50,16 @@ struct FormFactorStats {
   /// reported and warned about, expected 0.
   std::int64_t pairs_unverified = 0;
   double seconds = 0.0;           ///< wall time of the computation
-  /// Reciprocity averaging (0 when not applied; see reciprocity.hpp): the largest relative
-  /// change |G' - G| / G of an entry that was present (G = A_i F_ij), and the G-weighted
-  /// mean Σ|G' - G| / ΣG over all entries.
+  /// Reciprocity averaging (0 when not applied; see reciprocity.hpp), of its averaging step
+  /// alone (G = A_i F_ij before, G' = (A_i F_ij + A_j F_ji) / 2): the largest relative change
+  /// |G' - G| / G of an entry that was present, and the G-weighted mean Σ|G' - G| / ΣG over
+  /// all entries (created mirrors, G = 0, count in the numerator).
   double reciprocity_max_relative_change = 0.0;
   double reciprocity_mean_relative_change = 0.0;
+  /// The smallest and largest factor d_i d_j min(s_i, s_j) by which balancing and the cap
+  /// scaled an averaged pair (1 = untouched).
+  double reciprocity_scale_min = 0.0;
+  double reciprocity_scale_max = 0.0;
   /// Rows still above 1 after balancing, scaled down by the cap, and the largest row sum
   /// before the cap; balancing sweeps made.
   std::int64_t reciprocity_rows_scaled = 0;

@@ -1,11 +1,12 @@
-// Reciprocity averaging: see reciprocity.hpp for the equations, the balancing and the
-// row-sum cap.
+// Reciprocity averaging: see reciprocity.hpp for the equations, the balancing, the row-sum
+// cap and the in-place layout.
 
 #include "geometry/formfactors/reciprocity.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
@@ -15,17 +16,153 @@ namespace {
 
 using Index = SparseF::StorageIndex;
 
-// (diag(a) M + (diag(a) M)^T) / 2 with M = F, or for standard errors the root of
-// ((diag(a) S)² + ((diag(a) S)^T)²) / 4; both have the union of M's and M^T's patterns.
-SparseF average_G(const SparseF& M, const Eigen::VectorXd& a, bool squares) {
-  SparseF G = a.asDiagonal() * M;
-  if (squares) G = G.unaryExpr([](double v) { return v * v; });  // same pattern
-  const SparseF Gt = G.transpose();
-  SparseF H = (G + Gt) * (squares ? 0.25 : 0.5);
-  if (squares)
-    for (std::int64_t k = 0; k < H.nonZeros(); ++k) H.valuePtr()[k] = std::sqrt(H.valuePtr()[k]);
-  H.makeCompressed();
-  return H;
+// Position of column j in the sorted run col[begin, end), or -1.
+std::int64_t find_col(const Index* col, std::int64_t begin, std::int64_t end, Index j) {
+  const Index* p = std::lower_bound(col + begin, col + end, j);
+  return p != col + end && *p == j ? p - col : -1;
+}
+
+// Per-row sums of the averaging step's change (stats), reduced in row order afterwards so
+// that they do not depend on the thread count.
+struct RowChange {
+  double changed = 0.0, total = 0.0, max_rel = 0.0;
+  std::int64_t matched = 0;  // entries of the row whose mirror is stored
+};
+
+// Step 1 on F's own layout, rows in parallel: every pair stored both ways (i < j) gets
+// G_ij = (A_i F_ij + A_j F_ji) / 2 in both entries (G units, divided by A_i at the end);
+// an entry whose mirror is missing gets -A_i F_ij / 2, the sign marking it for
+// append_mirrors (F ≥ 0; std::signbit also marks a stored 0). Standard errors likewise:
+// sqrt((A_i s_ij)² + (A_j s_ji)²) / 2, or A_i s_ij / 2 one-way. Each pair is written by the
+// thread of its lower row only, and column indices are only read: no races.
+void average_pairs(SparseF& F, SparseF* S, const Eigen::VectorXd& a, int threads,
+                   std::vector<RowChange>& change) {
+  const Index* outer = F.outerIndexPtr();
+  const Index* col = F.innerIndexPtr();
+  double* val = F.valuePtr();
+  double* err = S ? S->valuePtr() : nullptr;
+  parallel_for(F.rows(), 256, threads, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) {
+      RowChange rc;
+      for (std::int64_t k = outer[i]; k < outer[i + 1]; ++k) {
+        const Index j = col[k];
+        const double gij = a[i] * val[k];
+        if (j == i) {  // its own mirror: unchanged
+          val[k] = gij;
+          if (err) err[k] *= a[i];
+          rc.total += gij;
+          ++rc.matched;
+          continue;
+        }
+        const std::int64_t q = find_col(col, outer[j], outer[j + 1], static_cast<Index>(i));
+        if (q < 0) {
+          const double g = gij / 2;
+          val[k] = -g;
+          if (err) err[k] = a[i] * err[k] / 2;
+          rc.changed += 2 * g;  // |g - G_ij| here and |g - 0| at the created mirror
+          rc.total += gij;
+          if (gij > 0.0) rc.max_rel = std::max(rc.max_rel, 0.5);
+          continue;
+        }
+        ++rc.matched;
+        if (j < i) continue;  // the pair was done from row j
+        const double gji = a[j] * val[q];
+        const double g = (gij + gji) / 2;
+        val[k] = val[q] = g;
+        if (err) {
+          const double si = a[i] * err[k], sj = a[j] * err[q];
+          err[k] = err[q] = std::sqrt(si * si + sj * sj) / 2;
+        }
+        // Both entries' changes are counted here, in row i's sums (a sum over pairs).
+        rc.changed += std::abs(g - gij) + std::abs(g - gji);
+        rc.total += gij + gji;
+        if (gij > 0.0) rc.max_rel = std::max(rc.max_rel, std::abs(g - gij) / gij);
+        if (gji > 0.0) rc.max_rel = std::max(rc.max_rel, std::abs(g - gji) / gji);
+      }
+      change[i] = rc;
+    }
+  });
+}
+
+// Moves every row of F (and the values of S) to its place in the union pattern, from the
+// last row to the first: row i goes from old[i] to start[i] ≥ old[i] (rows before i only
+// gain entries), so a row never overwrites one not yet moved. Its mirror slots follow it.
+void spread_rows(SparseF& F, SparseF* S, const std::vector<std::int64_t>& old,
+                 const std::vector<std::int64_t>& start) {
+  Index* col = F.innerIndexPtr();
+  double* val = F.valuePtr();
+  double* err = S ? S->valuePtr() : nullptr;
+  for (std::int64_t i = static_cast<std::int64_t>(start.size()) - 2; i >= 0; --i) {
+    const std::int64_t from = old[i], count = old[i + 1] - old[i], to = start[i];
+    if (to == from) break;  // rows 0..i gain nothing: already in place
+    std::copy_backward(col + from, col + from + count, col + to + count);
+    std::copy_backward(val + from, val + from + count, val + to + count);
+    if (err) std::copy_backward(err + from, err + from + count, err + to + count);
+  }
+}
+
+// The created mirrors, sequentially: the marked entry (i, j) (average_pairs) gets its
+// G = A_i F_ij / 2 back, and (j, i) with the same G is appended to row j's mirror slots.
+// Rows are visited in increasing i, so every row's appended run is sorted by column.
+void append_mirrors(SparseF& F, SparseF* S, const std::vector<std::int64_t>& old,
+                    const std::vector<std::int64_t>& start) {
+  const auto n = static_cast<std::int64_t>(start.size()) - 1;
+  Index* col = F.innerIndexPtr();
+  double* val = F.valuePtr();
+  double* err = S ? S->valuePtr() : nullptr;
+  std::vector<std::int64_t> fill(n);
+  for (std::int64_t i = 0; i < n; ++i) fill[i] = start[i] + (old[i + 1] - old[i]);
+  for (std::int64_t i = 0; i < n; ++i) {
+    for (std::int64_t k = start[i]; k < start[i] + (old[i + 1] - old[i]); ++k) {
+      if (!std::signbit(val[k])) continue;
+      val[k] = -val[k];
+      const Index j = col[k];
+      const std::int64_t at = fill[j]++;
+      col[at] = static_cast<Index>(i);
+      val[at] = val[k];
+      if (err) err[at] = err[k];
+    }
+  }
+  for (std::int64_t i = 0; i < n; ++i)
+    LAMBERT_CHECK(fill[i] == start[i + 1], "reciprocity: mirror count mismatch");
+}
+
+// Merges each row's two sorted runs (its own entries, then its created mirrors) in place,
+// rows in parallel: the shorter mirror run is copied to a per-task buffer and the two are
+// merged from the back. O(nnz) time, O(longest mirror run) memory per task.
+void merge_runs(SparseF& F, SparseF* S, const std::vector<std::int64_t>& old,
+                const std::vector<std::int64_t>& start, int threads) {
+  Index* col = F.innerIndexPtr();
+  double* val = F.valuePtr();
+  double* err = S ? S->valuePtr() : nullptr;
+  const auto n = static_cast<std::int64_t>(start.size()) - 1;
+  parallel_for(n, 256, threads, [&](std::int64_t begin, std::int64_t end) {
+    std::vector<Index> bc;
+    std::vector<double> bv, be;
+    for (std::int64_t i = begin; i < end; ++i) {
+      const std::int64_t own_end = start[i] + (old[i + 1] - old[i]);
+      const std::int64_t extra = start[i + 1] - own_end;
+      if (extra == 0) continue;
+      bc.assign(col + own_end, col + start[i + 1]);
+      bv.assign(val + own_end, val + start[i + 1]);
+      if (err) be.assign(err + own_end, err + start[i + 1]);
+      std::int64_t p = own_end - 1, b = extra - 1, w = start[i + 1] - 1;
+      while (b >= 0) {  // once the buffer is empty the rest of the own run is in place
+        if (p >= start[i] && col[p] > bc[b]) {
+          col[w] = col[p];
+          val[w] = val[p];
+          if (err) err[w] = err[p];
+          --p;
+        } else {
+          col[w] = bc[b];
+          val[w] = bv[b];
+          if (err) err[w] = be[b];
+          --b;
+        }
+        --w;
+      }
+    }
+  });
 }
 
 // Σ_j H_ij d_j for every row (rows in parallel; each row summed in order: deterministic).
@@ -76,40 +213,74 @@ void average_reciprocal(SparseF& F, SparseF* stderr_F, const std::vector<double>
   LAMBERT_CHECK(F.rows() == n && F.cols() == n, "reciprocity: F does not match the areas");
   F.makeCompressed();
   const Eigen::Map<const Eigen::VectorXd> a(areas.data(), n);
-  const Index* fo = F.outerIndexPtr();
-  const Index* fc = F.innerIndexPtr();
-  const double* fv = F.valuePtr();
+  const bool with_err = stderr_F && stderr_F->nonZeros() == F.nonZeros() && F.nonZeros() > 0;
+  SparseF* S = with_err ? stderr_F : nullptr;
+  if (S) {
+    S->makeCompressed();
+    LAMBERT_CHECK(std::equal(F.outerIndexPtr(), F.outerIndexPtr() + n + 1, S->outerIndexPtr()) &&
+                      std::equal(F.innerIndexPtr(), F.innerIndexPtr() + F.nonZeros(),
+                                 S->innerIndexPtr()),
+                  "reciprocity: stderr pattern differs from F");
+  }
   // The targets: each row's own sum before averaging, at most 1.
   std::vector<double> target(n, 0.0);
+  std::vector<std::int64_t> old(F.outerIndexPtr(), F.outerIndexPtr() + n + 1);
   for (Eigen::Index i = 0; i < n; ++i) {
     double s = 0.0;
-    for (std::int64_t k = fo[i]; k < fo[i + 1]; ++k) s += fv[k];
+    for (std::int64_t k = old[i]; k < old[i + 1]; ++k) s += F.valuePtr()[k];
     target[i] = std::min(s, 1.0);
   }
-  SparseF H = average_G(F, a, false);
-  const bool with_err = stderr_F && stderr_F->nonZeros() == F.nonZeros() && F.nonZeros() > 0;
-  SparseF E;
-  if (with_err) {
-    stderr_F->makeCompressed();
-    E = average_G(*stderr_F, a, true);
-    LAMBERT_CHECK(E.nonZeros() == H.nonZeros(), "reciprocity: stderr pattern differs from F");
-  }
-  const Index* outer = H.outerIndexPtr();
-  const Index* col = H.innerIndexPtr();
-  double* val = H.valuePtr();
 
-  // Balance: H_ij ← d_i d_j H_ij (symmetric, so still reciprocal).
+  // 1. Average in F's own layout; row i of the union gains the entries of column i whose
+  // mirror is missing: (entries in column i) - (entries of row i with a mirror).
+  std::vector<RowChange> change(n);
+  average_pairs(F, S, a, threads, change);
+  std::vector<std::int64_t> start(n + 1, 0);
+  for (std::int64_t k = 0; k < F.nonZeros(); ++k) ++start[F.innerIndexPtr()[k] + 1];
+  double changed = 0.0, total = 0.0, max_rel = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    start[i + 1] += start[i] - change[i].matched + (old[i + 1] - old[i]);
+    changed += change[i].changed;
+    total += change[i].total;
+    max_rel = std::max(max_rel, change[i].max_rel);
+  }
+  stats.reciprocity_max_relative_change = max_rel;
+  stats.reciprocity_mean_relative_change = total > 0.0 ? changed / total : 0.0;
+  std::vector<RowChange>().swap(change);
+
+  // The union's storage: within the allocation resizeNonZeros only moves the end (no copy,
+  // pointers kept; callers that reserved room, like gather, take this path). Otherwise it
+  // reallocates once, copying: the old and the new storage coexist for that moment.
+  const std::int64_t union_nnz = start[n];
+  F.resizeNonZeros(union_nnz);
+  if (S) S->resizeNonZeros(union_nnz);
+  spread_rows(F, S, old, start);
+  append_mirrors(F, S, old, start);
+  merge_runs(F, S, old, start, threads);
+  std::copy(start.begin(), start.end(), F.outerIndexPtr());
+  if (S) {
+    std::copy(start.begin(), start.end(), S->outerIndexPtr());
+    std::copy(F.innerIndexPtr(), F.innerIndexPtr() + union_nnz, S->innerIndexPtr());
+  }
+  std::vector<std::int64_t>().swap(old);
+
+  const Index* outer = F.outerIndexPtr();
+  const Index* col = F.innerIndexPtr();
+  double* val = F.valuePtr();
+  double* err = S ? S->valuePtr() : nullptr;
+
+  // 2. Balance: G_ij ← d_i d_j G_ij (symmetric, so still reciprocal).
   int iterations = 0;
-  const std::vector<double> d = balance(H, a, target, threads, iterations);
+  const std::vector<double> d = balance(F, a, target, threads, iterations);
   stats.reciprocity_balance_iterations = iterations;
   for (Eigen::Index i = 0; i < n; ++i)
     for (std::int64_t k = outer[i]; k < outer[i + 1]; ++k) {
       const double s = d[i] * d[col[k]];
       val[k] *= s;
-      if (with_err) E.valuePtr()[k] *= s;
+      if (err) err[k] *= s;
     }
 
-  // The cap: rows still above 1 (balancing stopped short, or a row without a target).
+  // 3. The cap: rows still above 1 (balancing stopped short, or a row without a target).
   std::vector<double> scale(n, 1.0);
   stats.reciprocity_max_row_sum = 0.0;
   stats.reciprocity_rows_scaled = 0;
@@ -124,29 +295,23 @@ void average_reciprocal(SparseF& F, SparseF* stderr_F, const std::vector<double>
     }
   }
 
-  // Scale pairs by min(s_i, s_j), compare with the old G (a merged sweep of the sorted rows
-  // of H and F: F's pattern is a subset of H's), and divide by A_i.
-  double changed = 0.0, total = 0.0, max_rel = 0.0;
+  // Scale pairs by min(s_i, s_j), record the factor d_i d_j min(s_i, s_j) of balance and
+  // cap, and divide by A_i.
+  double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
   for (Eigen::Index i = 0; i < n; ++i) {
-    std::int64_t f = fo[i];
     for (std::int64_t k = outer[i]; k < outer[i + 1]; ++k) {
       const Index j = col[k];
       const double s = std::min(scale[i], scale[j]);
+      const double factor = d[i] * d[j] * s;
+      lo = std::min(lo, factor);
+      hi = std::max(hi, factor);
       val[k] *= s;
-      double old_g = 0.0;
-      while (f < fo[i + 1] && fc[f] < j) ++f;
-      if (f < fo[i + 1] && fc[f] == j) old_g = a[i] * fv[f];
-      changed += std::abs(val[k] - old_g);
-      total += old_g;
-      if (old_g > 0.0) max_rel = std::max(max_rel, std::abs(val[k] - old_g) / old_g);
       val[k] /= a[i];
-      if (with_err) E.valuePtr()[k] *= s / a[i];
+      if (err) err[k] *= s / a[i];
     }
   }
-  stats.reciprocity_max_relative_change = max_rel;
-  stats.reciprocity_mean_relative_change = total > 0.0 ? changed / total : 0.0;
-  F.swap(H);  // swap: Eigen 3.4 sparse matrices have no move (std::move copies)
-  if (with_err) stderr_F->swap(E);
+  stats.reciprocity_scale_min = F.nonZeros() > 0 ? lo : 1.0;
+  stats.reciprocity_scale_max = F.nonZeros() > 0 ? hi : 1.0;
 }
 
 }  // namespace lambert::ff

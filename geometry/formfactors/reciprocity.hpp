@@ -23,8 +23,24 @@
 //     only decrease.
 // Standard errors (independent rows) become sqrt((A_i s_ij)² + (A_j s_ji)²) / 2 / A_i, then
 // scaled like their entries (the balancing factors are treated as constants).
-// Complexity O(nnz) per step (one sparse transpose; balancing O(nnz) per sweep, rows in
-// parallel). Deterministic for any thread count.
+//
+// In place: F's storage becomes the result, so the peak is the averaged CSR (the union of
+// F's and F^T's patterns, at most 2 nnz) plus O(N). (a) Pairs stored both ways are averaged
+// where they stand, rows in parallel, each pair by its lower row (its mirror found by
+// binary search); an entry without a mirror is marked by its sign. (b) Row i of the union
+// gains (entries of column i) − (entries of row i with a mirror); rows move to their final
+// starts from the last to the first. (c) The marked entries' mirrors are appended to their
+// rows in increasing source row (each appended run sorted), and (d) every row merges its
+// two sorted runs from the back through a buffer of its appended run. If the storage has no
+// room for the union (F.data().allocatedSize()), it is reallocated once with a copy (the old
+// and new storage coexist for that moment): callers that reserve room for the union (gather)
+// avoid it. Complexity O(nnz log L) for the mirror searches (L the row length), O(nnz) for
+// the moves and merges, O(nnz) per balancing sweep (rows in parallel). Deterministic, and
+// bitwise identical for any thread count.
+//
+// Statistics: the originals are not kept, so the change is reported for the averaging step
+// (reciprocity_mean/max_relative_change, computed as it happens) and the balancing and cap
+// as the range of their pair factors d_i d_j min(s_i, s_j) (reciprocity_scale_min/max).
 
 #include <vector>
 

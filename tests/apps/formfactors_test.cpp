@@ -137,7 +137,12 @@ TEST(FormFactorsCommand, GatherOnTheCornellBoxStoresItsRaysInTheSettings) {
   EXPECT_TRUE(ff.at("estimator_requested").is_null());
   // 200 patches x 64 rays (the mesh has about --patches patches).
   EXPECT_EQ(report.at("rays").get<std::int64_t>(), 64 * report.at("patches").get<std::int64_t>());
-  EXPECT_TRUE(report.at("reciprocity_averaging").at("applied").get<bool>());
+  const auto& rec = report.at("reciprocity_averaging");
+  EXPECT_TRUE(rec.at("applied").get<bool>());
+  // Balancing factors are clamped to [1/4, 4] (kMaxScale), the cap only lowers a pair.
+  EXPECT_GE(rec.at("scale_min").get<double>(), 1.0 / 16.0);
+  EXPECT_LE(rec.at("scale_min").get<double>(), rec.at("scale_max").get<double>());
+  EXPECT_LE(rec.at("scale_max").get<double>(), 16.0);
   EXPECT_LE(report.at("row_sums").at("max").get<double>(), 1.0 + 1e-12);
 }
 
