@@ -129,18 +129,20 @@ double hemicube_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
   return entries * (16.0 + 12.0 + (o.reciprocity == "average" ? 2.0 * kCsrEntry : 0.0));
 }
 
-// Peak of compute_gather: a row holds at most min(K, n - 1) entries, kept as 24-byte
-// (j, F, stderr) entries until the CSR F is filled, plus the pattern union for the stats
-// (F^T and F + F^T: 3 CSR entries per entry); per task K 16-byte hits. Averaging builds
-// F in place (reciprocity.cpp): the union holds up to 2 entries per entry, 3 for the
-// moment of its one reallocation when F has no room reserved; at most the stats' 3 CSR
-// entries per entry either way; standard errors double the CSR part.
+// Peak of compute_gather: rows have at most min(K, n - 1) entries; the CSR is written in
+// place (assembly.hpp) and averaging adds the mirrors there, so resident memory is the final
+// pattern, at most twice the rows' entries (and n(n - 1)); standard errors double it. Plus
+// the staging of one block of rows (24-byte entries) and per thread a dense accumulator of
+// n doubles and K hits (16 bytes).
 double gather_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
   const double n = static_cast<double>(patches);
-  const double entries = n * std::min(n - 1.0, static_cast<double>(o.rays));
-  const double csr = 3.0 * kCsrEntry;
-  return entries * (24.0 + csr * (o.with_stderr ? 2.0 : 1.0)) +
-         static_cast<double>(resolve_threads(o.threads)) * o.rays * 16.0;
+  const double row = std::min(n - 1.0, static_cast<double>(o.rays));
+  const double entries =
+      std::min(n * (n - 1.0), (o.reciprocity == "average" ? 2.0 : 1.0) * n * row);
+  const double staging = std::min(n, static_cast<double>(ff::kGatherBlockRows)) * row * 24.0;
+  const double per_thread = 8.0 * n + 16.0 * o.rays;
+  return entries * kCsrEntry * (o.with_stderr ? 2.0 : 1.0) + staging +
+         static_cast<double>(resolve_threads(o.threads)) * per_thread;
 }
 
 const std::vector<EstimatorEntry>& registry() {

@@ -37,9 +37,6 @@
 namespace lambert::ff {
 namespace {
 
-// Rows are traced in blocks of this many (in parallel within a block) and appended to the
-// CSR after each block: the staging is one block of rows.
-constexpr std::int32_t kGatherBlockRows = 4096;
 
 struct Hit {
   std::int32_t j;

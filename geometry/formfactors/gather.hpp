@@ -18,10 +18,15 @@
 
 namespace lambert::ff {
 
+/// Rows are traced in blocks of this many (in parallel within a block) and appended to the
+/// reserved CSR after each block: the staging is one block of rows.
+constexpr std::int32_t kGatherBlockRows = 4096;
+
 /// Estimator "gather": options.rays rays per patch, in replicate_count(rays) independently
 /// shifted Kronecker point sets (replicates.hpp) whose spread gives the standard errors.
-/// Rows are computed in parallel into per-row buffers and assembled in row order, so F is
-/// bitwise identical for any thread count. stats.rays = N·K; stats.pairs_tested = the
+/// Rows are computed in parallel, a block at a time, and appended in row order to a CSR
+/// reserved with room for averaging's mirrors, so F is bitwise identical for any thread
+/// count and averaging runs in place. stats.rays = N·K; stats.pairs_tested = the
 /// unordered pairs connected by at least one ray (either way), pairs_culled the rest.
 /// Reciprocity averaging is the caller's (compute_form_factors).
 FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& options,

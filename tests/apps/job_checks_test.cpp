@@ -147,8 +147,12 @@ TEST_F(JobChecks, JobsBeyondTheMemoryLimitAreRefused) {
   // The documented maximum mesh: about 1e8 x 456 bytes (mesh_peak_bytes) = 42 GiB > 1 GiB.
   expect_refused({"info", obj(), "-q", "--patches", "100000000", "--max-memory", "1G"},
                  kExitUsage, "--max-memory");
-  // 20000 patches: F's all-pairs bound 2e8 pairs x 56 bytes = 11 GiB > 1 GiB.
-  expect_refused({"formfactors", obj(), "-q", "--patches", "20000", "--max-memory", "1G", "-o",
+  // 20000 patches with hybrid: F's all-pairs bound 2e8 pairs x 32 bytes = 6 GiB > 1 GiB.
+  expect_refused({"formfactors", obj(), "-q", "--patches", "20000", "--estimator", "hybrid",
+                  "--max-memory", "1G", "-o", file("F3.bin")},
+                 kExitUsage, "form factors");
+  // The same with auto (gather there): 2 x 20000 x 1024 entries x 16 bytes = 655 MB > 256 MiB.
+  expect_refused({"formfactors", obj(), "-q", "--patches", "20000", "--max-memory", "256M", "-o",
                   file("F3.bin")},
                  kExitUsage, "form factors");
   ::setenv("LAMBERT_MAX_MEMORY", "1M", 1);
