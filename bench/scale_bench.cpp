@@ -5,8 +5,9 @@
 //    raw Embree closest-hit rays (rtcIntersect1) on the same BVH, in the same run, on rays
 //    of the same distribution (stratified points, cosine directions; pre-generated so only
 //    the traversal is timed), with the same thread count;
-//  - nnz of F and the peak RSS of the whole case (forked child: its peak is its own),
-//    against the bytes of the final CSR;
+//  - nnz of F and the peak RSS of the whole case (forked child: its peak is its own; it
+//    includes the mesh, BVH, the solvers' vectors and the 4M raw rays, ~100 MB, traced
+//    before F), against the bytes of the final CSR;
 //  - time to a relative residual of 1e-8 for gauss-seidel, bicgstab and cg.
 // Usage: scale_bench [--sizes 10000,30000,100000] [--rays K] [-j N] [--scenes cornell,room]
 // The machine is shared: compare ratios, and rerun for medians.
@@ -177,8 +178,7 @@ CaseResult run_case(const std::string& scene_name, std::int64_t target, int rays
   r.bvh_s = tb.seconds();
   // About 4M raw rays: enough for a stable rate, a few seconds at most.
   const int stride = std::max<std::int64_t>(1, static_cast<std::int64_t>(mesh.size()) * 64 / 4000000);
-  const std::vector<Ray> rays = hemisphere_rays(mesh, 64, stride);
-  r.raw_rate = raw_closest_hit(bvh, rays, threads);
+  r.raw_rate = raw_closest_hit(bvh, hemisphere_rays(mesh, 64, stride), threads);  // freed here
   FormFactorOptions o;
   o.estimator = "gather";
   o.rays = rays_per_patch;
