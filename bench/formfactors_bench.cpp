@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "bench/child.hpp"
+#include "bench/raw_rays.hpp"
 #include "core/log.hpp"
 #include "core/parallel.hpp"
 #include "core/sampling.hpp"
@@ -58,38 +59,6 @@ std::vector<Ray> mc_rays(const PatchMesh& mesh, int samples, std::int64_t pairs)
     }
   }
   return rays;
-}
-
-// `per_patch` rays from uniform points of every patch in cosine-distributed directions
-// (Malley), lifted like gather's.
-std::vector<Ray> gather_rays(const PatchMesh& mesh, int per_patch) {
-  const auto geom = ff::patch_geometry(mesh);
-  std::vector<Ray> rays;
-  Rng rng(54321);
-  const double offset = 1e-6 * mesh.scale;
-  for (const auto& g : geom) {
-    const Eigen::Vector3d t = g.normal.unitOrthogonal(), b = g.normal.cross(t);
-    for (int s = 0; s < per_patch; ++s) {
-      double jac;
-      const Eigen::Vector3d x = ff::sample_patch(g, rng.uniform(), rng.uniform(), jac);
-      const double u = rng.uniform(), phi = 2.0 * M_PI * rng.uniform(), r = std::sqrt(u);
-      const Eigen::Vector3d d =
-          r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(1.0 - u) * g.normal;
-      rays.push_back({(x + offset * g.normal).cast<float>(), d.cast<float>()});
-    }
-  }
-  return rays;
-}
-
-// Rays per second of bvh.intersect (closest hit) over `rays` on `threads` threads.
-double raw_closest_throughput(const Bvh& bvh, const std::vector<Ray>& rays, int threads) {
-  std::vector<std::int32_t> hit(rays.size());
-  Timer t;
-  parallel_for(static_cast<std::int64_t>(rays.size()), 4096, threads,
-               [&](std::int64_t b, std::int64_t e) {
-                 for (auto k = b; k < e; ++k) hit[k] = bvh.intersect(rays[k].org, rays[k].dir).patch;
-               });
-  return static_cast<double>(rays.size()) / t.seconds();
 }
 
 double median(std::vector<double> v) {
@@ -181,10 +150,10 @@ int main(int argc, char** argv) {
   std::printf("%-34s %14.2f %8.2f\n", "end-to-end fill, estimator hybrid", hy_m / 1e6, hy_m / raw_m);
 
   // Gather: closest-hit rays, K per patch.
-  const std::vector<Ray> grays = gather_rays(mesh, gather_k);
+  const std::vector<BenchRay> grays = hemisphere_rays(mesh, gather_k);
   std::vector<double> raw_closest, e2e_gather;
   for (int r = 0; r < repeats; ++r) {
-    raw_closest.push_back(raw_closest_throughput(bvh, grays, threads));
+    raw_closest.push_back(raw_closest_hit_rate(bvh, grays, threads));
     FormFactorOptions o;
     o.estimator = "gather";
     o.rays = gather_k;

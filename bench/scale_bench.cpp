@@ -20,6 +20,7 @@
 
 #include "apps/problem.hpp"
 #include "bench/child.hpp"
+#include "bench/raw_rays.hpp"
 #include "core/log.hpp"
 #include "core/parallel.hpp"
 #include "core/sampling.hpp"
@@ -116,45 +117,6 @@ Scene generated_room() {
   return s;
 }
 
-struct Ray {
-  Eigen::Vector3f org, dir;
-};
-
-// `per_patch` rays from every `stride`-th patch: uniform points, cosine-distributed
-// directions, origins lifted off the patch as the estimators do.
-std::vector<Ray> hemisphere_rays(const PatchMesh& mesh, int per_patch, int stride) {
-  const auto geom = ff::patch_geometry(mesh);
-  std::vector<Ray> rays;
-  Rng rng(777);
-  const double offset = 1e-6 * mesh.scale;
-  for (std::int32_t i = 0; i < mesh.size(); i += stride) {
-    const Eigen::Vector3d n = geom[i].normal;
-    const Eigen::Vector3d t = (std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY())
-                                  .cross(n)
-                                  .normalized();
-    const Eigen::Vector3d b = n.cross(t);
-    for (int k = 0; k < per_patch; ++k) {
-      double jac;
-      const Eigen::Vector3d x = ff::sample_patch(geom[i], rng.uniform(), rng.uniform(), jac);
-      const double r = std::sqrt(rng.uniform()), phi = 2 * M_PI * rng.uniform();
-      const Eigen::Vector3d d = r * std::cos(phi) * t + r * std::sin(phi) * b +
-                                std::sqrt(std::max(0.0, 1 - r * r)) * n;
-      rays.push_back({(x + offset * n).cast<float>(), d.cast<float>()});
-    }
-  }
-  return rays;
-}
-
-double raw_closest_hit(const Bvh& bvh, const std::vector<Ray>& rays, int threads) {
-  std::vector<std::int32_t> hit(rays.size());
-  Timer t;
-  parallel_for(static_cast<std::int64_t>(rays.size()), 4096, threads,
-               [&](std::int64_t b, std::int64_t e) {
-                 for (auto k = b; k < e; ++k) hit[k] = bvh.intersect(rays[k].org, rays[k].dir).patch;
-               });
-  return static_cast<double>(rays.size()) / t.seconds();
-}
-
 struct CaseResult {
   int patches = 0;
   double bvh_s = 0, raw_rate = 0, ff_s = 0, ff_rate = 0, rays = 0, average_s = 0, nnz = 0;
@@ -178,7 +140,7 @@ CaseResult run_case(const std::string& scene_name, std::int64_t target, int rays
   r.bvh_s = tb.seconds();
   // About 4M raw rays: enough for a stable rate, a few seconds at most.
   const int stride = std::max<std::int64_t>(1, static_cast<std::int64_t>(mesh.size()) * 64 / 4000000);
-  r.raw_rate = raw_closest_hit(bvh, hemisphere_rays(mesh, 64, stride), threads);  // freed here
+  r.raw_rate = raw_closest_hit_rate(bvh, hemisphere_rays(mesh, 64, stride), threads);  // freed here
   FormFactorOptions o;
   o.estimator = "gather";
   o.rays = rays_per_patch;

@@ -90,3 +90,25 @@ TEST(AccuracyCommand, SceneAndCaseTogetherIsAUsageError) {
 }
 
 }  // namespace lambert
+
+namespace lambert {
+
+// --estimators gather --gather-rays: one row per K, and its F within 4 standard errors of
+// the closed form. Unit squares 1 apart, one patch each, F = 0.19982; one row's K = 4096
+// Bernoulli rays have sigma <= sqrt(F (1 - F) / K) = 0.0063 (the stratified lattice only
+// lowers it, averaging with the mirror row lowers it by up to sqrt 2): 4 sigma = 0.025.
+TEST(AccuracyCommand, GatherRunsAtEveryRequestedRayCount) {
+  testing::TempDir dir;
+  const std::string prefix = dir.file("acc");
+  ASSERT_EQ(run({"accuracy", "--case", "parallel_squares", "--max-edge", "1", "-q",
+                 "--estimators", "gather", "--gather-rays", "1024,4096", "-o", prefix}),
+            kExitOk);
+  const auto table = lines(prefix + "_table.csv");
+  ASSERT_EQ(table.size(), 1u + 1u + 2u);  // header, reference, K = 1024 and 4096
+  EXPECT_EQ(column(table[0], table[2], "estimator"), "gather");
+  EXPECT_EQ(column(table[0], table[2], "setting"), "K=1024");
+  EXPECT_EQ(column(table[0], table[3], "setting"), "K=4096");
+  EXPECT_LT(std::stod(column(table[0], table[3], "F_exact_abs_err")), 0.025);
+}
+
+}  // namespace lambert

@@ -1,0 +1,55 @@
+#pragma once
+// Rays for measuring raw Embree throughput against the estimators (benchmarks only): the
+// rays are generated first, so only the traversal is timed.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "core/parallel.hpp"
+#include "core/sampling.hpp"
+#include "core/timer.hpp"
+#include "geometry/bvh.hpp"
+#include "geometry/formfactors/kernels.hpp"
+#include "geometry/mesh.hpp"
+
+struct BenchRay {
+  Eigen::Vector3f org, dir;
+};
+
+/// `per_patch` rays from every `stride`-th patch: uniform points, cosine-distributed
+/// directions (Malley), origins lifted off the patch like gather's (1e-6 x diagonal).
+inline std::vector<BenchRay> hemisphere_rays(const lambert::PatchMesh& mesh, int per_patch,
+                                             int stride = 1) {
+  const auto geom = lambert::ff::patch_geometry(mesh);
+  std::vector<BenchRay> rays;
+  lambert::Rng rng(54321);
+  const double offset = 1e-6 * mesh.scale;
+  for (std::int32_t i = 0; i < mesh.size(); i += stride) {
+    const auto& g = geom[i];
+    const Eigen::Vector3d t = g.normal.unitOrthogonal(), b = g.normal.cross(t);
+    for (int s = 0; s < per_patch; ++s) {
+      double jac;
+      const Eigen::Vector3d x = lambert::ff::sample_patch(g, rng.uniform(), rng.uniform(), jac);
+      const double u = rng.uniform(), phi = 2.0 * M_PI * rng.uniform(), r = std::sqrt(u);
+      const Eigen::Vector3d d =
+          r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(1.0 - u) * g.normal;
+      rays.push_back({(x + offset * g.normal).cast<float>(), d.cast<float>()});
+    }
+  }
+  return rays;
+}
+
+/// Rays per second of bvh.intersect (closest hit) over `rays` on `threads` threads.
+inline double raw_closest_hit_rate(const lambert::Bvh& bvh, const std::vector<BenchRay>& rays,
+                                   int threads) {
+  std::vector<std::int32_t> hit(rays.size());
+  lambert::Timer t;
+  lambert::parallel_for(static_cast<std::int64_t>(rays.size()), 4096, threads,
+                        [&](std::int64_t b, std::int64_t e) {
+                          for (auto k = b; k < e; ++k)
+                            hit[k] = bvh.intersect(rays[k].org, rays[k].dir).patch;
+                        });
+  return static_cast<double>(rays.size()) / t.seconds();
+}
