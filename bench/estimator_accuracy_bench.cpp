@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "apps/problem.hpp"
+#include "bench/power_law.hpp"
 #include "core/log.hpp"
 #include "core/parallel.hpp"
 #include "core/timer.hpp"
@@ -123,25 +124,6 @@ Errors corrected(Errors e, const Errors& noise) {
   e.b_rms = q(e.b_rms, noise.b_rms);
   e.bs_rms = q(e.bs_rms, noise.bs_rms);
   return e;
-}
-
-// The power law y = c x^p fitted to the points by least squares in log-log, at x (timings on
-// a shared machine are noisy: a fit through all gather runs is steadier than interpolating
-// between neighbours, and extrapolates with the overall slope); `extrapolated` says whether
-// x lies outside the points' range.
-double power_law_at(const std::vector<std::pair<double, double>>& pts, double x,
-                    bool& extrapolated) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0, lo = 1e300, hi = 0;
-  for (const auto& [px, py] : pts) {
-    const double lx = std::log(px), ly = std::log(std::max(py, 1e-300));
-    sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly;
-    lo = std::min(lo, px), hi = std::max(hi, px);
-  }
-  const double n = static_cast<double>(pts.size());
-  const double den = n * sxx - sx * sx;
-  const double slope = den > 0 ? (n * sxy - sx * sy) / den : 0.0;
-  extrapolated = x < lo || x > hi;
-  return std::exp((sy - slope * sx) / n + slope * std::log(x));
 }
 
 std::vector<int> parse_list(const char* s) {
@@ -289,11 +271,12 @@ int main(int argc, char** argv) {
       std::vector<std::pair<double, double>> pts;
       for (const auto& g : runs)
         if (g.estimator == "gather") pts.push_back({g.seconds, metric(g.err, k)});
-      bool extra = false;
+      const PowerLaw law = fit_power_law(pts);
+      const bool extra = law.extrapolates(h.seconds);
       Errors g_err;
       double* g_slot[kMetrics] = {&g_err.sf_max, &g_err.sf_rms, &g_err.row_max,
                                   &g_err.row_rms, &g_err.b_rms,  &g_err.bs_rms};
-      *g_slot[k] = power_law_at(pts, h.seconds, extra);
+      *g_slot[k] = law.at(h.seconds);
       const double n = metric(noise, k);
       const bool h_res = metric(h.err, k) > 2 * n, g_res = *g_slot[k] > 2 * n;
       const double he = metric(corrected(h.err, noise), k), ge = metric(corrected(g_err, noise), k);
