@@ -2,31 +2,35 @@
 // a generated scene family and on the Cornell box.
 //
 // Family (bench/scene_generator.hpp: the Cornell box with many tessellated ellipsoids, at
-// 10^3 ... 10^6 input triangles): per size, in a forked child (its peak RSS is its own),
-// solve_hierarchical at --epsilon, printing input triangles, elements, leaves, links (and
-// those with a cluster), links per input face, rays, peak RSS, the time of each phase
-// (build / refine / solve) and the total; then, where the scene meshes to at most
-// --family-matrix-patches patches, the matrix path on that mesh (mesh_scene,
-// compute_form_factors with gather at --family-rays, reciprocity averaging, gauss-seidel to
-// 1e-8) and the per-surface difference: area-weighted average radiosity of each surface,
-// worst |B_h - B_m| / B_m over surfaces and channels, and its area-weighted mean. The matrix
-// result has errors of its own (discretisation, gather noise): this is a difference, not an
-// error. Last, log-log least-squares growth exponents of time, links and rays against the
-// input triangles over the sizes run.
+// 10^3 ... 10^6 input triangles; ~2 minutes on 2 cores): per size, in a forked child,
+// solve_hierarchical at --epsilon, printing input triangles, elements, clusters, leaves,
+// links (and the share with a cluster end), links per input face, rays, peak RSS after the
+// solve, the method's own memory count, the time of each phase (build / refine / solve) and
+// the total; then, where the scene meshes to about --family-matrix-patches patches, the
+// matrix path on that mesh (mesh_scene, compute_form_factors with gather at --family-rays,
+// reciprocity averaging, gauss-seidel to 1e-8) and the per-surface difference: area-weighted
+// average radiosity of each surface, worst |B_h - B_m| / B_m over surfaces and channels, the
+// area-weighted mean of each surface's worst channel and the area-weighted mean signed
+// difference (bias). The matrix result has errors of its own (discretisation, gather noise):
+// this is a difference, not an error. Last, log-log least-squares growth exponents of time,
+// links, rays and peak RSS against the input triangles over the sizes run.
 //
 // Cornell box (the built-in scene): a reference from the matrix path at --ref-patches
 // patches (hybrid, --samples per pair, gauss-seidel to 1e-10) whose own error is estimated as
 // the worst per-surface difference to the same computation at a quarter of the patches (at
 // twice the element size, a discretisation error falling as h^p, p >= 1, leaves the fine
 // mesh an error <= that difference); then the matrix path (hybrid at --patches counts,
-// gauss-seidel to 1e-6) and the hierarchical method (at --epsilons) against it: time and worst
-// per-surface relative error. For each method the time to a worst error of 1.5 % (the
-// RenderPark figure: 1.5 % in 1.6 s) from a power law t = c e^p fitted to its runs whose
-// error exceeds twice the reference's (the cheapest measured run at or below 1.5 % too), and
-// the speed ratio at equal error at the reference's size: the reference's time against
-// hierarchical's time (from its fit) at the reference's estimated error.
+// gauss-seidel to 1e-6) and the hierarchical method (at --epsilons) against it: time, worst
+// and mean per-surface relative error, bias, and the escaped share of the emitted power (the
+// box is open at the front). For each method the time to a worst error of 1.5 % (the
+// RenderPark figure: 1.5 % in 1.6 s): interpolated between the runs bracketing it, from a
+// power law t = c e^p fitted to its runs whose error exceeds twice the reference's, and the
+// cheapest measured run at or below it. At the reference's size: its time against
+// hierarchical's time at the reference's estimated error (fit), and against the hierarchical
+// run with the nearest leaf count. Last, per surface, the signed difference of the finest run
+// of each method.
 //
-// Usage: hierarchical_bench [--sections family,cornell] [--sizes 1000,10000,100000]
+// Usage: hierarchical_bench [--sections family,cornell] [--sizes 1000,10000,100000,1000000]
 //   [--epsilon E] [--link-rays K] [--family-matrix-patches N] [--family-rays K]
 //   [--epsilons 1e-2,1e-3,1e-4,1e-5] [--patches 100,300,1000,3000] [--ref-patches N]
 //   [--samples S] [--seed S] [-j N]
@@ -65,7 +69,7 @@ constexpr double kTargetError = 0.015;
 
 struct Settings {
   std::vector<std::string> sections = {"family", "cornell"};
-  std::vector<double> sizes = {1000, 10000, 100000};
+  std::vector<double> sizes = {1000, 10000, 100000, 1000000};  // ~2 min in all
   double epsilon = HierarchicalOptions{}.epsilon;
   int link_rays = HierarchicalOptions{}.link_rays;
   std::int64_t family_matrix_patches = 20000;
@@ -119,6 +123,7 @@ SurfaceDiff surface_difference(const std::vector<SurfaceRadiosity>& a,
 struct MatrixRun {
   std::int32_t patches = 0;
   double ff_s = 0.0, seconds = 0.0;  ///< form factors; mesh + form factors + solve
+  double escaped = 0.0;              ///< escaped / emitted power, green channel
   std::vector<SurfaceRadiosity> surfaces;
 };
 
@@ -138,6 +143,7 @@ MatrixRun run_matrix(const Scene& scene, std::int64_t patches, const FormFactorO
   r.ff_s = f.stats.seconds;
   r.patches = mesh.size();
   r.surfaces = surface_averages(mesh, sol.B);
+  r.escaped = sol.energy[1].escaped / sol.energy[1].emitted;
   return r;
 }
 
@@ -277,7 +283,9 @@ void run_family(const Settings& s) {
     m_pts.push_back({tri, r.peak_kb / 1024.0});
   }
   std::printf(
-      "\n(clust%%: links with a cluster at one end; l/face: links per input face; "
+      "\n(peak MB: the child's peak RSS after the hierarchical solve (scene included); hier "
+      "MB: the method's own count of its nodes, links and BVH; case MB: the child's peak with "
+      "the matrix path; clust%%: links with a cluster at one end; l/face: links per input face; "
       "pass/it: refinement passes / Jacobi sweeps, ! = not converged; imbal: worst "
       "channel's |emitted - absorbed - escaped| / emitted)\n");
   if (t_pts.size() >= 2) {
@@ -296,7 +304,9 @@ struct Point {
   std::string label;
   double seconds = 0.0, error = 0.0;
   SurfaceDiff diff;
-  std::string surface;
+  std::string surface;  ///< where the worst error is, "name/channel"
+  std::vector<SurfaceRadiosity> surfaces;
+  std::int64_t leaves = 0;  ///< hierarchical: leaf elements
 };
 
 // Time to kTargetError: between the two runs bracketing it (log t linear in log e), and from
@@ -333,7 +343,7 @@ void print_time_to_target(const char* method, std::vector<Point> runs, double re
 
 Point point(const std::string& label, double seconds, const std::vector<SurfaceRadiosity>& a,
             const std::vector<SurfaceRadiosity>& ref) {
-  Point p{label, seconds, 0.0, surface_difference(a, ref), ""};
+  Point p{label, seconds, 0.0, surface_difference(a, ref), "", a, 0};
   p.error = p.diff.worst;
   if (p.diff.surface >= 0) p.surface = ref[p.diff.surface].name + "/" + "RGB"[p.diff.channel];
   return p;
@@ -345,79 +355,118 @@ void print_point(const char* method, const Point& p, const char* extra) {
   std::fflush(stdout);
 }
 
-void run_cornell(const Settings& s) {
-  const Scene scene = load_obj(builtin_cornell_box_path());
-  std::printf("== Cornell box: reference = hybrid, %d samples, gauss-seidel 1e-10 ==\n", s.samples);
-  const MatrixRun fine =
-      run_matrix(scene, s.ref_patches, matrix_options(s, "hybrid"), 1e-10, s.threads);
-  const MatrixRun coarse =
-      run_matrix(scene, s.ref_patches / 4, matrix_options(s, "hybrid"), 1e-10, s.threads);
-  const SurfaceDiff own = surface_difference(coarse.surfaces, fine.surfaces);
+struct Reference {
+  MatrixRun fine, coarse;
+  SurfaceDiff own;  ///< coarse against fine: the fine one's error estimate
+};
+
+Reference cornell_reference(const Scene& scene, const Settings& s) {
+  Reference r;
+  r.fine = run_matrix(scene, s.ref_patches, matrix_options(s, "hybrid"), 1e-10, s.threads);
+  r.coarse = run_matrix(scene, s.ref_patches / 4, matrix_options(s, "hybrid"), 1e-10, s.threads);
+  r.own = surface_difference(r.coarse.surfaces, r.fine.surfaces);
   std::printf(
-      "reference: %d patches in %.1f s (form factors %.1f s); at %d patches (%.1f s) "
-      "it differs by %.2e worst (%s/%c), %.2e mean: the reference's own error "
-      "estimate\n\n",
-      fine.patches, fine.seconds, fine.ff_s, coarse.patches, coarse.seconds, own.worst,
-      fine.surfaces[std::max(own.surface, 0)].name.c_str(), "RGB"[std::max(own.channel, 0)],
-      own.mean);
-  std::printf("  %-12s %-22s %9s %10s %10s %10s  %-16s\n", "method", "setting", "seconds", "worst",
-              "mean", "bias", "worst at");
-  std::vector<Point> matrix, hier;
-  std::vector<std::int64_t> leaves;
+      "reference: %d patches in %.1f s (form factors %.1f s), escaped %.2f %% of the emitted "
+      "power (G); at %d patches (%.1f s) it differs by %.2e worst (%s/%c), %.2e mean, %+.2e "
+      "bias: the reference's own error estimate\n\n",
+      r.fine.patches, r.fine.seconds, r.fine.ff_s, 100 * r.fine.escaped, r.coarse.patches,
+      r.coarse.seconds, r.own.worst, r.fine.surfaces[std::max(r.own.surface, 0)].name.c_str(),
+      "RGB"[std::max(r.own.channel, 0)], r.own.mean, r.own.bias);
+  return r;
+}
+
+std::vector<Point> cornell_matrix(const Scene& scene, const Settings& s, const Reference& ref) {
+  std::vector<Point> runs;
   for (const double n : s.patches) {
     const MatrixRun m = run_matrix(scene, static_cast<std::int64_t>(n), matrix_options(s, "hybrid"),
                                    1e-6, s.threads);
-    char label[64];
+    char label[64], extra[96];
     std::snprintf(label, sizeof label, "%d patches", m.patches);
-    matrix.push_back(point(label, m.seconds, m.surfaces, fine.surfaces));
-    char extra[64];
-    std::snprintf(extra, sizeof extra, "(form factors %.2f s)", m.ff_s);
-    print_point("matrix", matrix.back(), extra);
+    runs.push_back(point(label, m.seconds, m.surfaces, ref.fine.surfaces));
+    std::snprintf(extra, sizeof extra, "(form factors %.2f s, escaped %.2f %%)", m.ff_s,
+                  100 * m.escaped);
+    print_point("matrix", runs.back(), extra);
   }
+  return runs;
+}
+
+std::vector<Point> cornell_hierarchical(const Scene& scene, const Settings& s,
+                                        const Reference& ref) {
+  std::vector<Point> runs;
   for (const double eps : s.epsilons) {
     Timer t;
     const HierarchicalResult h = solve_hierarchical(scene, hierarchical_options(s, eps));
     const double seconds = t.seconds();
-    char label[64], extra[160];
+    const HierarchicalStats& st = h.stats;
+    char label[64], extra[192];
     std::snprintf(label, sizeof label, "epsilon %.0e", eps);
-    hier.push_back(point(label, seconds, surface_averages(h.mesh, h.B), fine.surfaces));
-    std::snprintf(extra, sizeof extra, "(%lld leaves, %.3g links, %.3g rays, %d passes%s)",
-                  static_cast<long long>(h.stats.leaves), static_cast<double>(h.stats.links),
-                  static_cast<double>(h.stats.rays), h.stats.passes,
-                  h.stats.converged ? "" : ", not converged");
-    print_point("hierarchical", hier.back(), extra);
-    leaves.push_back(h.stats.leaves);
+    runs.push_back(point(label, seconds, surface_averages(h.mesh, h.B), ref.fine.surfaces));
+    runs.back().leaves = st.leaves;
+    std::snprintf(extra, sizeof extra,
+                  "(%lld leaves, %.3g links, %.3g rays, %d passes%s, escaped %.2f %%)",
+                  static_cast<long long>(st.leaves), static_cast<double>(st.links),
+                  static_cast<double>(st.rays), st.passes, st.converged ? "" : ", not converged",
+                  100 * st.energy[1].escaped / st.energy[1].emitted);
+    print_point("hierarchical", runs.back(), extra);
   }
-  std::printf("\ntime to a worst per-surface error of %.1f %% (RenderPark: 1.6 s):\n",
-              100 * kTargetError);
-  print_time_to_target("matrix", matrix, own.worst);
-  print_time_to_target("hierarchical", hier, own.worst);
-  // At the reference's size: its time at its estimated error against hierarchical's time at
-  // that error (fit), and against the hierarchical run with the leaf count nearest to it.
+  return runs;
+}
+
+// At the reference's size: its time at its estimated error against hierarchical's time at
+// that error (fit), and against the hierarchical run with the leaf count nearest to it.
+void print_equal_error(const Reference& ref, const std::vector<Point>& hier) {
+  const double e = ref.own.worst, tm = ref.fine.seconds;
+  std::printf("matrix at %d patches: %.1f s, error <= %.2e (its estimate)\n", ref.fine.patches, tm,
+              e);
   std::vector<std::pair<double, double>> pts;
   for (const Point& p : hier)
-    if (p.error > 2.0 * own.worst) pts.push_back({p.error, p.seconds});
-  std::printf("matrix at %d patches: %.1f s, error <= %.2e (its estimate)\n", fine.patches,
-              fine.seconds, own.worst);
+    if (p.error > 2.0 * e) pts.push_back({p.error, p.seconds});
   if (pts.size() >= 2) {
     const PowerLaw law = fit_power_law(pts);
-    const double th = law.at(own.worst);
     std::printf(
         "  hierarchical at that error (fit): %.2f s%s; time ratio hierarchical / matrix "
         "%.2f\n",
-        th, law.extrapolates(own.worst) ? " (extrapolated)" : "", th / fine.seconds);
+        law.at(e), law.extrapolates(e) ? " (extrapolated)" : "", law.at(e) / tm);
   }
-  std::size_t near = 0;
-  for (std::size_t i = 0; i < hier.size(); ++i)
-    if (std::abs(std::log(static_cast<double>(leaves[i]) / fine.patches)) <
-        std::abs(std::log(static_cast<double>(leaves[near]) / fine.patches)))
-      near = i;
-  if (!hier.empty())
-    std::printf(
-        "  hierarchical with the nearest leaf count (%s, %lld leaves): %.2f s, error "
-        "%.2e; time ratio hierarchical / matrix %.2f\n",
-        hier[near].label.c_str(), static_cast<long long>(leaves[near]), hier[near].seconds,
-        hier[near].error, hier[near].seconds / fine.seconds);
+  if (hier.empty()) return;
+  auto off = [&](const Point& p) {
+    return std::abs(std::log(p.leaves / double(ref.fine.patches)));
+  };
+  const Point& near = *std::min_element(
+      hier.begin(), hier.end(), [&](const Point& a, const Point& b) { return off(a) < off(b); });
+  std::printf(
+      "  hierarchical with the nearest leaf count (%s, %lld leaves): %.2f s, error %.2e; "
+      "time ratio hierarchical / matrix %.2f\n",
+      near.label.c_str(), static_cast<long long>(near.leaves), near.seconds, near.error,
+      near.seconds / tm);
+}
+
+// Signed relative difference per surface (green channel) of the finest run of each method.
+void print_surfaces(const Reference& ref, const Point& matrix, const Point& hier) {
+  std::printf("\nper surface, (B - B_ref) / B_ref, green: %-14s %-14s %-14s\n", "coarse ref",
+              matrix.label.c_str(), hier.label.c_str());
+  for (std::size_t i = 0; i < ref.fine.surfaces.size(); ++i) {
+    const double r = ref.fine.surfaces[i].average[1];
+    std::printf("  %-38s %+14.2e %+14.2e %+14.2e\n", ref.fine.surfaces[i].name.c_str(),
+                ref.coarse.surfaces[i].average[1] / r - 1, matrix.surfaces[i].average[1] / r - 1,
+                hier.surfaces[i].average[1] / r - 1);
+  }
+}
+
+void run_cornell(const Settings& s) {
+  const Scene scene = load_obj(builtin_cornell_box_path());
+  std::printf("== Cornell box: reference = hybrid, %d samples, gauss-seidel 1e-10 ==\n", s.samples);
+  const Reference ref = cornell_reference(scene, s);
+  std::printf("  %-12s %-22s %9s %10s %10s %10s  %-16s\n", "method", "setting", "seconds", "worst",
+              "mean", "bias", "worst at");
+  const std::vector<Point> matrix = cornell_matrix(scene, s, ref);
+  const std::vector<Point> hier = cornell_hierarchical(scene, s, ref);
+  std::printf("\ntime to a worst per-surface error of %.1f %% (RenderPark: 1.6 s):\n",
+              100 * kTargetError);
+  print_time_to_target("matrix", matrix, ref.own.worst);
+  print_time_to_target("hierarchical", hier, ref.own.worst);
+  print_equal_error(ref, hier);
+  if (!matrix.empty() && !hier.empty()) print_surfaces(ref, matrix.back(), hier.back());
   std::printf("\n");
 }
 
