@@ -55,17 +55,55 @@ struct State {
   std::vector<Eigen::Vector3d> B, H;
   std::vector<Corners> gathered;  ///< at an element's corners (clusters: uniform, [0])
   std::vector<Eigen::Vector3d> lo, hi;  ///< per channel min and max of the leaves' B below
+  std::vector<Eigen::Matrix3d> grad;    ///< elements: gradient of B (row = channel), in plane
+  /// B of node q read at offset d from its centroid (its linear fit, kept within [lo, hi]).
+  Eigen::Vector3d read(std::int32_t q, const float* d) const {
+    const Eigen::Vector3d offset(d[0], d[1], d[2]);
+    return (B[q] + grad[q] * offset).cwiseMax(lo[q]).cwiseMin(hi[q]);
+  }
   hr::SourceB source(std::int32_t q) const {
     return {B[q].maxCoeff(), (hi[q] - lo[q]).maxCoeff(), hi[q].maxCoeff()};
   }
   void resize(std::size_t n) {
     lo.resize(n, Eigen::Vector3d::Zero());
+    grad.resize(n, Eigen::Matrix3d::Zero());
     hi.resize(n, Eigen::Vector3d::Zero());
     B.resize(n, Eigen::Vector3d::Zero());
     gathered.resize(n, kNoCorners);
     H.resize(n, Eigen::Vector3d::Zero());
   }
 };
+
+/// Least-squares gradient (rows: channels) in the plane with unit normal n of values v_k at
+/// points x_k with weights w_k: the linear fit v = v̄ + g (x - x̄). Zero when the points do
+/// not span the plane.
+Eigen::Matrix3d plane_gradient(const Eigen::Vector3d& n, const Eigen::Vector3d* x,
+                               const Eigen::Vector3d* v, const double* w, int count) {
+  const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+  double sw = 0.0;
+  Eigen::Vector3d xm = Eigen::Vector3d::Zero(), vm = Eigen::Vector3d::Zero();
+  for (int k = 0; k < count; ++k) {
+    sw += w[k];
+    xm += w[k] * x[k];
+    vm += w[k] * v[k];
+  }
+  if (!(sw > 0.0)) return Eigen::Matrix3d::Zero();
+  xm /= sw;
+  vm /= sw;
+  Eigen::Matrix2d M = Eigen::Matrix2d::Zero();
+  Eigen::Matrix<double, 2, 3> R = Eigen::Matrix<double, 2, 3>::Zero();
+  for (int k = 0; k < count; ++k) {
+    const Eigen::Vector2d a(t1.dot(x[k] - xm), t2.dot(x[k] - xm));
+    M += w[k] * a * a.transpose();
+    R += w[k] * a * (v[k] - vm).transpose();
+  }
+  // Degenerate (collinear) point sets: no gradient rather than an ill-conditioned one.
+  if (!(M.determinant() > 1e-12 * M.squaredNorm())) return Eigen::Matrix3d::Zero();
+  const Eigen::Matrix<double, 2, 3> g = M.inverse() * R;  // rows: in-plane directions
+  Eigen::Matrix3d out;
+  for (int c = 0; c < 3; ++c) out.row(c) = (g(0, c) * t1 + g(1, c) * t2).transpose();
+  return out;
+}
 
 /// The corner values of child k of element i (split_element's order) interpolated from i's:
 /// edge midpoints average two corners, a quad's centre all four (exact for the linear and
@@ -110,11 +148,14 @@ double push_pull(const Hierarchy& h, std::int32_t i, const Corners& down, State&
     // The spread of B over the leaf: its irradiance varies between the corner values.
     s.lo[i] = b;
     s.hi[i] = b;
+    Eigen::Vector3d bk[4];
     for (int k = 0; k < corners; ++k) {
-      const Eigen::Vector3d bk = face.emission + face.rho.cwiseProduct(H[k]);
-      s.lo[i] = s.lo[i].cwiseMin(bk);
-      s.hi[i] = s.hi[i].cwiseMax(bk);
+      bk[k] = face.emission + face.rho.cwiseProduct(H[k]);
+      s.lo[i] = s.lo[i].cwiseMin(bk[k]);
+      s.hi[i] = s.hi[i].cwiseMax(bk[k]);
     }
+    const ff::PatchGeom& g = h.geom(i);
+    s.grad[i] = plane_gradient(g.normal, g.p.data(), bk, mu.data(), corners);
     s.H[i] = mean;
     return change;
   }
@@ -134,6 +175,17 @@ double push_pull(const Hierarchy& h, std::int32_t i, const Corners& down, State&
   s.lo[i] = lo;
   s.hi[i] = hi;
   s.B[i] = sum / n.area;
+  if (!n.cluster) {
+    Eigen::Vector3d x[4], v[4];
+    double w[4];
+    for (int k = 0; k < n.child_count; ++k) {
+      const std::int32_t c = h.child(i, k);
+      x[k] = h.geom(c).centroid;
+      v[k] = s.B[c];
+      w[k] = h.node(c).area;
+    }
+    s.grad[i] = plane_gradient(h.geom(i).normal, x, v, w, n.child_count);
+  }
   return change;
 }
 
@@ -160,7 +212,7 @@ void gather(const LinkTable& t, State& s, int threads) {
     for (std::int64_t r = begin; r < end; ++r) {
       Corners sum = kNoCorners;
       for (std::int64_t k = t.starts[r]; k < t.starts[r + 1]; ++k) {
-        const Eigen::Vector3d& b = s.B[t.links[k].q];
+        const Eigen::Vector3d b = s.read(t.links[k].q, t.links[k].d);
         for (int c = 0; c < 4; ++c) sum[c] += static_cast<double>(t.links[k].c[c]) * b;
       }
       s.gathered[t.links[t.starts[r]].p] = sum;

@@ -140,16 +140,34 @@ Action element_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, cons
   double seen_weight = 0.0, weight = 0.0;
   int traced = 0, points_seen = 0, points_blocked = 0, exhausted = 0;
   bool partial = false;
+  // Rays drawn with the kernel's density from each point (the count_visible kernel, with the
+  // sampled ends kept): their mean end is the kernel centroid y* on q, where the link reads
+  // q's linear radiosity (offset from q's centroid, Link::d).
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  double centroid_weight = 0.0;
   for (int k = 0; k < count; ++k) {
-    const int seen = ff::count_visible(ctx.bvh, points[k].x, gp.normal, gq, per_point,
-                                       hash_keys(ctx.seed, link_key(p, q), k), ctx.offset,
-                                       exhausted);
+    const ff::KernelSampler sampler(points[k].x, gp.normal, gq);
+    if (sampler.empty()) continue;
+    const std::uint64_t stream = hash_keys(ctx.seed, link_key(p, q), k);
+    const Kronecker4 seq(stream);
+    Rng rng(mix64(stream));
+    int seen = 0;
+    Eigen::Vector3d ends = Eigen::Vector3d::Zero();
+    for (int r = 0; r < per_point; ++r) {
+      bool gave_up = false;
+      const Eigen::Vector3d y = sampler.sample(seq.get(r, 0), seq.get(r, 1), seq.get(r, 2), rng, gave_up);
+      exhausted += gave_up;
+      ends += y;
+      seen += ff::visible(ctx.bvh, points[k].x, gp.normal, y, gq.normal, ctx.offset);
+    }
     traced += per_point;
     partial |= seen > 0 && seen < per_point;
     points_seen += seen > 0;
     points_blocked += seen < per_point;
     seen_weight += points[k].weight * seen / per_point;
     weight += points[k].weight;
+    centroid += points[k].weight * ends / per_point;
+    centroid_weight += points[k].weight;
   }
   rays += traced;
   partial |= points_seen > 0 && points_blocked > 0;
@@ -157,6 +175,10 @@ Action element_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, cons
   link.p = p;
   link.q = q;
   link.F = static_cast<float>(unoccluded * vis);
+  const Eigen::Vector3d d =
+      centroid_weight > 0.0 ? Eigen::Vector3d(centroid / centroid_weight - gq.centroid)
+                            : Eigen::Vector3d::Zero();
+  for (int k = 0; k < 3; ++k) link.d[k] = static_cast<float>(d[k]);
   for (int k = 0; k < 4; ++k) link.c[k] = static_cast<float>(unoccluded * vis * shape[k]);
   // Visibility is uncertain by 1 where the shadow boundary crosses the link, else by the
   // chance that `traced` rays all agree while the true fraction is not 0 or 1 (~1/(n+1)).

@@ -46,7 +46,7 @@
 
 namespace lambert::hr {
 
-/// One link p <- q (32 bytes).
+/// One link p <- q (44 bytes).
 struct Link {
   std::int32_t p = 0;  ///< receiver node
   std::int32_t q = 0;  ///< source node
@@ -56,6 +56,10 @@ struct Link {
   /// the link delivers is interpolated from corner values c_k B_q (linear on triangles,
   /// bilinear on quads) with mean F (sum_k mu_k c_k = F, corner_masses).
   float c[4] = {0, 0, 0, 0};
+  /// Where the link reads q's radiosity: the kernel centroid on q minus q's centroid (scene
+  /// units; 0 for cluster links). The transfer uses B_q + grad B_q · d, q's linear fit,
+  /// which removes the first-order error of transferring q's average.
+  float d[3] = {0, 0, 0};
 };
 
 /// What to do with a link.
