@@ -75,6 +75,16 @@ Json energy_json(const EnergyBalance& e) {
           {"relative_non_reciprocity_part", relative(e, e.non_reciprocity_part)}};
 }
 
+Json surface_averages_json(const std::vector<SurfaceRadiosity>& surfaces) {
+  Json list = Json::array();
+  for (const auto& s : surfaces)
+    list.push_back({{"name", s.name},
+                    {"area", s.area},
+                    {"patches", s.patches},
+                    {"average_radiosity", {s.average[0], s.average[1], s.average[2]}}});
+  return list;
+}
+
 std::string energy_split_text(const EnergyBalance& e) {
   char buf[96];
   std::snprintf(buf, sizeof buf, "residual part %.2e, non-reciprocity part %.2e",
