@@ -1,0 +1,394 @@
+#include "geometry/hierarchical/hierarchical.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <unordered_map>
+
+#include "core/error.hpp"
+#include "core/memory.hpp"
+#include "core/parallel.hpp"
+#include "core/progress.hpp"
+#include "core/timer.hpp"
+#include "geometry/bvh.hpp"
+#include "geometry/formfactors/constants.hpp"
+#include "geometry/hierarchical/hierarchy.hpp"
+#include "geometry/hierarchical/links.hpp"
+
+namespace lambert {
+namespace {
+
+using hr::Action;
+using hr::Hierarchy;
+using hr::Link;
+
+/// Relative element area bound when --min-area is 0: 1e-5 of the total area lets a surface
+/// of 1 % of the scene split to ~1000 leaves, the resolution of a fine uniform mesh.
+constexpr double kAutoMinAreaFraction = 1e-5;
+
+/// Chunk sizes of the parallel loops (items per task): big enough to amortise scheduling,
+/// small enough to balance 2-64 threads.
+constexpr std::int64_t kEvalChunk = 256;
+constexpr std::int64_t kGatherChunk = 1024;
+
+void check_options(const HierarchicalOptions& o) {
+  if (!(o.epsilon > 0.0 && o.epsilon < 1.0))
+    throw UsageError("--epsilon must be in (0, 1), got " + std::to_string(o.epsilon));
+  if (!(o.min_area >= 0.0 && std::isfinite(o.min_area)))
+    throw UsageError("--min-area must be a finite number >= 0");
+  if (o.link_rays < 1 || o.link_rays > 4096)
+    throw UsageError("--link-rays must be in [1, 4096], got " + std::to_string(o.link_rays));
+  if (!(o.tol > 0.0 && o.tol < 1.0)) throw UsageError("--tol must be in (0, 1)");
+  if (o.max_iterations < 1) throw UsageError("--max-iter must be >= 1");
+  if (o.max_passes < 1) throw UsageError("the number of refinement passes must be >= 1");
+}
+
+/// The per-node state of the solution: radiosity B (area average below the node), the
+/// irradiance gathered over the node's own links, and for leaves the total irradiance.
+struct State {
+  std::vector<Eigen::Vector3d> B, gathered, H;
+  std::vector<Eigen::Vector3d> lo, hi;  ///< per channel min and max of the leaves' B below
+  hr::SourceB source(std::int32_t q) const {
+    return {B[q].maxCoeff(), (hi[q] - lo[q]).maxCoeff(), hi[q].maxCoeff()};
+  }
+  void resize(std::size_t n) {
+    lo.resize(n, Eigen::Vector3d::Zero());
+    hi.resize(n, Eigen::Vector3d::Zero());
+    B.resize(n, Eigen::Vector3d::Zero());
+    gathered.resize(n, Eigen::Vector3d::Zero());
+    H.resize(n, Eigen::Vector3d::Zero());
+  }
+};
+
+/// Push-pull: irradiance down (each child receives its ancestors' gathered irradiance, a
+/// cluster's spread uniformly over its area), B = E + rho H at the leaves, area-averaged B
+/// up. Returns the largest change of a leaf's B (any channel).
+double push_pull(const Hierarchy& h, std::int32_t i, const Eigen::Vector3d& down, State& s) {
+  const Eigen::Vector3d H = down + s.gathered[i];
+  const hr::Node& n = h.node(i);
+  if (n.child_count == 0) {
+    const Patch& face = h.faces().patches[n.face];
+    const Eigen::Vector3d b = face.emission + face.rho.cwiseProduct(H);
+    const double change = (b - s.B[i]).cwiseAbs().maxCoeff();
+    s.B[i] = b;
+    s.lo[i] = b;
+    s.hi[i] = b;
+    s.H[i] = H;
+    return change;
+  }
+  double change = 0.0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = Eigen::Vector3d::Zero();
+  for (int k = 0; k < n.child_count; ++k) {
+    const std::int32_t c = h.child(i, k);
+    change = std::max(change, push_pull(h, c, H, s));
+    sum += h.node(c).area * s.B[c];
+    lo = lo.cwiseMin(s.lo[c]);
+    hi = hi.cwiseMax(s.hi[c]);
+  }
+  s.lo[i] = lo;
+  s.hi[i] = hi;
+  s.B[i] = sum / n.area;
+  return change;
+}
+
+/// Links sorted by receiver, with the start of each receiver's run.
+struct LinkTable {
+  std::vector<Link> links;
+  std::vector<std::int64_t> starts;  ///< run k is links[starts[k], starts[k+1])
+  void index() {
+    std::sort(links.begin(), links.end(), [](const Link& a, const Link& b) {
+      return a.p < b.p || (a.p == b.p && a.q < b.q);
+    });
+    starts.clear();
+    for (std::size_t k = 0; k < links.size(); ++k)
+      if (k == 0 || links[k].p != links[k - 1].p) starts.push_back(static_cast<std::int64_t>(k));
+    starts.push_back(static_cast<std::int64_t>(links.size()));
+  }
+};
+
+/// gathered[p] = sum over p's links of F_pq B_q, in link order (deterministic).
+void gather(const LinkTable& t, State& s, int threads) {
+  std::fill(s.gathered.begin(), s.gathered.end(), Eigen::Vector3d::Zero());
+  const std::int64_t runs = static_cast<std::int64_t>(t.starts.size()) - 1;
+  parallel_for(runs, kGatherChunk, threads, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t r = begin; r < end; ++r) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (std::int64_t k = t.starts[r]; k < t.starts[r + 1]; ++k)
+        sum += static_cast<double>(t.links[k].F) * s.B[t.links[k].q];
+      s.gathered[t.links[t.starts[r]].p] = sum;
+    }
+  });
+}
+
+/// A link to refine and how.
+struct Refinement {
+  std::int32_t p, q;
+  Action action;
+};
+
+/// The child links of refined links (after their nodes were split), in order.
+std::vector<std::pair<std::int32_t, std::int32_t>> expand(const Hierarchy& h,
+                                                          const std::vector<Refinement>& r) {
+  std::vector<std::pair<std::int32_t, std::int32_t>> out;
+  for (const auto& x : r) {
+    const hr::Node& np = h.node(x.p);
+    const hr::Node& nq = h.node(x.q);
+    if (x.action == Action::SplitBoth) {
+      for (int a = 0; a < np.child_count; ++a)
+        for (int b = 0; b < np.child_count; ++b) out.emplace_back(h.child(x.p, a), h.child(x.p, b));
+    } else if (x.action == Action::SplitReceiver) {
+      for (int a = 0; a < np.child_count; ++a) out.emplace_back(h.child(x.p, a), x.q);
+    } else {
+      for (int b = 0; b < nq.child_count; ++b) out.emplace_back(x.p, h.child(x.q, b));
+    }
+  }
+  return out;
+}
+
+/// Gives every element that a refinement splits its children, in increasing node order (so
+/// node numbers do not depend on threads), initialising their B from the parent's.
+void split_nodes(Hierarchy& h, const std::vector<Refinement>& r, State& s) {
+  std::vector<std::int32_t> nodes;
+  for (const auto& x : r) {
+    if (x.action != Action::SplitSource) nodes.push_back(x.p);
+    if (x.action == Action::SplitSource) nodes.push_back(x.q);
+  }
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  for (const std::int32_t i : nodes) {
+    if (h.node(i).cluster || h.node(i).child_count > 0) continue;
+    if (h.size() > std::numeric_limits<std::int32_t>::max() - 8)
+      throw Error("hierarchical: more than 2^31 nodes; raise --epsilon or --min-area");
+    h.split_element(i);
+    s.resize(h.nodes().size());
+    for (int k = 0; k < 4; ++k) {
+      const std::int32_t c = h.child(i, k);
+      s.B[c] = s.lo[c] = s.hi[c] = s.B[i];
+    }
+  }
+}
+
+double memory_bytes(const Hierarchy& h, const LinkTable& t, std::size_t pending) {
+  return h.bytes() + static_cast<double>(t.links.capacity()) * sizeof(Link) +
+         static_cast<double>(pending) * (sizeof(Link) + sizeof(Refinement)) +
+         static_cast<double>(h.nodes().capacity()) * 3 * sizeof(Eigen::Vector3d) +
+         static_cast<double>(h.faces().size()) * 256.0;  // the face BVH, ~2 nodes per face
+}
+
+/// The leaves as a PatchMesh (vertices shared within a surface by exact position) and B.
+void export_leaves(const Hierarchy& h, const State& s, HierarchicalResult& out) {
+  const PatchMesh& faces = h.faces();
+  PatchMesh& mesh = out.mesh;
+  mesh.surface_names = faces.surface_names;
+  mesh.scale = faces.scale;
+  struct Key {
+    std::int32_t surface;
+    double x, y, z;
+    bool operator==(const Key& o) const {
+      return surface == o.surface && std::memcmp(&x, &o.x, 3 * sizeof(double)) == 0;
+    }
+  };
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      std::uint64_t b[3];
+      std::memcpy(b, &k.x, sizeof b);
+      return hash_keys(static_cast<std::uint64_t>(k.surface), b[0] ^ mix64(b[1]), b[2]);
+    }
+  };
+  std::unordered_map<Key, std::int32_t, KeyHash> index;
+  std::vector<std::int32_t> leaves, stack;
+  for (std::int32_t f = 0; f < faces.size(); ++f) {
+    stack.assign(1, f);
+    while (!stack.empty()) {
+      const std::int32_t i = stack.back();
+      stack.pop_back();
+      if (h.is_leaf(i)) {
+        leaves.push_back(i);
+        continue;
+      }
+      for (int k = h.node(i).child_count - 1; k >= 0; --k) stack.push_back(h.child(i, k));
+    }
+  }
+  mesh.patches.reserve(leaves.size());
+  out.B.resize(static_cast<Eigen::Index>(leaves.size()), 3);
+  for (std::size_t l = 0; l < leaves.size(); ++l) {
+    const std::int32_t i = leaves[l];
+    const ff::PatchGeom& g = h.geom(i);
+    const Patch& face = faces.patches[h.node(i).face];
+    Patch p = face;
+    p.vertex_count = g.n;
+    p.area = g.area;
+    p.centroid = g.centroid;
+    for (int c = 0; c < g.n; ++c) {
+      const Key key{face.surface, g.p[c].x(), g.p[c].y(), g.p[c].z()};
+      auto [it, inserted] = index.emplace(key, static_cast<std::int32_t>(mesh.vertices.size()));
+      if (inserted) {
+        mesh.vertices.push_back(g.p[c]);
+        mesh.vertex_surface.push_back(face.surface);
+      }
+      p.vertices[c] = it->second;
+    }
+    mesh.patches.push_back(p);
+    out.B.row(static_cast<Eigen::Index>(l)) = s.B[i].transpose();
+  }
+}
+
+/// Power bookkeeping over the leaves (header of HierarchicalEnergy).
+void energy_balance(const Hierarchy& h, const State& s, HierarchicalStats& st) {
+  for (int c = 0; c < 3; ++c) st.energy[c] = HierarchicalEnergy{};
+  double sent[3] = {0, 0, 0}, received[3] = {0, 0, 0};
+  for (std::int32_t i = 0; i < h.size(); ++i) {
+    if (!h.is_leaf(i) || h.node(i).cluster) continue;
+    const Patch& face = h.faces().patches[h.node(i).face];
+    const double a = h.node(i).area;
+    for (int c = 0; c < 3; ++c) {
+      st.energy[c].emitted += a * face.emission[c];
+      st.energy[c].absorbed += a * (1.0 - face.rho[c]) * s.H[i][c];
+      sent[c] += a * s.B[i][c];
+      received[c] += a * s.H[i][c];
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    HierarchicalEnergy& e = st.energy[c];
+    e.escaped = sent[c] - received[c];
+    e.relative_imbalance =
+        e.emitted > 0 ? std::abs(e.emitted - e.absorbed - e.escaped) / e.emitted : 0.0;
+  }
+}
+
+}  // namespace
+
+HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOptions& o) {
+  check_options(o);
+  const int threads = resolve_threads(o.threads);
+  HierarchicalResult result;
+  HierarchicalStats& st = result.stats;
+  Timer timer;
+  Hierarchy h(mesh_scene(scene, MeshOptions{}));
+  const Bvh bvh(h.faces(), threads);
+  st.faces = h.faces().size();
+  st.clusters = h.clusters();
+  st.build_seconds = timer.seconds();
+
+  double total_area = 0.0;
+  Eigen::Vector3d emitted = Eigen::Vector3d::Zero();
+  for (const Patch& f : h.faces().patches) {
+    total_area += f.area;
+    emitted += f.area * f.emission;
+  }
+  st.min_area = o.min_area > 0 ? o.min_area : kAutoMinAreaFraction * total_area;
+  const double scale = h.faces().scale;
+  const hr::LinkContext ctx{h,
+                            bvh,
+                            o.link_rays,
+                            o.seed,
+                            ff::kRayOffset * scale,
+                            ff::kPlaneEps * scale,
+                            st.min_area,
+                            o.epsilon * emitted.maxCoeff()};
+
+  State s;
+  s.resize(h.nodes().size());
+  push_pull(h, h.root(), Eigen::Vector3d::Zero(), s);  // B = E
+
+  LinkTable table;
+  std::vector<std::pair<std::int32_t, std::int32_t>> pending;
+  if (emitted.maxCoeff() > 0.0) pending.emplace_back(h.root(), h.root());
+  Progress progress("hierarchical", o.progress ? o.max_passes : 0, "links");
+  std::int64_t rays = 0;
+  for (int pass = 1; pass <= o.max_passes; ++pass) {
+    Timer refine_timer;
+    std::vector<Refinement> refine;
+    if (pass > 1) {  // recheck the accepted links against the new B
+      std::vector<Action> verdict(table.links.size());
+      parallel_for(static_cast<std::int64_t>(verdict.size()), kGatherChunk, threads,
+                   [&](std::int64_t b, std::int64_t e) {
+                     for (std::int64_t k = b; k < e; ++k)
+                       verdict[k] = hr::recheck_link(ctx, table.links[k],
+                                                     s.source(table.links[k].q));
+                   });
+      std::size_t kept = 0;
+      for (std::size_t k = 0; k < verdict.size(); ++k) {
+        if (verdict[k] == Action::Accept)
+          table.links[kept++] = table.links[k];
+        else
+          refine.push_back({table.links[k].p, table.links[k].q, verdict[k]});
+      }
+      table.links.resize(kept);
+      if (refine.empty()) break;  // nothing changes: the previous pass's solution stands
+    }
+    ++st.passes;
+    while (!pending.empty() || !refine.empty()) {
+      split_nodes(h, refine, s);
+      const auto children = expand(h, refine);
+      pending.insert(pending.end(), children.begin(), children.end());
+      refine.clear();
+      std::vector<Link> evaluated(pending.size());
+      std::vector<Action> action(pending.size());
+      std::vector<std::int64_t> chunk_rays((pending.size() + kEvalChunk - 1) / kEvalChunk, 0);
+      parallel_for(static_cast<std::int64_t>(pending.size()), kEvalChunk, threads,
+                   [&](std::int64_t b, std::int64_t e) {
+                     std::int64_t r = 0;
+                     for (std::int64_t k = b; k < e; ++k) {
+                       const auto [p, q] = pending[k];
+                       action[k] = hr::evaluate_link(ctx, p, q, s.source(q), evaluated[k], r);
+                     }
+                     chunk_rays[b / kEvalChunk] += r;
+                   });
+      for (const std::int64_t r : chunk_rays) rays += r;
+      for (std::size_t k = 0; k < pending.size(); ++k) {
+        if (action[k] == Action::Accept)
+          table.links.push_back(evaluated[k]);
+        else if (action[k] != Action::Drop)
+          refine.push_back({pending[k].first, pending[k].second, action[k]});
+      }
+      pending.clear();
+      const double bytes = memory_bytes(h, table, refine.size() * 4);
+      if (o.memory_limit > 0 && bytes > o.memory_limit)
+        throw Error("hierarchical: the hierarchy needs more than " + format_bytes(o.memory_limit) +
+                    " (" + std::to_string(h.size()) + " nodes, " +
+                    std::to_string(table.links.size()) +
+                    " links so far); raise --epsilon or --min-area, or the memory limit");
+    }
+    table.index();
+    st.refine_seconds += refine_timer.seconds();
+
+    Timer solve_timer;
+    s.resize(h.nodes().size());
+    double max_b = 0.0;
+    st.converged = false;
+    for (int it = 1; it <= o.max_iterations; ++it) {
+      gather(table, s, threads);
+      const double change = push_pull(h, h.root(), Eigen::Vector3d::Zero(), s);
+      ++st.iterations;
+      max_b = 0.0;
+      for (std::int32_t i = 0; i < h.size(); ++i)
+        if (h.is_leaf(i) && !h.node(i).cluster) max_b = std::max(max_b, s.B[i].maxCoeff());
+      st.change = max_b > 0 ? change / max_b : 0.0;
+      if (st.change <= o.tol) {
+        st.converged = true;
+        break;
+      }
+    }
+    st.solve_seconds += solve_timer.seconds();
+    progress.advance(1, static_cast<std::int64_t>(table.links.size()));
+  }
+  progress.finish();
+  if (emitted.maxCoeff() <= 0.0) st.converged = true;  // B = E = 0 is exact
+
+  st.elements = h.size() - h.clusters();
+  st.links = static_cast<std::int64_t>(table.links.size());
+  for (const Link& l : table.links)
+    st.cluster_links += h.node(l.p).cluster || h.node(l.q).cluster;
+  st.rays = rays;
+  st.memory_bytes = memory_bytes(h, table, 0);
+  energy_balance(h, s, st);
+  export_leaves(h, s, result);
+  st.leaves = result.mesh.size();
+  return result;
+}
+
+}  // namespace lambert

@@ -1,0 +1,88 @@
+#pragma once
+// The element and cluster hierarchy of the hierarchical method (internal to geometry/).
+//
+// Nodes live in one vector. Root elements are the faces of the scene (one PatchMesh patch
+// each, from mesh_scene without an edge bound); a binary cluster tree sits above them,
+// built bottom-up by median splits of the face centroids along the longest axis of their
+// bounding box (deterministic: the order of faces decides ties). Elements get 4 children on
+// demand (split_element): triangles 4 similar triangles through the edge midpoints 0.5 (a + b),
+// quads 4 quads through the edge midpoints and the bilinear centre. Children tile their
+// parent exactly, so areas add up and neighbours that split to the same depth share their
+// vertices bit for bit.
+//
+// Not thread-safe for mutation (split_element); reads are.
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <vector>
+
+#include "core/sampling.hpp"
+#include "geometry/formfactors/kernels.hpp"
+#include "geometry/mesh.hpp"
+
+namespace lambert::hr {
+
+/// One node: a cluster (children are nodes of either kind) or an element (a planar
+/// triangle or quad on one face; children are its 4 sub-elements).
+struct Node {
+  std::int32_t parent = -1;
+  std::int32_t first_child = -1;  ///< children are first_child .. first_child + child_count - 1
+  std::int32_t second_child = -1; ///< clusters: the second child (children are not contiguous)
+  std::int8_t child_count = 0;
+  bool cluster = false;
+  std::int8_t depth = 0;          ///< element depth below its face (0 = the face)
+  std::int32_t face = -1;         ///< elements: the face (patch of the face mesh) it lies on
+  double area = 0.0;              ///< total surface area below the node
+  Eigen::AlignedBox3d box;        ///< bounding box of the surfaces below
+};
+
+/// The hierarchy over one scene's faces.
+class Hierarchy {
+ public:
+  /// Root elements from the patches of `faces` (one per face), clusters above them.
+  explicit Hierarchy(const PatchMesh& faces);
+
+  const PatchMesh& faces() const { return faces_; }
+  const std::vector<Node>& nodes() const { return nodes_; }
+  const Node& node(std::int32_t i) const { return nodes_[i]; }
+  /// Geometry of an element node (unused for clusters).
+  const ff::PatchGeom& geom(std::int32_t i) const { return geom_[i]; }
+  std::int32_t root() const { return root_; }
+  std::int32_t size() const { return static_cast<std::int32_t>(nodes_.size()); }
+  std::int64_t clusters() const { return clusters_; }
+
+  /// Child k of node i.
+  std::int32_t child(std::int32_t i, int k) const {
+    const Node& n = nodes_[i];
+    return n.cluster ? (k == 0 ? n.first_child : n.second_child) : n.first_child + k;
+  }
+  /// True when i is an element that has not been split.
+  bool is_leaf(std::int32_t i) const { return nodes_[i].child_count == 0; }
+
+  /// Gives element i its 4 children (no-op if it has them). Invalidates references.
+  void split_element(std::int32_t i);
+
+  /// A point of the surfaces below node i, uniform in area, with its element's normal;
+  /// descends the tree choosing children by area (u picks the child, its remainder is
+  /// reused), then samples the element with (v, w).
+  Eigen::Vector3d sample_point(std::int32_t i, double u, double v, double w,
+                               Eigen::Vector3d& normal) const;
+
+  /// Bytes held by nodes and element geometry.
+  double bytes() const;
+
+ private:
+  std::int32_t build_clusters(std::vector<std::int32_t>& elements, std::size_t begin,
+                              std::size_t end);
+
+  PatchMesh faces_;
+  std::vector<Node> nodes_;
+  std::vector<ff::PatchGeom> geom_;
+  std::int32_t root_ = -1;
+  std::int64_t clusters_ = 0;
+};
+
+/// Squared distance between two boxes (0 when they overlap or touch).
+double box_distance_squared(const Eigen::AlignedBox3d& a, const Eigen::AlignedBox3d& b);
+
+}  // namespace lambert::hr

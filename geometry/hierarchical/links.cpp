@@ -1,0 +1,197 @@
+#include "geometry/hierarchical/links.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "geometry/formfactors/pairwise.hpp"
+#include "geometry/formfactors/quadrature.hpp"
+#include "geometry/formfactors/visibility.hpp"
+
+namespace lambert::hr {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::uint64_t link_key(std::int32_t p, std::int32_t q) {
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(p)) << 32) |
+         static_cast<std::uint32_t>(q);
+}
+
+// True when every corner of `box` lies behind (or on) the plane of element g.
+bool box_behind(const ff::PatchGeom& g, const Eigen::AlignedBox3d& box, double eps) {
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3d corner = box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c));
+    if (g.normal.dot(corner - g.p[0]) > eps) return false;
+  }
+  return true;
+}
+
+// Which end to split, or Accept when neither can be.
+Action split_choice(const LinkContext& ctx, std::int32_t p, std::int32_t q) {
+  const bool sp = splittable(ctx, p), sq = splittable(ctx, q);
+  if (!sp && !sq) return Action::Accept;
+  if (sp != sq) return sp ? Action::SplitReceiver : Action::SplitSource;
+  const Node& np = ctx.h.node(p);
+  const Node& nq = ctx.h.node(q);
+  const bool larger_p = np.cluster || nq.cluster
+                            ? np.box.diagonal().squaredNorm() >= nq.box.diagonal().squaredNorm()
+                            : np.area >= nq.area;
+  return larger_p ? Action::SplitReceiver : Action::SplitSource;
+}
+
+Action decide(const LinkContext& ctx, const Link& link, const SourceB& b_q) {
+  const bool cluster = ctx.h.node(link.p).cluster || ctx.h.node(link.q).cluster;
+  const double error =
+      cluster ? static_cast<double>(link.err) * b_q.high
+              : static_cast<double>(link.err) * b_q.mean +
+                    ctx.h.node(link.p).area * static_cast<double>(link.F) * b_q.spread;
+  if (error <= ctx.threshold) return Action::Accept;
+  return split_choice(ctx, link.p, link.q);
+}
+
+// Element p <- element q: the exact unoccluded factor (adaptive quadrature of the contour
+// formula over p) times the visible fraction at p's Gauss points (header).
+Action element_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, const SourceB& b_q,
+                    Link& link, std::int64_t& rays) {
+  const ff::PatchGeom& gp = ctx.h.geom(p);
+  const ff::PatchGeom& gq = ctx.h.geom(q);
+  if (!ff::can_exchange(gp, gq, ctx.plane_eps)) return Action::Drop;
+  // Unoccluded factor: the 2 x 2 Gauss rule over p where q is farther from p than p's
+  // diameter (the rule's relative error falls like (diameter / 2 distance)^4 there, see
+  // quadrature.hpp), else the adaptive quadrature (shared edges, contact lines, near pairs).
+  thread_local std::vector<ff::QuadCell> cells;
+  cells.clear();
+  const bool near = box_distance_squared(ctx.h.node(p).box, ctx.h.node(q).box) <=
+                    gp.diameter * gp.diameter;
+  double unoccluded = 0.0;
+  if (near) {
+    unoccluded = ff::integrate_unoccluded(gp, gq, ff::kEstimatorAccuracy, cells) / gp.area;
+    if (!(unoccluded > 0.0)) return Action::Drop;
+  }
+  // Visibility points: p's 2 x 2 Gauss points weighted by w F(x -> q), or, when q is seen
+  // from none of them (p mostly behind q's plane), the centroids of the quadrature cells
+  // with the largest shares.
+  struct Point {
+    Eigen::Vector3d x;
+    double weight;
+  };
+  Point points[4];
+  int count = 0;
+  double f_min = std::numeric_limits<double>::infinity(), f_max = 0.0;
+  const ff::GaussRule rule = ff::gauss_legendre(2);
+  for (int a = 0; a < rule.n; ++a)
+    for (int b = 0; b < rule.n; ++b) {
+      double jacobian = 0.0;
+      const Eigen::Vector3d x = ff::quadrature_point(gp, rule.x[a], rule.x[b], jacobian);
+      const double f = ff::point_to_patch(x, gp.normal, gq);
+      f_min = std::min(f_min, f);
+      f_max = std::max(f_max, f);
+      const double w = rule.w[a] * rule.w[b] * jacobian;
+      if (!near) unoccluded += w * f / gp.area;
+      if (f > 0.0) points[count++] = {x, w * f};
+    }
+  if (!(unoccluded > 0.0)) return Action::Drop;
+  if (count == 0) {
+    std::vector<std::size_t> order(cells.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    const std::size_t keep = std::min<std::size_t>(4, order.size());
+    std::partial_sort(order.begin(), order.begin() + keep, order.end(),
+                      [&](std::size_t x, std::size_t y) { return cells[x].G > cells[y].G; });
+    for (std::size_t k = 0; k < keep; ++k)
+      points[count++] = {cells[order[k]].g.centroid, cells[order[k]].G};
+  }
+  for (int c = 0; c <= gp.n; ++c) {
+    const Eigen::Vector3d& x = c < gp.n ? gp.p[c] : gp.centroid;
+    const double f = ff::point_to_patch(x, gp.normal, gq);
+    f_min = std::min(f_min, f);
+    f_max = std::max(f_max, f);
+  }
+  const int per_point = std::max(1, ctx.rays / 4);
+  double seen_weight = 0.0, weight = 0.0;
+  int traced = 0, points_seen = 0, points_blocked = 0, exhausted = 0;
+  bool partial = false;
+  for (int k = 0; k < count; ++k) {
+    const int seen = ff::count_visible(ctx.bvh, points[k].x, gp.normal, gq, per_point,
+                                       hash_keys(ctx.seed, link_key(p, q), k), ctx.offset,
+                                       exhausted);
+    traced += per_point;
+    partial |= seen > 0 && seen < per_point;
+    points_seen += seen > 0;
+    points_blocked += seen < per_point;
+    seen_weight += points[k].weight * seen / per_point;
+    weight += points[k].weight;
+  }
+  rays += traced;
+  partial |= points_seen > 0 && points_blocked > 0;
+  const double vis = weight > 0.0 ? seen_weight / weight : 0.0;
+  link.p = p;
+  link.q = q;
+  link.F = static_cast<float>(unoccluded * vis);
+  // Visibility is uncertain by 1 where the shadow boundary crosses the link, else by the
+  // chance that `traced` rays all agree while the true fraction is not 0 or 1 (~1/(n+1)).
+  const double vis_uncertainty = partial ? 1.0 : 1.0 / (traced + 1);
+  link.err = static_cast<float>(gp.area * ((f_max - f_min) * vis + unoccluded * vis_uncertainty));
+  return decide(ctx, link, b_q);
+}
+
+// Monte Carlo transfer between two nodes, one of them a cluster (header).
+double cluster_transfer(const LinkContext& ctx, std::int32_t p, std::int32_t q,
+                        std::int64_t& rays) {
+  const Kronecker4 sx(hash_keys(ctx.seed, link_key(p, q), 1));
+  const Kronecker4 sy(hash_keys(ctx.seed, link_key(p, q), 2));
+  double sum = 0.0;
+  for (int s = 0; s < ctx.rays; ++s) {
+    Eigen::Vector3d nx, ny;
+    const Eigen::Vector3d x = ctx.h.sample_point(p, sx.get(s, 0), sx.get(s, 1), sx.get(s, 2), nx);
+    const Eigen::Vector3d y = ctx.h.sample_point(q, sy.get(s, 0), sy.get(s, 1), sy.get(s, 2), ny);
+    const Eigen::Vector3d r = y - x;
+    const double r2 = r.squaredNorm();
+    if (r2 <= 0.0) continue;
+    const double cx = nx.dot(r), cy = -ny.dot(r);
+    if (cx <= 0.0 || cy <= 0.0) continue;
+    ++rays;
+    if (ff::visible(ctx.bvh, x, nx, y, ny, ctx.offset)) sum += cx * cy / (kPi * r2 * r2);
+  }
+  return ctx.h.node(p).area * ctx.h.node(q).area * sum / ctx.rays;
+}
+
+Action cluster_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, const SourceB& b_q,
+                    Link& link, std::int64_t& rays) {
+  const Node& np = ctx.h.node(p);
+  const Node& nq = ctx.h.node(q);
+  if (!np.cluster && box_behind(ctx.h.geom(p), nq.box, ctx.plane_eps)) return Action::Drop;
+  if (!nq.cluster && box_behind(ctx.h.geom(q), np.box, ctx.plane_eps)) return Action::Drop;
+  double t_max = std::min(np.area, nq.area);
+  const double d2 = box_distance_squared(np.box, nq.box);
+  if (d2 > 0.0) t_max = std::min(t_max, np.area * nq.area / (kPi * d2));
+  link.p = p;
+  link.q = q;
+  link.err = static_cast<float>(t_max);
+  const Action action = decide(ctx, link, b_q);
+  if (action != Action::Accept) return action;
+  const double t = std::min(cluster_transfer(ctx, p, q, rays), t_max);
+  link.F = static_cast<float>(t / np.area);
+  return Action::Accept;
+}
+
+}  // namespace
+
+bool splittable(const LinkContext& ctx, std::int32_t i) {
+  const Node& n = ctx.h.node(i);
+  return n.cluster || n.area >= 4.0 * ctx.min_area;
+}
+
+Action evaluate_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, const SourceB& b_q,
+                     Link& link, std::int64_t& rays) {
+  if (p == q) return ctx.h.node(p).cluster ? Action::SplitBoth : Action::Drop;
+  if (!ctx.h.node(p).cluster && !ctx.h.node(q).cluster)
+    return element_link(ctx, p, q, b_q, link, rays);
+  return cluster_link(ctx, p, q, b_q, link, rays);
+}
+
+Action recheck_link(const LinkContext& ctx, const Link& link, const SourceB& b_q) {
+  return decide(ctx, link, b_q);
+}
+
+}  // namespace lambert::hr

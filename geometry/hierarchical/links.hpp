@@ -1,0 +1,86 @@
+#pragma once
+// Links of the hierarchical method and the refinement oracle (internal to geometry/).
+//
+// A link p <- q carries F_pq, the area-averaged factor with H_p += F_pq B_q (H the irradiance,
+// W/m^2), and err_pq, a bound on the power error of the transfer per unit source radiosity
+// (scene units^2): the transfer A_p F_pq B_q is wrong by at most err_pq B_q. The oracle
+// refines a link while its power error exceeds threshold (epsilon x emitted power): for an
+// element source err_pq B_q + A_p F_pq ΔB_q, the second term the error of transferring q's
+// area average where q's leaves differ by ΔB_q (max - min, max over channels); for a cluster
+// at either end err_pq max B_q (the bound times the brightest leaf below q).
+//
+// Element - element (both planar polygons): F_pq = sum_k w_k F(x_k -> q) vis_k over the
+// 2 x 2 Gauss points x_k of p (weights w_k = Gauss weight x Jacobian / A_p), F(x -> q) the
+// exact contour formula and vis_k the visible fraction from link_rays / 4 kernel-sampled
+// rays (the hybrid estimator's kernel, visibility.hpp). Error per unit B_q:
+//   err = A_p (ΔF vis + F partial),  ΔF = max - min of F(x -> q) over p's corners, centroid
+//   and Gauss points, vis the mean visible fraction, partial = 1 when some rays were blocked
+//   and others not (the shadow boundary crosses the link), F the unoccluded mean.
+// A pair that cannot exchange (each behind the other's plane, can_exchange) is dropped, and
+// so is a fully occluded pair (every ray blocked: err = 0, F = 0).
+//
+// With a cluster at either end: the transfer T = A_p F_pq = (1/π) ∫_p ∫_q cos+ cos+ V / r^2
+// is bounded by T_max = min(A_p A_q / (π d^2), A_p, A_q), d the distance between the two
+// bounding boxes (cosines <= 1; F_pq <= 1 and F_qp <= 1 by reciprocity) — isotropic, and
+// conservative for any orientation, which is why the root cluster can link to itself. err =
+// T_max. An accepted cluster link is estimated by Monte Carlo: link_rays pairs (x, y)
+// uniform in area below p and q, T ≈ A_p A_q mean(cos+_x cos+_y V / (π r^2)), capped at
+// T_max. A cluster receiver spreads what it gathers uniformly over its area (push).
+// Pairs with an element whose plane has the other end's box entirely behind it are dropped.
+//
+// Refinement splits the larger end that can be split (clusters: by box diagonal, elements:
+// by area; an element can be split while area >= 4 min_area); a self-link of a cluster
+// becomes the links between all pairs of its children (and their self-links); an element's
+// self-link is dropped (a planar element does not see itself).
+//
+// Evaluation is a pure function of (hierarchy, p, q, seed): thread-safe and deterministic.
+
+#include <cstdint>
+
+#include "geometry/bvh.hpp"
+#include "geometry/hierarchical/hierarchy.hpp"
+
+namespace lambert::hr {
+
+/// One link p <- q (16 bytes).
+struct Link {
+  std::int32_t p = 0;  ///< receiver node
+  std::int32_t q = 0;  ///< source node
+  float F = 0.0f;      ///< H_p += F B_q
+  float err = 0.0f;    ///< power error bound per unit source radiosity (scene units^2)
+};
+
+/// What to do with a link.
+enum class Action : std::uint8_t { Drop, Accept, SplitReceiver, SplitSource, SplitBoth };
+
+/// What the oracle sees.
+struct LinkContext {
+  const Hierarchy& h;
+  const Bvh& bvh;
+  int rays = 16;            ///< visibility rays per element link, MC pairs per cluster link
+  std::uint64_t seed = 1;
+  double offset = 0.0;      ///< ray ends are lifted this far off their surfaces
+  double plane_eps = 0.0;   ///< plane tolerance of culling tests (scene units)
+  double min_area = 0.0;    ///< elements are split while area >= 4 min_area
+  double threshold = 0.0;   ///< power error allowed per link (W)
+};
+
+/// What the oracle knows of a source's radiosity (max over channels): its area average, the
+/// spread (max - min) of its leaves' B, and their maximum.
+struct SourceB {
+  double mean = 0.0, spread = 0.0, high = 0.0;
+};
+
+/// True when node i may be split (clusters always; elements while area >= 4 min_area).
+bool splittable(const LinkContext& ctx, std::int32_t i);
+
+/// The oracle's verdict on a new link p <- q with source radiosity b_q: its F and err
+/// (Accept), or how to split it. Adds the rays it traced.
+Action evaluate_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, const SourceB& b_q,
+                     Link& link, std::int64_t& rays);
+
+/// The verdict on an evaluated link against a new source radiosity b_q: Accept, or which end
+/// to split (split_choice).
+Action recheck_link(const LinkContext& ctx, const Link& link, const SourceB& b_q);
+
+}  // namespace lambert::hr
