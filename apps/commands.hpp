@@ -5,6 +5,7 @@
 
 #include "apps/common.hpp"
 #include "apps/ff_args.hpp"
+#include "apps/method.hpp"
 #include "apps/render_stages.hpp"
 #include "solvers/radiosity.hpp"
 
@@ -42,6 +43,7 @@ int run_formfactors(const FormFactorsOptions& opts);
 struct SolveCommandOptions {
   SceneArgs scene;
   RunArgs run;
+  MethodArgs method;
   FormFactorArgs ff;
   SolveOptions solve;
   std::string output = "radiosity.csv";  ///< per-patch CSV; summary JSON beside it
@@ -55,6 +57,7 @@ int run_solve(const SolveCommandOptions& opts);
 struct CompareOptions {
   SceneArgs scene;
   RunArgs run;
+  MethodArgs method;  ///< hierarchical: its runs (one per --epsilon) against a matrix reference
   FormFactorArgs ff;
   SolveOptions solve;                ///< tolerance etc. shared by every solver
   std::vector<std::string> solvers;  ///< empty = all
@@ -62,7 +65,9 @@ struct CompareOptions {
 };
 /// Registers `compare` on the app.
 CLI::App* add_compare_command(CLI::App& app, CompareOptions& opts);
-/// Runs every solver on one system; prints and writes the table, histories and plots.
+/// Matrix: runs every solver on one system; prints and writes the table, histories and plots.
+/// Hierarchical: one hierarchical run per --epsilon against the matrix reference (F + direct);
+/// prints and writes the table and the per-surface averages.
 int run_compare(const CompareOptions& opts);
 
 /// Options of `lambert solvers`.
@@ -78,6 +83,7 @@ int run_solvers(const SolversOptions& opts);
 struct RenderOptions {
   SceneArgs scene;
   RunArgs run;
+  MethodArgs method;
   FormFactorArgs ff;
   SolveOptions solver;
   CameraArgs camera;
@@ -97,6 +103,7 @@ int run_render(const RenderOptions& opts);
 struct RunOptions {
   SceneArgs scene;
   RunArgs run;
+  MethodArgs method;
   FormFactorArgs ff;
   SolveOptions solver;
   CameraArgs camera;

@@ -106,15 +106,16 @@ std::optional<MemoryLimit> job_memory_limit(const std::string& option) {
   return MemoryLimit{*bytes, from + " " + text};
 }
 
-CLI::Validator finite_number(double lo, double hi, bool open_low) {
-  const std::string range =
-      std::isinf(hi) ? (open_low ? "> " : ">= ") + shortest(lo)
-                     : "in " + std::string(open_low ? "(" : "[") + shortest(lo) + ", " +
-                           shortest(hi) + "]";
+CLI::Validator finite_number(double lo, double hi, bool open_low, bool open_high) {
+  const std::string range = std::isinf(hi)
+                                ? (open_low ? "> " : ">= ") + shortest(lo)
+                                : "in " + std::string(open_low ? "(" : "[") + shortest(lo) + ", " +
+                                      shortest(hi) + (open_high ? ")" : "]");
   return CLI::Validator(
       [=](std::string& text) -> std::string {
         double x = 0;
-        const bool ok = parse_finite_number(text, x) && (open_low ? x > lo : x >= lo) && x <= hi;
+        const bool ok = parse_finite_number(text, x) && (open_low ? x > lo : x >= lo) &&
+                        (open_high ? x < hi : x <= hi);
         return ok ? "" : "'" + text + "' is not a finite number " + range;
       },
       "NUMBER " + range);
@@ -289,16 +290,21 @@ Scene load_scene_file(const SceneArgs& args) {
   return load_obj(args.scene.empty() ? builtin_cornell_box_path() : args.scene, nullptr, options);
 }
 
-LoadedScene load_scene(const SceneArgs& args, const JobPlan& plan) {
-  LoadedScene out;
-  out.scene = load_scene_file(args);
+Scene load_checked_scene(const SceneArgs& args, const JobPlan& plan) {
+  Scene scene = load_scene_file(args);
   std::vector<NamedFile> inputs = plan.inputs;
-  for (size_t k = 0; k < out.scene.files.size(); ++k) {
-    const std::string& f = out.scene.files[k];
+  for (size_t k = 0; k < scene.files.size(); ++k) {
+    const std::string& f = scene.files[k];
     const bool camera = std::filesystem::path(f).extension() == ".camera";
     inputs.push_back({k == 0 ? "scene" : camera ? "camera sidecar" : "material library", f});
   }
   check_job_files(inputs, plan.outputs);
+  return scene;
+}
+
+LoadedScene load_scene(const SceneArgs& args, const JobPlan& plan) {
+  LoadedScene out;
+  out.scene = load_checked_scene(args, plan);
   MeshOptions mo;
   mo.max_edge = args.max_edge;
   mo.target_patches = args.patches > 0 || args.max_edge > 0 ? args.patches : args.default_patches;

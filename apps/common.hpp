@@ -69,9 +69,9 @@ CLI::Validator output_prefix_check();
 std::string output_prefix(const std::string& output, const std::string& name);
 
 /// CLI11 check for a floating-point option: a finite number (NaN and inf refused) in
-/// [lo, hi], or (lo, hi] when `open_low`; hi = infinity means no upper bound. The message
-/// states the range.
-CLI::Validator finite_number(double lo, double hi, bool open_low = false);
+/// [lo, hi], open at lo when `open_low` and at hi when `open_high`; hi = infinity means no
+/// upper bound. The message states the range.
+CLI::Validator finite_number(double lo, double hi, bool open_low = false, bool open_high = false);
 
 /// CLI11 check for a floating-point value that may be any finite number (NaN, inf refused).
 CLI::Validator any_finite_number();
@@ -121,6 +121,9 @@ void check_job_memory(std::int64_t patches, const JobPlan& plan);
 
 /// Loads the scene (or the built-in Cornell box) with the loading options.
 Scene load_scene_file(const SceneArgs& args);
+/// Loads the scene (or the built-in Cornell box) and checks the plan's files against the
+/// scene's (check_job_files), without meshing it (a method that meshes on its own).
+Scene load_checked_scene(const SceneArgs& args, const JobPlan& plan = {});
 /// Loads the scene (or the built-in Cornell box), checks the plan's files against the
 /// scene's and its memory estimate (check_job_files, check_job_memory), and meshes it.
 LoadedScene load_scene(const SceneArgs& args, const JobPlan& plan = {});

@@ -1,15 +1,18 @@
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
 
 #include "apps/cli.hpp"
 #include "apps/commands.hpp"
+#include "apps/hierarchical_stage.hpp"
 #include "apps/problem.hpp"
 #include "apps/solve_args.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/timer.hpp"
 #include "io/plot.hpp"
 
 namespace lambert {
@@ -148,28 +151,8 @@ std::vector<Plot> convergence_plots(const std::vector<CompareRow>& rows, int c, 
   return {by_iteration, by_time};
 }
 
-}  // namespace
-
-CLI::App* add_compare_command(CLI::App& app, CompareOptions& opts) {
-  auto* cmd = app.add_subcommand(
-      "compare", "Run several solvers on one system: table, histories and convergence plots");
-  opts.scene.default_patches = 2000;
-  add_scene_options(cmd, opts.scene);
-  add_ff_options(cmd, opts.ff);
-  add_solve_options(cmd, opts.solve, false);
-  cmd->add_option("--solvers", opts.solvers, "Comma-separated solvers (default: all)")
-      ->delimiter(',')
-      ->check(CLI::IsMember(solver_names()));
-  cmd->add_option("-o,--output", opts.output,
-                  "Output directory (existing or ending in /) or file prefix")
-      ->check(output_prefix_check())
-      ->capture_default_str();
-  add_run_options(cmd, opts.run);
-  return cmd;
-}
-
-int run_compare(const CompareOptions& opts) {
-  apply_run_options(opts.run);
+// --method matrix: every solver (--solvers) on one F.
+int compare_matrix(const CompareOptions& opts) {
   const std::string base = output_prefix(opts.output, "compare");
   const std::string table = base + "_table.csv", history = base + "_history.csv";
   const std::string svg = base + "_convergence.svg", png = base + "_convergence.png";
@@ -238,6 +221,173 @@ int run_compare(const CompareOptions& opts) {
     return kExitNotConverged;
   }
   return kExitOk;
+}
+
+// One hierarchical run of the comparison and its per-surface differences to the reference.
+struct HierarchicalRow {
+  double epsilon = 0.0;
+  HierarchicalRun run;
+  std::vector<SurfaceRadiosity> surfaces;
+  std::vector<Eigen::Vector3d> diff;  ///< per surface, |B_h - B_ref| / B_ref per channel (NaN:
+                                      ///< the reference is 0 there)
+  double max_diff = 0.0;              ///< over surfaces with area and channels with B_ref > 0
+  std::string worst;                  ///< the surface of max_diff
+};
+
+// Per-surface relative differences of `row` against the reference averages.
+void surface_differences(HierarchicalRow& row, const std::vector<SurfaceRadiosity>& ref) {
+  row.surfaces = surface_averages(row.run.loaded.mesh, row.run.B);
+  row.diff.assign(ref.size(), Eigen::Vector3d::Constant(std::nan("")));
+  for (size_t s = 0; s < ref.size(); ++s) {
+    if (ref[s].area <= 0.0) continue;
+    for (int c = 0; c < 3; ++c) {
+      if (ref[s].average[c] <= 0.0) continue;
+      const double d = std::abs(row.surfaces[s].average[c] - ref[s].average[c]) / ref[s].average[c];
+      row.diff[s][c] = d;
+      if (d > row.max_diff || row.worst.empty()) {
+        row.max_diff = std::max(row.max_diff, d);
+        row.worst = ref[s].name;
+      }
+    }
+  }
+}
+
+void write_hierarchical_table(const std::string& path, const std::vector<HierarchicalRow>& rows,
+                              std::int32_t patches, std::int64_t entries, std::int64_t rays,
+                              double seconds, const std::string& reference) {
+  write_stream_atomically(path, [&](std::ostream& out) {
+    out << "method,epsilon,patches,interactions,rays,seconds,status,max_surface_diff,"
+           "worst_surface,reference\n";
+    out << "matrix,," << patches << ',' << entries << ',' << rays << ',' << csv_number(seconds)
+        << ",reference,,," << csv_field(reference) << '\n';
+    for (const auto& r : rows) {
+      const HierarchicalStats& st = r.run.stats;
+      out << "hierarchical," << csv_number(r.epsilon) << ',' << st.leaves << ',' << st.links << ','
+          << st.rays << ',' << csv_number(r.run.seconds) << ','
+          << to_string(hierarchical_status(st)) << ',' << csv_number(r.max_diff) << ','
+          << csv_field(r.worst) << ',' << csv_field(reference) << '\n';
+    }
+  });
+}
+
+void write_surfaces_csv(const std::string& path, const std::vector<SurfaceRadiosity>& ref,
+                        const std::vector<HierarchicalRow>& rows) {
+  const auto cell = [](double d) { return std::isnan(d) ? std::string() : csv_number(d); };
+  write_stream_atomically(path, [&](std::ostream& out) {
+    out << "surface,area,method,epsilon,R,G,B,diff_R,diff_G,diff_B\n";
+    for (size_t s = 0; s < ref.size(); ++s) {
+      const auto& a = ref[s].average;
+      out << csv_field(ref[s].name) << ',' << csv_number(ref[s].area) << ",matrix,,"
+          << csv_number(a[0]) << ',' << csv_number(a[1]) << ',' << csv_number(a[2]) << ",,,\n";
+      for (const auto& r : rows) {
+        const auto& h = r.surfaces[s].average;
+        out << csv_field(ref[s].name) << ',' << csv_number(ref[s].area) << ",hierarchical,"
+            << csv_number(r.epsilon) << ',' << csv_number(h[0]) << ',' << csv_number(h[1]) << ','
+            << csv_number(h[2]) << ',' << cell(r.diff[s][0]) << ',' << cell(r.diff[s][1]) << ','
+            << cell(r.diff[s][2]) << '\n';
+      }
+    }
+  });
+}
+
+// --method hierarchical: one hierarchical run per --epsilon against the matrix reference (F
+// from the form-factor options on the --patches mesh, solved by direct, or gauss-seidel at
+// a tight tolerance when direct does not fit), compared per surface (the meshes differ).
+int compare_hierarchical(const CompareOptions& opts) {
+  const std::string base = output_prefix(opts.output, "compare");
+  const std::string table = base + "_table.csv", surfaces_csv = base + "_surfaces.csv";
+  JobPlan plan = job_plan(opts.run);
+  plan.outputs = {{"-o", table}, {"-o", surfaces_csv}};
+  plan_form_factors(plan, opts.ff, opts.run);
+  const LoadedScene loaded = load_scene(opts.scene, plan);
+  const Timer ff_timer;
+  const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);
+  const RadiosityProblem problem = make_problem(loaded.mesh, ff.F);
+  warn_about_lighting(loaded.mesh, ff.F);
+  check_closed_lossless(loaded.mesh, ff);
+  // The reference's own stopping rule (the default solver tolerance): --tol and --max-iter
+  // steer the hierarchical runs.
+  SolveOptions so;
+  so.threads = opts.run.threads;
+  set_memory_limit(so, opts.run.max_memory);
+  const std::string skip = direct_refusal(problem.F->size(), problem.F->entries(), so.memory_limit,
+                                          so.memory_limit_source);
+  if (!skip.empty()) log_warn("compare: skipping " + skip);
+  const Reference reference = find_reference(problem, so, {}, skip);
+  const double reference_seconds = ff_timer.seconds();
+  const std::vector<SurfaceRadiosity> ref = surface_averages(loaded.mesh, reference.B);
+
+  std::vector<double> epsilons;
+  for (double e : opts.method.hierarchical.epsilons)
+    if (std::find(epsilons.begin(), epsilons.end(), e) == epsilons.end()) epsilons.push_back(e);
+  std::vector<HierarchicalRow> rows;
+  for (double e : epsilons) {
+    log_info("compare: running hierarchical at epsilon " + csv_number(e));
+    HierarchicalRow row;
+    row.epsilon = e;
+    row.run = solve_scene_hierarchical(
+        loaded.scene, make_hierarchical_options(opts.method, e, opts.solve, opts.run));
+    surface_differences(row, ref);
+    rows.push_back(std::move(row));
+  }
+
+  std::printf("reference: matrix, %d patches, %lld form factors (%s), %s; %.3f s\n",
+              loaded.mesh.size(), static_cast<long long>(ff.F.nonZeros()),
+              ff_settings_text(ff.options, opts.ff.ff_file).c_str(), reference.name.c_str(),
+              reference_seconds);
+  std::printf("%-10s %-15s %10s %12s %12s %10s %12s  %s\n", "epsilon", "status", "leaves", "links",
+              "rays", "time (s)", "max surface", "worst surface");
+  bool all_converged = true;
+  for (const auto& r : rows) {
+    const HierarchicalStats& st = r.run.stats;
+    std::printf("%-10.3g %-15s %10lld %12lld %12lld %10.3f %12.3e  %s\n", r.epsilon,
+                to_string(hierarchical_status(st)), static_cast<long long>(st.leaves),
+                static_cast<long long>(st.links), static_cast<long long>(st.rays), r.run.seconds,
+                r.max_diff, r.worst.c_str());
+    all_converged = all_converged && st.converged;
+  }
+  std::printf(
+      "max surface: max over surfaces and channels of |B_h - B_ref| / B_ref of the "
+      "area-weighted surface averages\n");
+  write_hierarchical_table(table, rows, loaded.mesh.size(), ff.F.nonZeros(), ff.stats.rays,
+                           reference_seconds, "matrix " + reference.name);
+  write_surfaces_csv(surfaces_csv, ref, rows);
+  std::printf("wrote %s, %s\n", table.c_str(), surfaces_csv.c_str());
+  if (!all_converged) {
+    log_warn(
+        "some hierarchical runs did not converge within --max-iter; results were written "
+        "anyway");
+    return kExitNotConverged;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+CLI::App* add_compare_command(CLI::App& app, CompareOptions& opts) {
+  auto* cmd = app.add_subcommand(
+      "compare", "Run several solvers on one system: table, histories and convergence plots");
+  opts.scene.default_patches = 2000;
+  add_scene_options(cmd, opts.scene);
+  add_method_options(cmd, opts.method, true);
+  add_ff_options(cmd, opts.ff);
+  add_solve_options(cmd, opts.solve, false);
+  cmd->add_option("--solvers", opts.solvers, "Comma-separated solvers (default: all)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(solver_names()));
+  cmd->add_option("-o,--output", opts.output,
+                  "Output directory (existing or ending in /) or file prefix")
+      ->check(output_prefix_check())
+      ->capture_default_str();
+  add_run_options(cmd, opts.run);
+  return cmd;
+}
+
+int run_compare(const CompareOptions& opts) {
+  static const MethodTable<CompareOptions> kMethods = {{"matrix", compare_matrix},
+                                                       {"hierarchical", compare_hierarchical}};
+  // The hierarchical comparison runs a matrix reference: its problem options set it up.
+  return run_for_method(kMethods, opts, opts.method.name == "hierarchical" ? "matrix" : "");
 }
 
 }  // namespace lambert

@@ -1,19 +1,22 @@
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <utility>
 
 #include "apps/cli.hpp"
 #include "apps/commands.hpp"
-#include "core/error.hpp"
+#include "apps/hierarchical_stage.hpp"
 #include "apps/solve_args.hpp"
+#include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/radiosity_csv.hpp"
 
 namespace lambert {
 namespace {
 
-std::string render_settings(const RenderOptions& o, const LoadedScene& s, const RadiosityResult& r,
-                            const Camera& cam) {
+// The method's part of the settings line: how B was obtained.
+std::string matrix_settings(const RenderOptions& o, const LoadedScene& s,
+                            const RadiosityResult& r) {
   std::ostringstream ss;
   ss << "patches=" << s.mesh.size() << " max_edge=" << s.max_edge;
   if (!o.radiosity.empty()) {
@@ -22,12 +25,90 @@ std::string render_settings(const RenderOptions& o, const LoadedScene& s, const 
     ss << ' ' << ff_settings_text(r.ff_options, o.ff.ff_file) << " solver=" << o.solver.solver
        << " tol=" << o.solver.tol;
   }
+  return ss.str();
+}
+
+// The settings line: the method's part, then shading and camera.
+std::string render_settings(const RenderOptions& o, const std::string& method_part,
+                            const Camera& cam) {
+  std::ostringstream ss;
+  ss << method_part;
   ss << " interp=" << o.shade.vertex_interp << " shading=" << (o.shade.flat ? "flat" : "gouraud")
      << " antialias=" << o.shade.antialias << " render_seed=" << o.run.seed << " size=" << cam.width
      << "x" << cam.height << " eye=" << cam.eye.x() << "," << cam.eye.y() << "," << cam.eye.z()
      << " look_at=" << cam.look_at.x() << "," << cam.look_at.y() << "," << cam.look_at.z()
      << " vfov=" << cam.vfov_degrees;
   return ss.str();
+}
+
+std::string png_path(const RenderOptions& opts) {
+  return opts.png.empty() ? std::filesystem::path(opts.output).replace_extension(".png").string()
+                          : opts.png;
+}
+
+// Shades, renders and writes B on the loaded mesh; prints what was written.
+void render_and_write(const RenderOptions& opts, const LoadedScene& loaded,
+                      const Eigen::MatrixX3d& B, const Camera& camera,
+                      const std::string& method_settings) {
+  const ShadedField shaded = shade_vertices(loaded.mesh, B, opts.shade);
+  RenderStats stats;
+  const Image image = render_scene(loaded, B, shaded.field, camera, opts.shade, opts.run, &stats);
+  const double ev = choose_exposure(opts.shade, image);
+  OutputPaths paths;
+  paths.image_exr = opts.output;
+  paths.png = png_path(opts);
+  paths.vertex_exr = opts.vertex_exr;
+  paths.ply = opts.ply;
+  const auto written = write_outputs(paths, loaded.mesh, shaded, image, ev,
+                                     render_settings(opts, method_settings, camera));
+  const auto [power_after, power_before] = worst_power_error(shaded.power);
+  std::printf("rendered %dx%d, %lld rays in %.2fs, exposure %+.3f EV\n", image.width, image.height,
+              static_cast<long long>(stats.rays), stats.seconds, ev);
+  std::printf("vertex power error (max over surfaces): %.3g (%s), %.3g before rescale\n",
+              power_after, opts.shade.vertex_interp.c_str(), power_before);
+  for (const auto& f : written) std::printf("wrote %s\n", f.c_str());
+}
+
+JobPlan render_plan(const RenderOptions& opts) {
+  JobPlan plan = job_plan(opts.run);
+  plan.outputs = {{"-o", opts.output},
+                  {"--png", png_path(opts)},
+                  {"--vertex-exr", opts.vertex_exr},
+                  {"--ply", opts.ply}};
+  return plan;
+}
+
+// --method matrix: B from --radiosity, or F and a solve.
+int render_matrix(const RenderOptions& opts) {
+  JobPlan plan = render_plan(opts);
+  if (opts.radiosity.empty()) {
+    plan_form_factors(plan, opts.ff, opts.run);
+    plan.direct = opts.solver.solver == "direct";
+  } else
+    plan.inputs.push_back({"--radiosity", opts.radiosity});
+  const LoadedScene loaded = load_scene(opts.scene, plan);
+  const Camera camera = make_camera(loaded.scene, opts.camera);
+  RadiosityResult r;
+  if (!opts.radiosity.empty()) {
+    r.B = read_radiosity_csv(opts.radiosity, loaded.mesh);
+    log_info("radiosity: read " + std::to_string(loaded.mesh.size()) + " patches from " +
+             opts.radiosity);
+  } else {
+    r = compute_radiosity(loaded, opts.ff, opts.solver, opts.run);
+  }
+  render_and_write(opts, loaded, r.B, camera, matrix_settings(opts, loaded, r));
+  return r.solved && r.solution.status != SolveStatus::Converged ? kExitNotConverged : kExitOk;
+}
+
+// --method hierarchical: load (no meshing), solve hierarchically, render the leaves.
+int render_hierarchical(const RenderOptions& opts) {
+  Scene scene = load_checked_scene(opts.scene, render_plan(opts));
+  const Camera camera = make_camera(scene, opts.camera);
+  const HierarchicalRun h = solve_scene_hierarchical(
+      std::move(scene), make_hierarchical_options(opts.method, opts.method.hierarchical.epsilon,
+                                                  opts.solver, opts.run));
+  render_and_write(opts, h.loaded, h.B, camera, hierarchical_settings_text(h));
+  return hierarchical_status(h.stats) != SolveStatus::Converged ? kExitNotConverged : kExitOk;
 }
 
 }  // namespace
@@ -39,6 +120,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opts) {
   opts.scene.default_patches = 2000;
   add_scene_options(cmd, opts.scene);
   add_run_options(cmd, opts.run);
+  add_method_options(cmd, opts.method);
   add_ff_options(cmd, opts.ff);
   add_solve_options(cmd, opts.solver, true);
   add_camera_options(cmd, opts.camera);
@@ -59,47 +141,9 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opts) {
 }
 
 int run_render(const RenderOptions& opts) {
-  apply_run_options(opts.run);
-  const std::string png = opts.png.empty()
-                              ? std::filesystem::path(opts.output).replace_extension(".png").string()
-                              : opts.png;
-  JobPlan plan = job_plan(opts.run);
-  plan.outputs = {{"-o", opts.output}, {"--png", png}, {"--vertex-exr", opts.vertex_exr},
-                  {"--ply", opts.ply}};
-  if (opts.radiosity.empty()) {
-    plan_form_factors(plan, opts.ff, opts.run);
-    plan.direct = opts.solver.solver == "direct";
-  }
-  else plan.inputs.push_back({"--radiosity", opts.radiosity});
-  const LoadedScene loaded = load_scene(opts.scene, plan);
-  const Camera camera = make_camera(loaded.scene, opts.camera);
-  RadiosityResult r;
-  if (!opts.radiosity.empty()) {
-    r.B = read_radiosity_csv(opts.radiosity, loaded.mesh);
-    log_info("radiosity: read " + std::to_string(loaded.mesh.size()) + " patches from " +
-             opts.radiosity);
-  } else {
-    r = compute_radiosity(loaded, opts.ff, opts.solver, opts.run);
-  }
-  const ShadedField shaded = shade_vertices(loaded.mesh, r.B, opts.shade);
-  RenderStats stats;
-  const Image image =
-      render_scene(loaded, r.B, shaded.field, camera, opts.shade, opts.run, &stats);
-  const double ev = choose_exposure(opts.shade, image);
-  OutputPaths paths;
-  paths.image_exr = opts.output;
-  paths.png = png;
-  paths.vertex_exr = opts.vertex_exr;
-  paths.ply = opts.ply;
-  const auto written = write_outputs(paths, loaded.mesh, shaded, image, ev,
-                                     render_settings(opts, loaded, r, camera));
-  const auto [power_after, power_before] = worst_power_error(shaded.power);
-  std::printf("rendered %dx%d, %lld rays in %.2fs, exposure %+.3f EV\n", image.width, image.height,
-              static_cast<long long>(stats.rays), stats.seconds, ev);
-  std::printf("vertex power error (max over surfaces): %.3g (%s), %.3g before rescale\n",
-              power_after, opts.shade.vertex_interp.c_str(), power_before);
-  for (const auto& f : written) std::printf("wrote %s\n", f.c_str());
-  return r.solved && r.solution.status != SolveStatus::Converged ? kExitNotConverged : kExitOk;
+  static const MethodTable<RenderOptions> kMethods = {{"matrix", render_matrix},
+                                                      {"hierarchical", render_hierarchical}};
+  return run_for_method(kMethods, opts);
 }
 
 }  // namespace lambert

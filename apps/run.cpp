@@ -1,16 +1,21 @@
-// `lambert run`: the whole job in one command: load, mesh, form factors, solve, per-vertex
-// radiosity, render, and every output file, with one progress line per stage on stderr and
-// a closing summary on stdout.
+// `lambert run`: the whole job in one command: load, compute B with the chosen method
+// (matrix: mesh, form factors, solve; hierarchical: adaptive links and their solve),
+// per-vertex radiosity, render, and every output file, with one progress line per stage on
+// stderr and a closing summary on stdout.
 
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <utility>
 
 #include "apps/cli.hpp"
 #include "apps/commands.hpp"
+#include "apps/hierarchical_stage.hpp"
+#include "apps/problem.hpp"
 #include "apps/solve_args.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/memory.hpp"
 #include "core/progress.hpp"
 #include "core/timer.hpp"
 #include "geometry/formfactors/formfactors.hpp"
@@ -19,79 +24,91 @@
 namespace lambert {
 namespace {
 
-constexpr int kStages = 6;
+// "[k/n] what" on stderr, counting the stages of one run.
+class Stages {
+ public:
+  explicit Stages(int total) : total_(total) {}
+  void next(const std::string& what) {
+    log_info("[" + std::to_string(++k_) + "/" + std::to_string(total_) + "] " + what);
+  }
 
-void stage(int k, const std::string& what) {
-  log_info("[" + std::to_string(k) + "/" + std::to_string(kStages) + "] " + what);
-}
-
-// Seconds per stage, in order.
-struct StageTimes {
-  double load = 0, form_factors = 0, solve = 0, vertices = 0, render = 0, write = 0;
-  double total() const { return load + form_factors + solve + vertices + render + write; }
+ private:
+  int total_, k_ = 0;
 };
 
-std::string run_settings(const RunOptions& o, const LoadedScene& s, const RadiosityResult& r,
-                         const Camera& cam) {
-  std::ostringstream ss;
-  ss << "patches=" << s.mesh.size() << " max_edge=" << s.max_edge << ' '
-     << ff_settings_text(r.ff_options, o.ff.ff_file) << " solver=" << o.solver.solver
-     << " tol=" << o.solver.tol << " interp=" << o.shade.vertex_interp
-     << " shading=" << (o.shade.flat ? "flat" : "gouraud") << " antialias=" << o.shade.antialias
-     << " render_seed=" << o.run.seed << " size=" << cam.width << "x" << cam.height;
-  return ss.str();
-}
+// Where a run writes.
+struct RunPaths {
+  std::string name, dir;
+  OutputPaths files;
+  std::string report;
+};
+
+// What a method produced, for the stages every method shares (vertices, render, write), the
+// report and the summary.
+struct MethodOutcome {
+  MethodOutcome(std::string name, const LoadedScene& scene, const Eigen::MatrixX3d& radiosity)
+      : method(std::move(name)), loaded(scene), B(radiosity) {}
+  std::string method;
+  const LoadedScene& loaded;  ///< the mesh B lives on (and its BVH, for rendering)
+  const Eigen::MatrixX3d& B;
+  std::string settings;            ///< the method's part of the settings line
+  Json sections = Json::object();  ///< the method's report sections, in report order
+  Json energy = Json::array();     ///< energy_balance: one object per channel
+  std::vector<std::pair<std::string, double>> seconds;  ///< the method's stages, report keys
+  std::vector<std::string> time_labels;                 ///< the same for the summary's time line
+  std::int64_t rays = 0;
+  std::string rays_label;            ///< what traced them ("form factors", "links")
+  std::string patches_noun;          ///< after the patch count ("" or " leaves")
+  std::vector<std::string> summary;  ///< stdout lines between rays and vertices
+  SolveStatus status = SolveStatus::Converged;
+  std::string not_converged;  ///< the warning when status is not Converged
+};
 
 std::vector<double> as_vector(const Eigen::Vector3d& v) { return {v[0], v[1], v[2]}; }
 
-struct Report {
-  const RunOptions& opts;
-  const LoadedScene& loaded;
-  const RadiosityResult& r;
+std::string shade_settings(const RunOptions& o, const Camera& cam) {
+  std::ostringstream ss;
+  ss << " interp=" << o.shade.vertex_interp << " shading=" << (o.shade.flat ? "flat" : "gouraud")
+     << " antialias=" << o.shade.antialias << " render_seed=" << o.run.seed << " size=" << cam.width
+     << "x" << cam.height;
+  return ss.str();
+}
+
+// The stages after the method's: what the run hands on to the report.
+struct Tail {
   const ShadedField& shaded;
   const RenderStats& render;
   const Camera& camera;
   double ev;
-  const StageTimes& t;
+  double write_seconds;
   const std::vector<std::string>& files;
   std::string settings;
 };
 
-Json report_json(const Report& rp) {
-  const auto& r = rp.r;
-  Json j = {{"scene", rp.loaded.scene.source},
-            {"settings", rp.settings},
-            {"patches", rp.loaded.mesh.size()},
-            {"shading_vertices", rp.shaded.field.size()},
-            {"surfaces", rp.loaded.mesh.surface_names.size()}};
-  Json& ff = j["form_factors"] = ff_settings_json(r.ff_options, rp.opts.ff.ff_file);
-  ff["entries"] = r.ff_entries;
-  ff["pairs_tested"] = r.ff_stats.pairs_tested;
-  ff["rays"] = r.ff_stats.rays;
-  ff["reciprocity_max_relative_change"] = r.ff_stats.reciprocity_max_relative_change;
-  ff["reciprocity_mean_relative_change"] = r.ff_stats.reciprocity_mean_relative_change;
-  ff["reciprocity_scale_min"] = r.ff_stats.reciprocity_scale_min;
-  ff["reciprocity_scale_max"] = r.ff_stats.reciprocity_scale_max;
-  ff["reciprocity_rows_scaled"] = r.ff_stats.reciprocity_rows_scaled;
+double method_seconds(const MethodOutcome& m) {
+  double s = 0.0;
+  for (const auto& [key, t] : m.seconds) s += t;
+  return s;
+}
 
-  Json channels = Json::array();
-  for (const auto& c : r.solution.channels)
-    channels.push_back({{"status", to_string(c.status)},
-                        {"iterations", c.iterations},
-                        {"matvecs", c.matvecs},
-                        {"residual", c.residual},
-                        {"seconds", c.seconds}});
-  j["solver"] = {{"name", rp.opts.solver.solver},
-                 {"tol", rp.opts.solver.tol},
-                 {"status", to_string(r.solution.status)},
-                 {"channels", channels}};
+double total_seconds(const MethodOutcome& m, const Tail& t) {
+  return method_seconds(m) + t.shaded.seconds + t.render.seconds + t.write_seconds;
+}
 
-  Json& energy = j["energy_balance"] = Json::array();
-  for (const auto& e : r.solution.energy) energy.push_back(energy_json(e));
+Json report_json(const RunOptions& opts, const MethodOutcome& m, const Tail& t) {
+  Json j = {{"scene", m.loaded.scene.source},
+            {"method", m.method},
+            {"settings", t.settings},
+            {"patches", m.loaded.mesh.size()},
+            {"shading_vertices", t.shaded.field.size()},
+            {"surfaces", m.loaded.mesh.surface_names.size()}};
+  for (const auto& [key, value] : m.sections.items()) j[key] = value;
+  j["energy_balance"] = m.energy;
+  j["surface_averages"] = surface_averages_json(surface_averages(m.loaded.mesh, m.B));
 
-  const auto [after, before] = worst_power_error(rp.shaded.power);
+  const auto [after, before] = worst_power_error(t.shaded.power);
   Json surfaces = Json::array();
-  for (const auto& s : rp.shaded.power)
+  for (const auto& s : t.shaded.power)
     surfaces.push_back({{"name", s.name},
                         {"area", s.area},
                         {"patch_power", as_vector(s.patch_power)},
@@ -100,69 +117,265 @@ Json report_json(const Report& rp) {
                         {"relative_error", s.relative_error()},
                         {"area_weighted_relative_error", s.area_weighted_relative_error()}});
   j["vertex_power"] = {
-      {"interpolation", rp.opts.shade.vertex_interp},
+      {"interpolation", opts.shade.vertex_interp},
       {"max_relative_error", after},
       {"area_weighted_max_relative_error", before},
-      {"tolerance", rp.opts.shade.vertex_interp == "conservative" ? kPowerTolerance : before},
+      {"tolerance", opts.shade.vertex_interp == "conservative" ? kPowerTolerance : before},
       {"surfaces", surfaces}};
 
-  j["render"] = {{"width", rp.camera.width},
-                 {"height", rp.camera.height},
-                 {"samples_per_pixel", rp.opts.shade.antialias * rp.opts.shade.antialias},
-                 {"shading", rp.opts.shade.flat ? "flat" : "gouraud"},
-                 {"rays", rp.render.rays},
-                 {"exposure_ev", rp.ev}};
-  j["seconds"] = {{"load_and_mesh", rp.t.load}, {"form_factors", rp.t.form_factors},
-                  {"solve", rp.t.solve},        {"vertices", rp.t.vertices},
-                  {"render", rp.t.render},      {"write", rp.t.write},
-                  {"total", rp.t.total()}};
-  j["rays_total"] = r.ff_stats.rays + rp.render.rays;
-  j["files"] = rp.files;
+  j["render"] = {{"width", t.camera.width},
+                 {"height", t.camera.height},
+                 {"samples_per_pixel", opts.shade.antialias * opts.shade.antialias},
+                 {"shading", opts.shade.flat ? "flat" : "gouraud"},
+                 {"rays", t.render.rays},
+                 {"exposure_ev", t.ev}};
+  Json& seconds = j["seconds"] = Json::object();
+  for (const auto& [key, s] : m.seconds) seconds[key] = s;
+  seconds["vertices"] = t.shaded.seconds;
+  seconds["render"] = t.render.seconds;
+  seconds["write"] = t.write_seconds;
+  seconds["total"] = total_seconds(m, t);
+  j["rays_total"] = m.rays + t.render.rays;
+  j["files"] = t.files;
   return j;
 }
 
-void print_summary(const Report& rp) {
-  const auto& r = rp.r;
-  const char* channel[] = {"R", "G", "B"};
-  std::printf("scene      %s\n", rp.loaded.scene.source.c_str());
-  std::printf("patches    %d (%d shading vertices, %zu surfaces)\n", rp.loaded.mesh.size(),
-              rp.shaded.field.size(), rp.loaded.mesh.surface_names.size());
-  std::printf("rays       %s form factors + %s camera = %s\n",
-              format_si(static_cast<double>(r.ff_stats.rays)).c_str(),
-              format_si(static_cast<double>(rp.render.rays)).c_str(),
-              format_si(static_cast<double>(r.ff_stats.rays + rp.render.rays)).c_str());
-  std::printf("solver     %s: %s;", rp.opts.solver.solver.c_str(), to_string(r.solution.status));
-  for (int c = 0; c < 3; ++c)
-    std::printf(" %s %d it (res %.2g)", channel[c], r.solution.channels[c].iterations,
-                r.solution.channels[c].residual);
-  std::printf("\n");
-  std::printf("energy     emitted / absorbed / escaped (W), relative imbalance (its parts):\n");
-  for (int c = 0; c < 3; ++c) {
-    const auto& e = r.solution.energy[c];
-    std::printf("           %s %.6g / %.6g / %.6g, %.2e (%s)\n", channel[c], e.emitted, e.absorbed,
-                e.escaped, e.relative_imbalance, energy_split_text(e).c_str());
-  }
-  const auto [after, before] = worst_power_error(rp.shaded.power);
+void print_summary(const RunOptions& opts, const MethodOutcome& m, const Tail& t) {
+  std::printf("scene      %s\n", m.loaded.scene.source.c_str());
+  std::printf("patches    %d%s (%d shading vertices, %zu surfaces)\n", m.loaded.mesh.size(),
+              m.patches_noun.c_str(), t.shaded.field.size(), m.loaded.mesh.surface_names.size());
+  std::printf("rays       %s %s + %s camera = %s\n", format_si(static_cast<double>(m.rays)).c_str(),
+              m.rays_label.c_str(), format_si(static_cast<double>(t.render.rays)).c_str(),
+              format_si(static_cast<double>(m.rays + t.render.rays)).c_str());
+  for (const std::string& line : m.summary) std::printf("%s\n", line.c_str());
+  const auto [after, before] = worst_power_error(t.shaded.power);
   std::printf(
       "vertices   power error per surface (max) %.2e with %s interpolation "
       "(area-weighted alone: %.2e)\n",
-      after, rp.opts.shade.vertex_interp.c_str(), before);
-  std::printf("image      %dx%d, %d samples/pixel, exposure %+.2f EV\n", rp.camera.width,
-              rp.camera.height, rp.opts.shade.antialias * rp.opts.shade.antialias, rp.ev);
-  std::printf(
-      "time       load+mesh %s, form factors %s, solve %s, vertices %s, render %s, "
-      "write %s; total %s\n",
-      format_duration(rp.t.load).c_str(), format_duration(rp.t.form_factors).c_str(),
-      format_duration(rp.t.solve).c_str(), format_duration(rp.t.vertices).c_str(),
-      format_duration(rp.t.render).c_str(), format_duration(rp.t.write).c_str(),
-      format_duration(rp.t.total()).c_str());
+      after, opts.shade.vertex_interp.c_str(), before);
+  std::printf("image      %dx%d, %d samples/pixel, exposure %+.2f EV\n", t.camera.width,
+              t.camera.height, opts.shade.antialias * opts.shade.antialias, t.ev);
+  std::string times;
+  for (size_t k = 0; k < m.seconds.size(); ++k)
+    times += m.time_labels[k] + " " + format_duration(m.seconds[k].second) + ", ";
+  std::printf("time       %svertices %s, render %s, write %s; total %s\n", times.c_str(),
+              format_duration(t.shaded.seconds).c_str(), format_duration(t.render.seconds).c_str(),
+              format_duration(t.write_seconds).c_str(),
+              format_duration(total_seconds(m, t)).c_str());
   std::printf("files\n");
-  for (const auto& f : rp.files) std::printf("           %s\n", f.c_str());
+  for (const auto& f : t.files) std::printf("           %s\n", f.c_str());
+}
+
+// The stages every method shares: per-vertex radiosity, render, write, report, summary.
+int finish_run(const RunOptions& opts, const RunPaths& paths, const MethodOutcome& m,
+               const Camera& camera, Stages& stages) {
+  stages.next("per-vertex radiosity (" + opts.shade.vertex_interp + ")");
+  const ShadedField shaded = shade_vertices(m.loaded.mesh, m.B, opts.shade);
+
+  stages.next("rendering " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  RenderStats rs;
+  const Image image = render_scene(m.loaded, m.B, shaded.field, camera, opts.shade, opts.run, &rs);
+  const double ev = choose_exposure(opts.shade, image);
+
+  stages.next("writing " + opts.output_dir + "/" + paths.name + ".*");
+  const Timer timer;
+  const std::string settings = m.settings + shade_settings(opts, camera);
+  std::vector<std::string> files =
+      write_outputs(paths.files, m.loaded.mesh, shaded, image, ev, settings);
+  files.push_back(paths.report);
+  const Tail tail{shaded, rs, camera, ev, timer.seconds(), files, settings};
+  write_json_file(paths.report, report_json(opts, m, tail));
+  print_summary(opts, m, tail);
+  if (m.status != SolveStatus::Converged) {
+    log_warn(m.not_converged);
+    return kExitNotConverged;
+  }
+  return kExitOk;
 }
 
 std::string default_name(const SceneArgs& scene) {
   if (scene.scene.empty()) return "cornell";
   return std::filesystem::path(scene.scene).stem().string();
+}
+
+// The output names, the directory created; the plan with every output and --max-memory.
+RunPaths prepare_outputs(const RunOptions& opts, JobPlan& plan) {
+  RunPaths p;
+  p.name = opts.name.empty() ? default_name(opts.scene) : opts.name;
+  if (p.name.empty() || p.name.find('/') != std::string::npos)
+    throw UsageError("--name must be a non-empty file name prefix without '/'");
+  std::error_code ec;
+  std::filesystem::create_directories(opts.output_dir, ec);
+  if (!std::filesystem::is_directory(opts.output_dir))
+    throw IoError(opts.output_dir + ": cannot create the output directory" +
+                  (ec ? ": " + ec.message() : std::string()));
+  const std::filesystem::path dir(opts.output_dir);
+  p.files.image_exr = (dir / (p.name + ".exr")).string();
+  p.files.png = (dir / (p.name + ".png")).string();
+  p.files.vertex_exr = (dir / (p.name + "_vertices.exr")).string();
+  p.files.ply = (dir / (p.name + ".ply")).string();
+  p.report = (dir / "report.json").string();
+  plan = job_plan(opts.run);
+  plan.outputs = {{"-o", p.files.image_exr},
+                  {"-o", p.files.png},
+                  {"-o", p.files.vertex_exr},
+                  {"-o", p.files.ply},
+                  {"-o", p.report}};
+  return p;
+}
+
+std::string loading_what(const RunOptions& opts, const char* verb) {
+  return std::string(verb) +
+         (opts.scene.scene.empty() ? std::string("the built-in Cornell box") : opts.scene.scene);
+}
+
+// --method matrix: mesh, F, solve (stages 1-3 of 6).
+int run_matrix(const RunOptions& opts) {
+  Stages stages(6);
+  Timer timer;
+  stages.next(loading_what(opts, "loading and meshing "));
+  JobPlan plan;
+  const RunPaths paths = prepare_outputs(opts, plan);
+  plan_form_factors(plan, opts.ff, opts.run);
+  plan.direct = opts.solver.solver == "direct";
+  const LoadedScene loaded = load_scene(opts.scene, plan);
+  const Camera camera = make_camera(loaded.scene, opts.camera);
+  const double load_seconds = timer.seconds();
+  log_info("      " + std::to_string(loaded.mesh.size()) + " patches on " +
+           std::to_string(loaded.mesh.surface_names.size()) + " surfaces");
+
+  const std::string estimator =
+      opts.ff.estimator == "auto" ? auto_estimator(loaded.mesh.size()) : opts.ff.estimator;
+  const std::string count = estimator_count_option(estimator);
+  const std::string per =
+      count == "rays"      ? ", " + std::to_string(opts.ff.rays) + " rays per patch"
+      : count == "samples" ? ", " + std::to_string(opts.ff.samples) + " samples per pair"
+                           : "";
+  stages.next("form factors (" +
+              (opts.ff.ff_file.empty() ? estimator + per : "from " + opts.ff.ff_file) + ")");
+  RadiosityResult r;
+  timer.reset();
+  const FormFactors F = obtain_form_factors(loaded, opts.ff, opts.run);
+  r.ff_seconds = timer.seconds();
+
+  stages.next("solving (I - rho F) B = E with " + opts.solver.solver);
+  solve_scene(loaded, F, opts.solver, opts.run, r);
+
+  MethodOutcome m{"matrix", loaded, r.B};
+  std::ostringstream settings;
+  settings << "patches=" << loaded.mesh.size() << " max_edge=" << loaded.max_edge << ' '
+           << ff_settings_text(r.ff_options, opts.ff.ff_file) << " solver=" << opts.solver.solver
+           << " tol=" << opts.solver.tol;
+  m.settings = settings.str();
+  Json& ff = m.sections["form_factors"] = ff_settings_json(r.ff_options, opts.ff.ff_file);
+  ff["entries"] = r.ff_entries;
+  ff["pairs_tested"] = r.ff_stats.pairs_tested;
+  ff["rays"] = r.ff_stats.rays;
+  ff["reciprocity_max_relative_change"] = r.ff_stats.reciprocity_max_relative_change;
+  ff["reciprocity_mean_relative_change"] = r.ff_stats.reciprocity_mean_relative_change;
+  ff["reciprocity_scale_min"] = r.ff_stats.reciprocity_scale_min;
+  ff["reciprocity_scale_max"] = r.ff_stats.reciprocity_scale_max;
+  ff["reciprocity_rows_scaled"] = r.ff_stats.reciprocity_rows_scaled;
+  Json channels = Json::array();
+  for (const auto& c : r.solution.channels)
+    channels.push_back({{"status", to_string(c.status)},
+                        {"iterations", c.iterations},
+                        {"matvecs", c.matvecs},
+                        {"residual", c.residual},
+                        {"seconds", c.seconds}});
+  m.sections["solver"] = {{"name", opts.solver.solver},
+                          {"tol", opts.solver.tol},
+                          {"status", to_string(r.solution.status)},
+                          {"channels", channels}};
+  for (const auto& e : r.solution.energy) m.energy.push_back(energy_json(e));
+  m.seconds = {
+      {"load_and_mesh", load_seconds}, {"form_factors", r.ff_seconds}, {"solve", r.solve_seconds}};
+  m.time_labels = {"load+mesh", "form factors", "solve"};
+  m.rays = r.ff_stats.rays;
+  m.rays_label = "form factors";
+
+  char line[256];
+  std::string solver_line =
+      "solver     " + opts.solver.solver + ": " + to_string(r.solution.status) + ";";
+  for (int c = 0; c < 3; ++c) {
+    std::snprintf(line, sizeof line, " %s %d it (res %.2g)", channel_name(c),
+                  r.solution.channels[c].iterations, r.solution.channels[c].residual);
+    solver_line += line;
+  }
+  m.summary.push_back(solver_line);
+  m.summary.push_back(
+      "energy     emitted / absorbed / escaped (W), relative imbalance (its parts):");
+  for (int c = 0; c < 3; ++c) {
+    const auto& e = r.solution.energy[c];
+    std::snprintf(line, sizeof line, "           %s %.6g / %.6g / %.6g, %.2e (%s)", channel_name(c),
+                  e.emitted, e.absorbed, e.escaped, e.relative_imbalance,
+                  energy_split_text(e).c_str());
+    m.summary.push_back(line);
+  }
+  m.status = r.solution.status;
+  m.not_converged = "solver status " + std::string(to_string(r.solution.status)) +
+                    ": results were written but are not converged";
+  return finish_run(opts, paths, m, camera, stages);
+}
+
+// --method hierarchical: load (no meshing), hierarchical solve (stages 1-2 of 5).
+int run_hierarchical(const RunOptions& opts) {
+  Stages stages(5);
+  const Timer timer;
+  stages.next(loading_what(opts, "loading "));
+  JobPlan plan;
+  const RunPaths paths = prepare_outputs(opts, plan);
+  Scene scene = load_checked_scene(opts.scene, plan);
+  const Camera camera = make_camera(scene, opts.camera);
+  const double load_seconds = timer.seconds();
+  log_info("      " + std::to_string(scene.faces.size()) + " faces on " +
+           std::to_string(scene.surfaces.size()) + " surfaces");
+
+  const HierarchicalOptions ho = make_hierarchical_options(
+      opts.method, opts.method.hierarchical.epsilon, opts.solver, opts.run);
+  std::ostringstream what;
+  what << "hierarchical radiosity (epsilon " << ho.epsilon << ", " << ho.link_rays
+       << " rays per link, tol " << ho.tol << ")";
+  stages.next(what.str());
+  const HierarchicalRun h = solve_scene_hierarchical(std::move(scene), ho);
+  const HierarchicalStats& st = h.stats;
+
+  MethodOutcome m{"hierarchical", h.loaded, h.B};
+  m.settings = hierarchical_settings_text(h);
+  m.sections["hierarchical"] = hierarchical_json(h);
+  for (const auto& e : st.energy) m.energy.push_back(hierarchical_energy_json(e));
+  m.seconds = {{"load", load_seconds},
+               {"build", st.build_seconds},
+               {"refine", st.refine_seconds},
+               {"solve", st.solve_seconds}};
+  m.time_labels = {"load", "hierarchy build", "refine", "solve"};
+  m.rays = st.rays;
+  m.rays_label = "links";
+  m.patches_noun = " leaves";
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "hierarchy  %lld faces, %lld elements, %lld clusters; %lld links (%lld with a "
+                "cluster); min area %.3g; %s",
+                static_cast<long long>(st.faces), static_cast<long long>(st.elements),
+                static_cast<long long>(st.clusters), static_cast<long long>(st.links),
+                static_cast<long long>(st.cluster_links), st.min_area,
+                format_bytes(st.memory_bytes).c_str());
+  m.summary.push_back(line);
+  std::snprintf(line, sizeof line,
+                "solve      hierarchical: %s; %d passes, %d sweeps (change %.2g)",
+                to_string(hierarchical_status(st)), st.passes, st.iterations, st.change);
+  m.summary.push_back(line);
+  m.summary.push_back("energy     emitted / absorbed / escaped (W), relative imbalance:");
+  for (int c = 0; c < 3; ++c) {
+    const HierarchicalEnergy& e = st.energy[c];
+    std::snprintf(line, sizeof line, "           %s %.6g / %.6g / %.6g, %.2e", channel_name(c),
+                  e.emitted, e.absorbed, e.escaped, e.relative_imbalance);
+    m.summary.push_back(line);
+  }
+  m.status = hierarchical_status(st);
+  m.not_converged = "hierarchical status " + std::string(to_string(m.status)) +
+                    ": results were written but are not converged";
+  return finish_run(opts, paths, m, camera, stages);
 }
 
 }  // namespace
@@ -174,6 +387,7 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& opts) {
   opts.ff.samples = 16;
   add_scene_options(cmd, opts.scene);
   add_run_options(cmd, opts.run);
+  add_method_options(cmd, opts.method);
   add_ff_options(cmd, opts.ff);
   add_solve_options(cmd, opts.solver, true);
   add_camera_options(cmd, opts.camera);
@@ -187,84 +401,9 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& opts) {
 }
 
 int run_run(const RunOptions& opts) {
-  apply_run_options(opts.run);
-  StageTimes t;
-  Timer timer;
-  stage(1,
-        "loading and meshing " + (opts.scene.scene.empty() ? std::string("the built-in Cornell box")
-                                                           : opts.scene.scene));
-  const std::string name = opts.name.empty() ? default_name(opts.scene) : opts.name;
-  if (name.empty() || name.find('/') != std::string::npos)
-    throw UsageError("--name must be a non-empty file name prefix without '/'");
-  std::error_code ec;
-  std::filesystem::create_directories(opts.output_dir, ec);
-  if (!std::filesystem::is_directory(opts.output_dir))
-    throw IoError(opts.output_dir + ": cannot create the output directory" +
-                  (ec ? ": " + ec.message() : std::string()));
-  const std::filesystem::path dir(opts.output_dir);
-  OutputPaths paths;
-  paths.image_exr = (dir / (name + ".exr")).string();
-  paths.png = (dir / (name + ".png")).string();
-  paths.vertex_exr = (dir / (name + "_vertices.exr")).string();
-  paths.ply = (dir / (name + ".ply")).string();
-  const std::string report_path = (dir / "report.json").string();
-  JobPlan plan = job_plan(opts.run);
-  plan.outputs = {{"-o", paths.image_exr}, {"-o", paths.png}, {"-o", paths.vertex_exr},
-                  {"-o", paths.ply},       {"-o", report_path}};
-  plan_form_factors(plan, opts.ff, opts.run);
-  plan.direct = opts.solver.solver == "direct";
-  const LoadedScene loaded = load_scene(opts.scene, plan);
-  const Camera camera = make_camera(loaded.scene, opts.camera);
-  t.load = timer.seconds();
-  log_info("      " + std::to_string(loaded.mesh.size()) + " patches on " +
-           std::to_string(loaded.mesh.surface_names.size()) + " surfaces");
-
-  const std::string estimator =
-      opts.ff.estimator == "auto" ? auto_estimator(loaded.mesh.size()) : opts.ff.estimator;
-  const std::string count = estimator_count_option(estimator);
-  const std::string per =
-      count == "rays"      ? ", " + std::to_string(opts.ff.rays) + " rays per patch"
-      : count == "samples" ? ", " + std::to_string(opts.ff.samples) + " samples per pair"
-                           : "";
-  stage(2, "form factors (" +
-               (opts.ff.ff_file.empty() ? estimator + per : "from " + opts.ff.ff_file) +
-               ")");
-  RadiosityResult r;
-  timer.reset();
-  const FormFactors F = obtain_form_factors(loaded, opts.ff, opts.run);
-  r.ff_seconds = timer.seconds();
-  t.form_factors = r.ff_seconds;
-
-  stage(3, "solving (I - rho F) B = E with " + opts.solver.solver);
-  solve_scene(loaded, F, opts.solver, opts.run, r);
-  t.solve = r.solve_seconds;
-
-  stage(4, "per-vertex radiosity (" + opts.shade.vertex_interp + ")");
-  const ShadedField shaded = shade_vertices(loaded.mesh, r.B, opts.shade);
-  t.vertices = shaded.seconds;
-
-  stage(5, "rendering " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
-  RenderStats rs;
-  const Image image =
-      render_scene(loaded, r.B, shaded.field, camera, opts.shade, opts.run, &rs);
-  t.render = rs.seconds;
-  const double ev = choose_exposure(opts.shade, image);
-
-  stage(6, "writing " + opts.output_dir + "/" + name + ".*");
-  timer.reset();
-  const std::string settings = run_settings(opts, loaded, r, camera);
-  std::vector<std::string> files = write_outputs(paths, loaded.mesh, shaded, image, ev, settings);
-  files.push_back(report_path);
-  t.write = timer.seconds();
-  const Report report{opts, loaded, r, shaded, rs, camera, ev, t, files, settings};
-  write_json_file(report_path, report_json(report));
-  print_summary(report);
-  if (r.solution.status != SolveStatus::Converged) {
-    log_warn("solver status " + std::string(to_string(r.solution.status)) +
-             ": results were written but are not converged");
-    return kExitNotConverged;
-  }
-  return kExitOk;
+  static const MethodTable<RunOptions> kMethods = {{"matrix", run_matrix},
+                                                   {"hierarchical", run_hierarchical}};
+  return run_for_method(kMethods, opts);
 }
 
 }  // namespace lambert

@@ -1,9 +1,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <utility>
 
 #include "apps/cli.hpp"
 #include "apps/commands.hpp"
+#include "apps/hierarchical_stage.hpp"
 #include "apps/problem.hpp"
 #include "apps/solve_args.hpp"
 #include "core/atomic_file.hpp"
@@ -47,25 +49,8 @@ Json channel_json(const ChannelReport& r, const EnergyBalance& e, int c) {
   return j;
 }
 
-}  // namespace
-
-CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts) {
-  auto* cmd = app.add_subcommand("solve", "Solve the radiosity system and write per-patch B");
-  opts.scene.default_patches = 2000;
-  add_scene_options(cmd, opts.scene);
-  add_ff_options(cmd, opts.ff);
-  add_solve_options(cmd, opts.solve, true);
-  cmd->add_option("-o,--output", opts.output,
-                  "Per-patch radiosity CSV (patch,surface,area,R,G,B); the summary goes to the "
-                  "same name with .json")
-      ->check(output_file_check())
-      ->capture_default_str();
-  add_run_options(cmd, opts.run);
-  return cmd;
-}
-
-int run_solve(const SolveCommandOptions& opts) {
-  apply_run_options(opts.run);
+// --method matrix: mesh, F, one solver.
+int run_solve_matrix(const SolveCommandOptions& opts) {
   const Timer total;
   JobPlan plan = job_plan(opts.run);
   plan.outputs = {{"-o", opts.output}, {"the summary", summary_path(opts.output)}};
@@ -94,6 +79,7 @@ int run_solve(const SolveCommandOptions& opts) {
     residual = std::max(residual, r.residual);
   }
   Json j = {{"scene", loaded.scene.source},
+            {"method", "matrix"},
             {"patches", loaded.mesh.size()},
             {"solver", so.solver},
             {"status", to_string(sol.status)},
@@ -115,12 +101,7 @@ int run_solve(const SolveCommandOptions& opts) {
             {"form_factor_nonzeros", ff.F.nonZeros()}};
   Json& channels = j["channels"] = Json::array();
   for (int c = 0; c < 3; ++c) channels.push_back(channel_json(sol.channels[c], sol.energy[c], c));
-  Json& surface_list = j["surfaces"] = Json::array();
-  for (const auto& s : surfaces)
-    surface_list.push_back({{"name", s.name},
-                            {"area", s.area},
-                            {"patches", s.patches},
-                            {"average_radiosity", {s.average[0], s.average[1], s.average[2]}}});
+  j["surfaces"] = surface_averages_json(surfaces);
   write_json_file(json_path, j);
 
   std::printf("solver %s: %s\n", so.solver.c_str(), to_string(sol.status));
@@ -140,6 +121,83 @@ int run_solve(const SolveCommandOptions& opts) {
     return kExitNotConverged;
   }
   return kExitOk;
+}
+
+// --method hierarchical: load (no meshing), solve hierarchically; the leaves are the patches.
+int run_solve_hierarchical(const SolveCommandOptions& opts) {
+  const Timer total;
+  JobPlan plan = job_plan(opts.run);
+  const std::string json_path = summary_path(opts.output);
+  plan.outputs = {{"-o", opts.output}, {"the summary", json_path}};
+  Scene scene = load_checked_scene(opts.scene, plan);
+  const double load_seconds = total.seconds();
+  const HierarchicalRun h = solve_scene_hierarchical(
+      std::move(scene), make_hierarchical_options(opts.method, opts.method.hierarchical.epsilon,
+                                                  opts.solve, opts.run));
+  const HierarchicalStats& st = h.stats;
+  const SolveStatus status = hierarchical_status(st);
+  write_radiosity_csv(opts.output, h.loaded.mesh, h.B);
+  Json j = {{"scene", h.loaded.scene.source},
+            {"method", "hierarchical"},
+            {"patches", h.loaded.mesh.size()},
+            {"status", to_string(status)},
+            {"iterations", st.iterations},
+            {"change", st.change},
+            {"timings",
+             {{"load_seconds", load_seconds},
+              {"build_seconds", st.build_seconds},
+              {"refine_seconds", st.refine_seconds},
+              {"solve_seconds", st.solve_seconds}}},
+            {"hierarchical", hierarchical_json(h)}};
+  Json& channels = j["channels"] = Json::array();
+  for (int c = 0; c < 3; ++c)
+    channels.push_back({{"channel", channel_name(c)},
+                        {"status", to_string(status)},
+                        {"energy", hierarchical_energy_json(st.energy[c])}});
+  j["surfaces"] = surface_averages_json(surface_averages(h.loaded.mesh, h.B));
+  write_json_file(json_path, j);
+
+  std::printf(
+      "method hierarchical: %s; %lld leaves, %lld links, %d passes, %d sweeps (change "
+      "%.3e)\n",
+      to_string(status), static_cast<long long>(st.leaves), static_cast<long long>(st.links),
+      st.passes, st.iterations, st.change);
+  for (int c = 0; c < 3; ++c) {
+    const HierarchicalEnergy& e = st.energy[c];
+    std::printf("  %s: energy emitted %.6g absorbed %.6g escaped %.6g (imbalance %.2e)\n",
+                channel_name(c), e.emitted, e.absorbed, e.escaped, e.relative_imbalance);
+  }
+  std::printf("wrote %s and %s\n", opts.output.c_str(), json_path.c_str());
+  if (status != SolveStatus::Converged) {
+    log_warn(std::string("hierarchical status ") + to_string(status) +
+             ": results were written anyway");
+    return kExitNotConverged;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts) {
+  auto* cmd = app.add_subcommand("solve", "Solve the radiosity system and write per-patch B");
+  opts.scene.default_patches = 2000;
+  add_scene_options(cmd, opts.scene);
+  add_method_options(cmd, opts.method);
+  add_ff_options(cmd, opts.ff);
+  add_solve_options(cmd, opts.solve, true);
+  cmd->add_option("-o,--output", opts.output,
+                  "Per-patch radiosity CSV (patch,surface,area,R,G,B); the summary goes to the "
+                  "same name with .json")
+      ->check(output_file_check())
+      ->capture_default_str();
+  add_run_options(cmd, opts.run);
+  return cmd;
+}
+
+int run_solve(const SolveCommandOptions& opts) {
+  static const MethodTable<SolveCommandOptions> kMethods = {
+      {"matrix", run_solve_matrix}, {"hierarchical", run_solve_hierarchical}};
+  return run_for_method(kMethods, opts);
 }
 
 }  // namespace lambert

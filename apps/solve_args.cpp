@@ -1,8 +1,10 @@
 #include "apps/solve_args.hpp"
 
 #include <cstdio>
+#include <sstream>
 
 #include "apps/common.hpp"
+#include "geometry/hierarchical/hierarchical.hpp"
 
 namespace lambert {
 
@@ -11,10 +13,18 @@ void add_solve_options(CLI::App* cmd, SolveOptions& o, bool with_solver) {
     cmd->add_option("--solver", o.solver, "Solver (see `lambert solvers`)")
         ->check(CLI::IsMember(solver_names()))
         ->capture_default_str();
-  cmd->add_option("--tol", o.tol, "Stop when ||E - K B||_2 / ||E||_2 <= tol")
+  const HierarchicalOptions hierarchical;
+  std::ostringstream tol_help, iter_help;
+  tol_help << "Stop when ||E - K B||_2 / ||E||_2 <= tol (--method hierarchical: when the largest "
+              "change of a leaf's B over the largest B <= tol; its default "
+           << hierarchical.tol << ")";
+  iter_help << "Iteration limit per channel (--method hierarchical: sweeps per refinement pass; "
+               "its default "
+            << hierarchical.max_iterations << ")";
+  cmd->add_option("--tol", o.tol, tol_help.str())
       ->check(finite_number(1e-16, 0.5))
       ->capture_default_str();
-  cmd->add_option("--max-iter", o.max_iterations, "Iteration limit per channel")
+  cmd->add_option("--max-iter", o.max_iterations, iter_help.str())
       ->check(CLI::Range(1, 100000000))
       ->capture_default_str();
   cmd->add_option("--omega", o.omega, "SOR relaxation factor, in (0, 2)")
@@ -73,6 +83,16 @@ Json energy_json(const EnergyBalance& e) {
           {"non_reciprocity_part", e.non_reciprocity_part},
           {"relative_residual_part", relative(e, e.residual_part)},
           {"relative_non_reciprocity_part", relative(e, e.non_reciprocity_part)}};
+}
+
+Json surface_averages_json(const std::vector<SurfaceRadiosity>& surfaces) {
+  Json list = Json::array();
+  for (const auto& s : surfaces)
+    list.push_back({{"name", s.name},
+                    {"area", s.area},
+                    {"patches", s.patches},
+                    {"average_radiosity", {s.average[0], s.average[1], s.average[2]}}});
+  return list;
 }
 
 std::string energy_split_text(const EnergyBalance& e) {

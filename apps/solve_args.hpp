@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "apps/problem.hpp"
 #include "io/json.hpp"
 #include "solvers/radiosity.hpp"
 
@@ -24,6 +25,9 @@ const char* channel_name(int channel);
 /// residual_part, non_reciprocity_part (W, signed), relative_residual_part,
 /// relative_non_reciprocity_part (the parts over emitted)}.
 Json energy_json(const EnergyBalance& e);
+
+/// Per-surface averages as a JSON array of {name, area, patches, average_radiosity [R, G, B]}.
+Json surface_averages_json(const std::vector<SurfaceRadiosity>& surfaces);
 
 /// "residual part R, non-reciprocity part N": the imbalance's two parts relative to emitted.
 std::string energy_split_text(const EnergyBalance& e);

@@ -3,8 +3,11 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <numeric>
 
 #include "core/error.hpp"
+#include "core/sampling.hpp"
 
 namespace lambert {
 namespace {
@@ -27,6 +30,152 @@ struct Bilinear {
 Bilinear quad_of(const PatchMesh& mesh, const Patch& p) {
   return {mesh.vertices[p.vertices[0]], mesh.vertices[p.vertices[1]], mesh.vertices[p.vertices[2]],
           mesh.vertices[p.vertices[3]]};
+}
+
+// Unit normals with a smaller dot product than this are on either side of a crease.
+double cos_crease() { return std::cos(kCreaseAngleDegrees * M_PI / 180.0); }
+
+// Shading vertices hashed by (surface, exact position), open addressing with linear probing
+// in a table at most half full: the ones at a point are found in O(1) expected. -0.0 hashes
+// as +0.0 (x + 0.0), since == (the exact-position test) makes them equal.
+class PositionIndex {
+ public:
+  explicit PositionIndex(const VertexField& f) : f_(f) {
+    size_t size = 16;
+    while (size < 2 * f.positions.size()) size *= 2;
+    mask_ = size - 1;
+    slots_.assign(size, -1);
+    for (std::int32_t v = 0; v < f.size(); ++v) {
+      size_t s = home(f.surface[v], f.positions[v]);
+      while (slots_[s] >= 0) s = (s + 1) & mask_;
+      slots_[s] = v;
+    }
+  }
+
+  // Calls visit(v) for each shading vertex v of `surface` at exactly x; returns how many.
+  template <class Visit>
+  int for_each_at(std::int32_t surface, const Eigen::Vector3d& x, Visit&& visit) const {
+    int count = 0;
+    for (size_t s = home(surface, x); slots_[s] >= 0; s = (s + 1) & mask_) {
+      const std::int32_t v = slots_[s];
+      if (f_.surface[v] != surface || f_.positions[v] != x) continue;
+      visit(v);
+      ++count;
+    }
+    return count;
+  }
+
+ private:
+  size_t home(std::int32_t surface, const Eigen::Vector3d& x) const {
+    std::uint64_t h = mix64(static_cast<std::uint64_t>(surface));
+    for (int c = 0; c < 3; ++c) {
+      const double coordinate = x[c] + 0.0;
+      std::uint64_t bits;
+      std::memcpy(&bits, &coordinate, sizeof bits);
+      h = mix64(h ^ bits);
+    }
+    return static_cast<size_t>(h) & mask_;
+  }
+
+  const VertexField& f_;
+  size_t mask_ = 0;
+  std::vector<std::int32_t> slots_;  // shading vertex, or -1 for an empty slot
+};
+
+// The part [t0, t1] of a patch edge still to search, with the positions of its ends.
+struct EdgeSegment {
+  Eigen::Vector3d x0, x1;
+  double t0 = 0.0, t1 = 1.0;
+};
+
+// The search for hanging vertices along patch edges, in discovery order (patch, edge, then
+// depth-first halves); a shading vertex found twice keeps its first anchor.
+class HangingSearch {
+ public:
+  HangingSearch(const PatchMesh& mesh, const VertexField& f)
+      : mesh_(mesh), f_(f), index_(f), anchor_of_(f.size(), -1) {}
+
+  // Appends the shading vertices hanging on edge (corner k, corner k + 1) of patch i and
+  // compatible with it: midpoints looked up while found, halving the segment.
+  void search_edge(std::int32_t i, int k) {
+    const Patch& p = mesh_.patches[i];
+    const int k1 = (k + 1) % p.vertex_count;
+    todo_.push_back({mesh_.vertices[p.vertices[k]], mesh_.vertices[p.vertices[k1]], 0.0, 1.0});
+    while (!todo_.empty()) {
+      const EdgeSegment s = todo_.back();
+      todo_.pop_back();
+      const Eigen::Vector3d m = 0.5 * (s.x0 + s.x1);
+      if (m == s.x0 || m == s.x1) continue;  // the segment is down to rounding
+      const double t = 0.5 * (s.t0 + s.t1);
+      const int at_m = index_.for_each_at(p.surface, m, [&](std::int32_t v) {
+        if (anchor_of_[v] >= 0 || f_.normals[v].dot(p.normal) < cos_max_) return;
+        anchor_of_[v] = static_cast<std::int32_t>(found_.size());
+        found_.push_back({v, f_.patch_corners[i][k], f_.patch_corners[i][k1], t, i});
+      });
+      if (at_m == 0) continue;  // no vertex at m: none finer
+      todo_.push_back({m, s.x1, t, s.t1});
+      todo_.push_back({s.x0, m, s.t0, t});
+    }
+  }
+
+  // The anchors found so far.
+  const std::vector<HangingVertex>& found() const { return found_; }
+
+ private:
+  const PatchMesh& mesh_;
+  const VertexField& f_;
+  const PositionIndex index_;
+  const double cos_max_ = cos_crease();
+  std::vector<std::int32_t> anchor_of_;  // per shading vertex: index into found_, or -1
+  std::vector<HangingVertex> found_;
+  std::vector<EdgeSegment> todo_;  // depth-first stack of segments to search
+};
+
+// Orders `found` so that every anchor follows the anchors of its ends (Kahn's algorithm).
+// When only cycles remain, the first unfinished anchor is dropped (its vertex keeps its
+// value) and the sort goes on: n steps, each finishing one anchor.
+std::vector<HangingVertex> resolution_order(const std::vector<HangingVertex>& found,
+                                            std::int32_t vertices) {
+  const auto n = static_cast<std::int32_t>(found.size());
+  std::vector<std::int32_t> anchor_of(vertices, -1);
+  for (std::int32_t j = 0; j < n; ++j) anchor_of[found[j].vertex] = j;
+  // Dependents of each anchor (CSR): j depends on the anchors of its ends a and b.
+  std::vector<std::int32_t> start(n + 1, 0), pending(n, 0);
+  for (std::int32_t j = 0; j < n; ++j) {
+    for (std::int32_t end : {found[j].a, found[j].b}) {
+      if (anchor_of[end] < 0) continue;
+      ++start[anchor_of[end] + 1];
+      ++pending[j];
+    }
+  }
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::int32_t> dependents(start[n]), fill(start.begin(), start.end() - 1);
+  for (std::int32_t j = 0; j < n; ++j)
+    for (std::int32_t end : {found[j].a, found[j].b})
+      if (anchor_of[end] >= 0) dependents[fill[anchor_of[end]]++] = j;
+
+  std::vector<char> done(n, 0);
+  std::vector<std::int32_t> ready;  // FIFO: ready[head..] are waiting
+  for (std::int32_t j = 0; j < n; ++j)
+    if (pending[j] == 0) ready.push_back(j);
+  std::vector<HangingVertex> order;
+  order.reserve(n);
+  size_t head = 0;
+  std::int32_t unfinished = 0;
+  for (std::int32_t step = 0; step < n; ++step) {
+    std::int32_t j;
+    if (head < ready.size()) {
+      j = ready[head++];
+      order.push_back(found[j]);
+    } else {
+      while (done[unfinished]) ++unfinished;
+      j = unfinished;  // on a cycle: dropped
+    }
+    done[j] = 1;
+    for (std::int32_t d = start[j]; d < start[j + 1]; ++d)
+      if (--pending[dependents[d]] == 0 && !done[dependents[d]]) ready.push_back(dependents[d]);
+  }
+  return order;
 }
 
 double relative(const Eigen::Vector3d& value, const Eigen::Vector3d& reference) {
@@ -63,7 +212,7 @@ VertexField build_shading_vertices(const PatchMesh& mesh) {
     const Patch& p = mesh.patches[i];
     for (int k = 0; k < p.vertex_count; ++k) around[p.vertices[k]].push_back({i, k});
   }
-  const double cos_crease = std::cos(kCreaseAngleDegrees * M_PI / 180.0);
+  const double cos_max = cos_crease();
   VertexField f;
   f.patch_corners.assign(mesh.patches.size(), {-1, -1, -1, -1});
   for (size_t v = 0; v < nv; ++v) {
@@ -75,7 +224,7 @@ VertexField build_shading_vertices(const PatchMesh& mesh) {
       const Patch& p = mesh.patches[i];
       size_t g = 0;
       for (; g < group_normal.size(); ++g)
-        if (group_normal[g].normalized().dot(p.normal) >= cos_crease) break;
+        if (group_normal[g].normalized().dot(p.normal) >= cos_max) break;
       if (g == group_normal.size()) {
         group_normal.push_back(Eigen::Vector3d::Zero());
         group_id.push_back(f.size());
@@ -92,6 +241,22 @@ VertexField build_shading_vertices(const PatchMesh& mesh) {
   }
   f.values = Eigen::MatrixX3d::Zero(f.size(), 3);
   return f;
+}
+
+std::vector<HangingVertex> find_hanging_vertices(const PatchMesh& mesh, const VertexField& field) {
+  LAMBERT_CHECK(field.patch_corners.size() == mesh.patches.size(),
+                "vertex field does not match the mesh");
+  HangingSearch search(mesh, field);
+  for (std::int32_t i = 0; i < mesh.size(); ++i)
+    for (int k = 0; k < mesh.patches[i].vertex_count; ++k) search.search_edge(i, k);
+  return resolution_order(search.found(), field.size());
+}
+
+void anchor_hanging_vertices(const std::vector<HangingVertex>& hanging, VertexField& field) {
+  // v_a + t (v_b - v_a) rather than (1 - t) v_a + t v_b: exact when v_a = v_b (a constant).
+  for (const HangingVertex& h : hanging)
+    field.values.row(h.vertex) =
+        field.values.row(h.a) + h.t * (field.values.row(h.b) - field.values.row(h.a));
 }
 
 Eigen::Vector3d integrate_patch(const PatchMesh& mesh, const VertexField& field, std::int32_t i) {
@@ -148,6 +313,7 @@ VertexField interpolate_to_vertices(const PatchMesh& mesh, const Eigen::MatrixX3
   }
   for (std::int32_t k = 0; k < f.size(); ++k)
     if (weight[k] > 0) f.values.row(k) /= weight[k];
+  anchor_hanging_vertices(find_hanging_vertices(mesh, f), f);
 
   std::vector<SurfacePower> pw = surface_power(mesh, patch_values, f);
   if (mode == VertexInterpolation::Conservative) {

@@ -24,12 +24,45 @@
 // (c corners, each hat function integrating to A_i / c there), so ∫ f dA = sum_k sum_{i ∋ k}
 // A_i b_i / c = sum_i A_i b_i. It is not where a quad is not a parallelogram (its corner
 // masses differ from A/4: the Cornell floor is a trapezoid) or where triangles and quads
-// meet at a vertex; the error is small (2e-5 on the Cornell box) but not bounded by
-// rounding. The default (Conservative) therefore rescales each surface and channel by
-// s = sum_i A_i b_i / ∫ f dA, which makes power conservation exact up to rounding (relative
-// error <= kPowerTolerance), keeps f >= 0 and reproduces a constant field exactly.
+// meet at a vertex (the error is small, 2e-5 on the Cornell box, but not bounded by
+// rounding), nor once hanging vertices (below) are anchored (larger: a coarse edge's values
+// replace the fine patches' means). The default (Conservative) therefore rescales each
+// surface and channel by s = sum_i A_i b_i / ∫ f dA, which makes power conservation exact up
+// to rounding (relative error <= kPowerTolerance), keeps f >= 0 and reproduces a constant
+// field exactly.
 //
-// Complexity O(patches + vertices); single-threaded pure functions of their inputs.
+// Hanging vertices. A non-conforming mesh (the leaves of the hierarchical method: elements
+// split into 4 through their edge midpoints 0.5 (a + b) to different depths) has vertices h
+// inside an edge (a, b) of a coarser patch P. P interpolates linearly between a and b along
+// that edge, so the value at h must be v_h = (1 - t) v_a + t v_b with h = (1 - t) x_a + t x_b,
+// v_a and v_b being P's own corner values (patch_corners of P); otherwise the field cracks
+// along the edge. Every shading vertex at h whose smoothing group is compatible with P (same
+// surface, group normal within kCreaseAngleDegrees of P's normal) is anchored so, after the
+// area-weighted mean and before the integral and the rescale (a uniform per-surface scale
+// keeps the field continuous). The rule is unchanged on a conforming mesh (none are found).
+//
+// Detection is exact for midpoint subdivision: for each patch edge (a, b) the midpoint
+// m = 0.5 (a + b) is looked up by exact position among the shading vertices of P's surface
+// (a hash table); when found (t = 1/2), the halves (a, m) and (m, b) are searched the same
+// way (t = 1/4, 3/4, ...), until a midpoint is not a vertex. Limits: a vertex on an edge at
+// a non-dyadic position, or whose coordinates were not computed by repeated 0.5 (a + b) from
+// that edge's ends (other subdivision rules, most T-junctions of the input), is not found and
+// keeps its area-weighted value (and its crack). A shading vertex found on several coarse
+// edges (non-manifold surfaces) is anchored to the first (patch order).
+//
+// Chains: the ends a, b may themselves be anchored (h on a fine edge whose end hangs on a
+// coarser edge), so anchors are applied in dependency order (Kahn's topological sort: an
+// anchor after the anchors of its ends). Edge length is not a valid order (a fine element's
+// long edge may end at a vertex hanging on a short coarse edge). Midpoint subdivision of
+// faces that meet edge to edge creates no dependency cycle: the uniform subdivision to any
+// depth d is conforming, so a vertex inside an edge of a depth-d element first appears deeper
+// than d, while that element's corners appear at depth <= d. T-junctions in the input can
+// (a pinwheel of rectangles): the sort then drops the first anchor left on the cycle (its
+// vertex keeps its area-weighted value, the crack stays there) and goes on, so it always
+// terminates.
+//
+// Complexity O(patches + vertices) (the detection: one expected-O(1) lookup per patch edge
+// and two per hanging vertex found); single-threaded pure functions of their inputs.
 
 #include <Eigen/Core>
 #include <array>
@@ -94,7 +127,24 @@ struct SurfacePower {
 /// Builds the shading vertices of `mesh` (splitting at surfaces and creases); values empty.
 VertexField build_shading_vertices(const PatchMesh& mesh);
 
-/// Reconstructs per-vertex values of `patch_values` (N x 3) on the shading vertices. When
+/// A shading vertex tied to an edge of a coarser patch: v_vertex = (1 - t) v_a + t v_b.
+struct HangingVertex {
+  std::int32_t vertex = -1;  ///< the shading vertex at h
+  std::int32_t a = -1;       ///< the coarse patch's shading vertex at the first end
+  std::int32_t b = -1;       ///< the same for the second end
+  double t = 0.5;            ///< h = (1 - t) x_a + t x_b, a dyadic fraction in (0, 1)
+  std::int32_t patch = -1;   ///< the coarse patch whose edge (a, b) holds h
+};
+
+/// The hanging vertices of `field`'s shading vertices on `mesh` (the rule above), in an
+/// order where every anchor comes after the anchors of its ends. Empty on a conforming mesh.
+std::vector<HangingVertex> find_hanging_vertices(const PatchMesh& mesh, const VertexField& field);
+
+/// Sets field.values at each hanging vertex from its ends, in the given order.
+void anchor_hanging_vertices(const std::vector<HangingVertex>& hanging, VertexField& field);
+
+/// Reconstructs per-vertex values of `patch_values` (N x 3) on the shading vertices (the
+/// area-weighted mean, hanging vertices anchored, then the rescale if Conservative). When
 /// `power` is given, it receives one entry per surface (indexed by surface id).
 VertexField interpolate_to_vertices(const PatchMesh& mesh, const Eigen::MatrixX3d& patch_values,
                                     VertexInterpolation mode = VertexInterpolation::Conservative,

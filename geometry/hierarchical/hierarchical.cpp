@@ -44,37 +44,119 @@ void check_options(const HierarchicalOptions& o) {
   if (o.max_passes < 1) throw UsageError("the number of refinement passes must be >= 1");
 }
 
+/// A field given by its values at an element's corners, per channel.
+using Corners = std::array<Eigen::Vector3d, 4>;
+const Corners kNoCorners = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                            Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+
 /// The per-node state of the solution: radiosity B (area average below the node), the
 /// irradiance gathered over the node's own links, and for leaves the total irradiance.
 struct State {
-  std::vector<Eigen::Vector3d> B, gathered, H;
+  std::vector<Eigen::Vector3d> B, H;
+  std::vector<Corners> gathered;  ///< at an element's corners (clusters: uniform, [0])
   std::vector<Eigen::Vector3d> lo, hi;  ///< per channel min and max of the leaves' B below
+  std::vector<Eigen::Matrix3d> grad;    ///< elements: gradient of B (row = channel), in plane
+  /// B of node q read at offset d from its centroid (its linear fit, kept within [lo, hi]).
+  Eigen::Vector3d read(std::int32_t q, const float* d) const {
+    const Eigen::Vector3d offset(d[0], d[1], d[2]);
+    return (B[q] + grad[q] * offset).cwiseMax(lo[q]).cwiseMin(hi[q]);
+  }
   hr::SourceB source(std::int32_t q) const {
     return {B[q].maxCoeff(), (hi[q] - lo[q]).maxCoeff(), hi[q].maxCoeff()};
   }
   void resize(std::size_t n) {
     lo.resize(n, Eigen::Vector3d::Zero());
+    grad.resize(n, Eigen::Matrix3d::Zero());
     hi.resize(n, Eigen::Vector3d::Zero());
     B.resize(n, Eigen::Vector3d::Zero());
-    gathered.resize(n, Eigen::Vector3d::Zero());
+    gathered.resize(n, kNoCorners);
     H.resize(n, Eigen::Vector3d::Zero());
   }
 };
 
-/// Push-pull: irradiance down (each child receives its ancestors' gathered irradiance, a
-/// cluster's spread uniformly over its area), B = E + rho H at the leaves, area-averaged B
-/// up. Returns the largest change of a leaf's B (any channel).
-double push_pull(const Hierarchy& h, std::int32_t i, const Eigen::Vector3d& down, State& s) {
-  const Eigen::Vector3d H = down + s.gathered[i];
+/// Least-squares gradient (rows: channels) in the plane with unit normal n of values v_k at
+/// points x_k with weights w_k: the linear fit v = v̄ + g (x - x̄). Zero when the points do
+/// not span the plane.
+Eigen::Matrix3d plane_gradient(const Eigen::Vector3d& n, const Eigen::Vector3d* x,
+                               const Eigen::Vector3d* v, const double* w, int count) {
+  const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+  double sw = 0.0;
+  Eigen::Vector3d xm = Eigen::Vector3d::Zero(), vm = Eigen::Vector3d::Zero();
+  for (int k = 0; k < count; ++k) {
+    sw += w[k];
+    xm += w[k] * x[k];
+    vm += w[k] * v[k];
+  }
+  if (!(sw > 0.0)) return Eigen::Matrix3d::Zero();
+  xm /= sw;
+  vm /= sw;
+  Eigen::Matrix2d M = Eigen::Matrix2d::Zero();
+  Eigen::Matrix<double, 2, 3> R = Eigen::Matrix<double, 2, 3>::Zero();
+  for (int k = 0; k < count; ++k) {
+    const Eigen::Vector2d a(t1.dot(x[k] - xm), t2.dot(x[k] - xm));
+    M += w[k] * a * a.transpose();
+    R += w[k] * a * (v[k] - vm).transpose();
+  }
+  // Degenerate (collinear) point sets: no gradient rather than an ill-conditioned one.
+  if (!(M.determinant() > 1e-12 * M.squaredNorm())) return Eigen::Matrix3d::Zero();
+  const Eigen::Matrix<double, 2, 3> g = M.inverse() * R;  // rows: in-plane directions
+  Eigen::Matrix3d out;
+  for (int c = 0; c < 3; ++c) out.row(c) = (g(0, c) * t1 + g(1, c) * t2).transpose();
+  return out;
+}
+
+/// The corner values of child k of element i (split_element's order) interpolated from i's:
+/// edge midpoints average two corners, a quad's centre all four (exact for the linear and
+/// bilinear fields, the children being sub-triangles and parameter sub-squares).
+Corners child_corners(const Corners& c, int n, int k) {
+  auto m = [&](int a, int b) -> Eigen::Vector3d { return 0.5 * (c[a] + c[b]); };
+  if (n == 3) {
+    switch (k) {
+      case 0: return {c[0], m(0, 1), m(2, 0), Eigen::Vector3d::Zero()};
+      case 1: return {m(0, 1), c[1], m(1, 2), Eigen::Vector3d::Zero()};
+      case 2: return {m(2, 0), m(1, 2), c[2], Eigen::Vector3d::Zero()};
+      default: return {m(1, 2), m(2, 0), m(0, 1), Eigen::Vector3d::Zero()};
+    }
+  }
+  const Eigen::Vector3d centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+  switch (k) {
+    case 0: return {c[0], m(0, 1), centre, m(3, 0)};
+    case 1: return {m(0, 1), c[1], m(1, 2), centre};
+    case 2: return {centre, m(1, 2), c[2], m(2, 3)};
+    default: return {m(3, 0), centre, m(2, 3), c[3]};
+  }
+}
+
+/// Push-pull: irradiance down (a cluster spreads what it and its ancestors gathered
+/// uniformly over its area; an element adds its own gathered corner field to the inherited
+/// one and hands each child the interpolated field), B = E + rho mean(H) at the leaves,
+/// area-averaged B up. Returns the largest change of a leaf's B (any channel).
+double push_pull(const Hierarchy& h, std::int32_t i, const Corners& down, State& s) {
   const hr::Node& n = h.node(i);
+  Corners H;
+  const int corners = n.cluster ? 1 : h.geom(i).n;
+  for (int k = 0; k < 4; ++k) H[k] = n.cluster ? down[0] + s.gathered[i][0]
+                                               : down[k] + s.gathered[i][k];
   if (n.child_count == 0) {
     const Patch& face = h.faces().patches[n.face];
-    const Eigen::Vector3d b = face.emission + face.rho.cwiseProduct(H);
+    const std::array<double, 4> mu = hr::corner_masses(h.geom(i));
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int k = 0; k < corners; ++k) mean += mu[k] * H[k];
+    const Eigen::Vector3d b = face.emission + face.rho.cwiseProduct(mean);
     const double change = (b - s.B[i]).cwiseAbs().maxCoeff();
     s.B[i] = b;
+    // The spread of B over the leaf: its irradiance varies between the corner values.
     s.lo[i] = b;
     s.hi[i] = b;
-    s.H[i] = H;
+    Eigen::Vector3d bk[4];
+    for (int k = 0; k < corners; ++k) {
+      bk[k] = face.emission + face.rho.cwiseProduct(H[k]);
+      s.lo[i] = s.lo[i].cwiseMin(bk[k]);
+      s.hi[i] = s.hi[i].cwiseMax(bk[k]);
+    }
+    const ff::PatchGeom& g = h.geom(i);
+    s.grad[i] = plane_gradient(g.normal, g.p.data(), bk, mu.data(), corners);
+    s.H[i] = mean;
     return change;
   }
   double change = 0.0;
@@ -83,7 +165,9 @@ double push_pull(const Hierarchy& h, std::int32_t i, const Eigen::Vector3d& down
   Eigen::Vector3d hi = Eigen::Vector3d::Zero();
   for (int k = 0; k < n.child_count; ++k) {
     const std::int32_t c = h.child(i, k);
-    change = std::max(change, push_pull(h, c, H, s));
+    const Corners down_c = n.cluster ? Corners{H[0], H[0], H[0], H[0]}
+                                     : child_corners(H, corners, k);
+    change = std::max(change, push_pull(h, c, down_c, s));
     sum += h.node(c).area * s.B[c];
     lo = lo.cwiseMin(s.lo[c]);
     hi = hi.cwiseMax(s.hi[c]);
@@ -91,6 +175,17 @@ double push_pull(const Hierarchy& h, std::int32_t i, const Eigen::Vector3d& down
   s.lo[i] = lo;
   s.hi[i] = hi;
   s.B[i] = sum / n.area;
+  if (!n.cluster) {
+    Eigen::Vector3d x[4], v[4];
+    double w[4];
+    for (int k = 0; k < n.child_count; ++k) {
+      const std::int32_t c = h.child(i, k);
+      x[k] = h.geom(c).centroid;
+      v[k] = s.B[c];
+      w[k] = h.node(c).area;
+    }
+    s.grad[i] = plane_gradient(h.geom(i).normal, x, v, w, n.child_count);
+  }
   return change;
 }
 
@@ -109,15 +204,17 @@ struct LinkTable {
   }
 };
 
-/// gathered[p] = sum over p's links of F_pq B_q, in link order (deterministic).
+/// gathered[p] = sum over p's links of c_pq B_q (per corner), in link order (deterministic).
 void gather(const LinkTable& t, State& s, int threads) {
-  std::fill(s.gathered.begin(), s.gathered.end(), Eigen::Vector3d::Zero());
+  std::fill(s.gathered.begin(), s.gathered.end(), kNoCorners);
   const std::int64_t runs = static_cast<std::int64_t>(t.starts.size()) - 1;
   parallel_for(runs, kGatherChunk, threads, [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t r = begin; r < end; ++r) {
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      for (std::int64_t k = t.starts[r]; k < t.starts[r + 1]; ++k)
-        sum += static_cast<double>(t.links[k].F) * s.B[t.links[k].q];
+      Corners sum = kNoCorners;
+      for (std::int64_t k = t.starts[r]; k < t.starts[r + 1]; ++k) {
+        const Eigen::Vector3d b = s.read(t.links[k].q, t.links[k].d);
+        for (int c = 0; c < 4; ++c) sum[c] += static_cast<double>(t.links[k].c[c]) * b;
+      }
       s.gathered[t.links[t.starts[r]].p] = sum;
     }
   });
@@ -179,7 +276,8 @@ double memory_bytes(const Hierarchy& h, const LinkTable& t, std::size_t pending)
 }
 
 /// The leaves as a PatchMesh (vertices shared within a surface by exact position) and B.
-void export_leaves(const Hierarchy& h, const State& s, HierarchicalResult& out) {
+void export_leaves(const Hierarchy& h, const State& s, const std::vector<double>& error,
+                   HierarchicalResult& out) {
   const PatchMesh& faces = h.faces();
   PatchMesh& mesh = out.mesh;
   mesh.surface_names = faces.surface_names;
@@ -214,6 +312,7 @@ void export_leaves(const Hierarchy& h, const State& s, HierarchicalResult& out) 
   }
   mesh.patches.reserve(leaves.size());
   out.B.resize(static_cast<Eigen::Index>(leaves.size()), 3);
+  out.error_bound.resize(static_cast<Eigen::Index>(leaves.size()));
   for (std::size_t l = 0; l < leaves.size(); ++l) {
     const std::int32_t i = leaves[l];
     const ff::PatchGeom& g = h.geom(i);
@@ -233,7 +332,24 @@ void export_leaves(const Hierarchy& h, const State& s, HierarchicalResult& out) 
     }
     mesh.patches.push_back(p);
     out.B.row(static_cast<Eigen::Index>(l)) = s.B[i].transpose();
+    out.error_bound[static_cast<Eigen::Index>(l)] = face.rho.maxCoeff() * error[i];
   }
+}
+
+/// Per node, the transfer error (W/m^2, max channel) gathered over its own links and, at the
+/// leaves, over their ancestors' too (pushed down uniformly).
+std::vector<double> leaf_irradiance_error(const Hierarchy& h, const LinkTable& t,
+                                          const hr::LinkContext& ctx, const State& s) {
+  std::vector<double> e(h.nodes().size(), 0.0);
+  for (const Link& l : t.links) e[l.p] += hr::link_error(ctx, l, s.source(l.q)) / h.node(l.p).area;
+  std::vector<std::pair<std::int32_t, double>> stack{{h.root(), 0.0}};
+  while (!stack.empty()) {
+    const auto [i, down] = stack.back();
+    stack.pop_back();
+    e[i] += down;
+    for (int k = 0; k < h.node(i).child_count; ++k) stack.emplace_back(h.child(i, k), e[i]);
+  }
+  return e;
 }
 
 /// Power bookkeeping over the leaves (header of HierarchicalEnergy).
@@ -292,7 +408,7 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
 
   State s;
   s.resize(h.nodes().size());
-  push_pull(h, h.root(), Eigen::Vector3d::Zero(), s);  // B = E
+  push_pull(h, h.root(), kNoCorners, s);  // B = E
 
   LinkTable table;
   std::vector<std::pair<std::int32_t, std::int32_t>> pending;
@@ -362,7 +478,7 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
     st.converged = false;
     for (int it = 1; it <= o.max_iterations; ++it) {
       gather(table, s, threads);
-      const double change = push_pull(h, h.root(), Eigen::Vector3d::Zero(), s);
+      const double change = push_pull(h, h.root(), kNoCorners, s);
       ++st.iterations;
       max_b = 0.0;
       for (std::int32_t i = 0; i < h.size(); ++i)
@@ -386,7 +502,7 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
   st.rays = rays;
   st.memory_bytes = memory_bytes(h, table, 0);
   energy_balance(h, s, st);
-  export_leaves(h, s, result);
+  export_leaves(h, s, leaf_irradiance_error(h, table, ctx, s), result);
   st.leaves = result.mesh.size();
   return result;
 }

@@ -83,6 +83,11 @@ struct HierarchicalStats {
 struct HierarchicalResult {
   PatchMesh mesh;
   Eigen::MatrixX3d B;  ///< leaves x 3
+  /// Per leaf: the oracle's bound on |B - B_exact| from the transfers of the final links
+  /// (max over channels): rho x (sum over the links at the leaf and its ancestors of each
+  /// link's power error / its receiver's area). One bounce: interreflection can amplify it
+  /// by up to 1 / (1 - rho_max).
+  Eigen::VectorXd error_bound;
   HierarchicalStats stats;
 };
 

@@ -40,6 +40,29 @@ Eigen::Vector3d mid(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return
 
 }  // namespace
 
+std::array<double, 4> corner_masses(const ff::PatchGeom& g) {
+  if (g.n == 3) return {1.0 / 3, 1.0 / 3, 1.0 / 3, 0.0};
+  std::array<double, 4> mu{0, 0, 0, 0};
+  const ff::GaussRule rule = ff::gauss_legendre(2);
+  double total = 0.0;
+  for (int a = 0; a < rule.n; ++a)
+    for (int b = 0; b < rule.n; ++b) {
+      double jacobian = 0.0;
+      ff::quadrature_point(g, rule.x[a], rule.x[b], jacobian);
+      const auto w = corner_weights(g, rule.x[a], rule.x[b]);
+      const double dw = rule.w[a] * rule.w[b] * jacobian;
+      for (int k = 0; k < 4; ++k) mu[k] += dw * w[k];
+      total += dw;
+    }
+  for (double& m : mu) m /= total;
+  return mu;
+}
+
+std::array<double, 4> corner_weights(const ff::PatchGeom& g, double u, double v) {
+  if (g.n == 3) return {1.0 - u, u * (1.0 - v), u * v, 0.0};
+  return {(1 - u) * (1 - v), u * (1 - v), u * v, (1 - u) * v};
+}
+
 double box_distance_squared(const Eigen::AlignedBox3d& a, const Eigen::AlignedBox3d& b) {
   double d2 = 0.0;
   for (int k = 0; k < 3; ++k) {

@@ -82,6 +82,15 @@ class Hierarchy {
   std::int64_t clusters_ = 0;
 };
 
+/// Corner weights mu_k (sum 1) of the mean over element g of the field interpolated from
+/// corner values (linear on triangles: 1/3 each; bilinear on quads: the integral of each
+/// bilinear hat times the Jacobian over the area, exact with the 2 x 2 Gauss rule).
+std::array<double, 4> corner_masses(const ff::PatchGeom& g);
+
+/// Interpolation weights of the corners at parameter (u, v) of ff::quadrature_point
+/// (triangles: the collapsed map, (1-u, u(1-v), uv); quads: bilinear).
+std::array<double, 4> corner_weights(const ff::PatchGeom& g, double u, double v);
+
 /// Squared distance between two boxes (0 when they overlap or touch).
 double box_distance_squared(const Eigen::AlignedBox3d& a, const Eigen::AlignedBox3d& b);
 

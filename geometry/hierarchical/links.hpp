@@ -9,15 +9,19 @@
 // area average where q's leaves differ by ΔB_q (max - min, max over channels); for a cluster
 // at either end err_pq max B_q (the bound times the brightest leaf below q).
 //
-// Element - element (both planar polygons): F_pq = sum_k w_k F(x_k -> q) vis_k over the
-// 2 x 2 Gauss points x_k of p (weights w_k = Gauss weight x Jacobian / A_p), F(x -> q) the
-// exact contour formula and vis_k the visible fraction from link_rays / 4 kernel-sampled
-// rays (the hybrid estimator's kernel, visibility.hpp). Error per unit B_q:
-//   err = A_p (ΔF vis + F partial),  ΔF = max - min of F(x -> q) over p's corners, centroid
-//   and Gauss points, vis the mean visible fraction, partial = 1 when some rays were blocked
-//   and others not (the shadow boundary crosses the link), F the unoccluded mean.
-// A pair that cannot exchange (each behind the other's plane, can_exchange) is dropped, and
-// so is a fully occluded pair (every ray blocked: err = 0, F = 0).
+// Element - element (both planar polygons): F_pq = F0 vis, F0 the unoccluded mean factor
+// (1/A_p) ∫_p F(x -> q) dA, F(x -> q) the exact contour formula, integrated by the 2 x 2
+// Gauss rule over p when q is farther than p's diameter, else by the adaptive quadrature of
+// quadrature.hpp; vis the visible fraction at p's Gauss points (weighted by w F(x -> q))
+// from link_rays / 4 kernel-sampled rays each (the hybrid estimator's kernel,
+// visibility.hpp). The factor varies over p: the link carries it at p's corners
+// (c_k = F(corner_k -> q), scaled to mean F), so a receiver gathers a linear (bilinear)
+// irradiance, not a constant, and pushes it to its children by interpolation. Error per
+// unit B_q:
+//   err = A_p (dev vis + F0 u),  dev = max |F(x -> q) - interpolant(x)| over p's corners,
+//   Gauss points and centre, u = 1 where rays disagree (a shadow boundary crosses the link),
+//   else 1 / (rays + 1) (the chance-level uncertainty of a fraction all rays agree on).
+// A pair that cannot exchange (each behind the other's plane, can_exchange) is dropped.
 //
 // With a cluster at either end: the transfer T = A_p F_pq = (1/π) ∫_p ∫_q cos+ cos+ V / r^2
 // is bounded by T_max = min(A_p A_q / (π d^2), A_p, A_q), d the distance between the two
@@ -42,12 +46,20 @@
 
 namespace lambert::hr {
 
-/// One link p <- q (16 bytes).
+/// One link p <- q (44 bytes).
 struct Link {
   std::int32_t p = 0;  ///< receiver node
   std::int32_t q = 0;  ///< source node
-  float F = 0.0f;      ///< H_p += F B_q
+  float F = 0.0f;      ///< mean factor: H_p += F B_q on average over p
   float err = 0.0f;    ///< power error bound per unit source radiosity (scene units^2)
+  /// The factor at p's corners (an element receiver; all F for a cluster): the irradiance
+  /// the link delivers is interpolated from corner values c_k B_q (linear on triangles,
+  /// bilinear on quads) with mean F (sum_k mu_k c_k = F, corner_masses).
+  float c[4] = {0, 0, 0, 0};
+  /// Where the link reads q's radiosity: the kernel centroid on q minus q's centroid (scene
+  /// units; 0 for cluster links). The transfer uses B_q + grad B_q · d, q's linear fit,
+  /// which removes the first-order error of transferring q's average.
+  float d[3] = {0, 0, 0};
 };
 
 /// What to do with a link.
@@ -78,6 +90,10 @@ bool splittable(const LinkContext& ctx, std::int32_t i);
 /// (Accept), or how to split it. Adds the rays it traced.
 Action evaluate_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, const SourceB& b_q,
                      Link& link, std::int64_t& rays);
+
+/// The power error (W) of an evaluated link's transfer with source radiosity b_q, the
+/// quantity the oracle compares with the threshold.
+double link_error(const LinkContext& ctx, const Link& link, const SourceB& b_q);
 
 /// The verdict on an evaluated link against a new source radiosity b_q: Accept, or which end
 /// to split (split_choice).

@@ -1,11 +1,22 @@
 // Hierarchical radiosity (geometry/hierarchical/) against closed forms and conservation laws.
+//
+// Tolerances. solve_hierarchical reports per leaf the oracle's bound on the error of B from
+// its links (error_bound: rho x the summed power errors of the links above the leaf per unit
+// area, one bounce). A receiver that only sees a non-reflecting emitter gets one bounce, so
+// its area-weighted mean of error_bound bounds its mean error; in a closed box the error is
+// amplified by interreflection by at most 1 / (1 - rho). The Jacobi sweeps stop at a
+// relative change of tol = 1e-12 (of the largest B), far below both.
 #include <gtest/gtest.h>
 
+#include "core/error.hpp"
 #include "geometry/analytic.hpp"
 #include "geometry/hierarchical/hierarchical.hpp"
+#include "geometry/vertex_field.hpp"
 
 namespace lambert {
 namespace {
+
+using V = Eigen::Vector3d;
 
 Material mat(const std::string& name, double rho, double e) {
   Material m;
@@ -15,75 +26,202 @@ Material mat(const std::string& name, double rho, double e) {
   return m;
 }
 
-// Area-weighted mean of channel 0 of B over surface `s`.
-double surface_mean(const HierarchicalResult& r, int s) {
-  double sum = 0, area = 0;
-  for (std::int32_t i = 0; i < r.mesh.size(); ++i)
-    if (r.mesh.patches[i].surface == s) {
-      sum += r.mesh.patches[i].area * r.B(i, 0);
-      area += r.mesh.patches[i].area;
-    }
-  return sum / area;
+HierarchicalOptions options(double epsilon) {
+  HierarchicalOptions o;
+  o.epsilon = epsilon;
+  o.tol = 1e-12;
+  return o;
 }
 
-// Emitter a x b at z = 0 facing up, receiver at z = c facing down (rho = 1/2, so its mean
-// radiosity is F_receiver->emitter / 2 for E = 1).
-Scene parallel_plates(double a, double b, double c) {
-  Scene s;
-  add_polygon(s, "emitter", mat("e", 0.0, 1.0),
-              {{0, 0, 0}, {a, 0, 0}, {a, b, 0}, {0, b, 0}});
-  add_polygon(s, "receiver", mat("r", 0.5, 0.0),
-              {{0, 0, c}, {0, b, c}, {a, b, c}, {a, 0, c}});
-  return s;
+// Area-weighted means over surface `s` of channel 0 of B and of the error bound.
+struct Mean {
+  double B = 0, bound = 0, area = 0;
+};
+Mean surface_mean(const HierarchicalResult& r, int s) {
+  Mean m;
+  for (std::int32_t i = 0; i < r.mesh.size(); ++i)
+    if (r.mesh.patches[i].surface == s) {
+      const double a = r.mesh.patches[i].area;
+      m.B += a * r.B(i, 0);
+      m.bound += a * r.error_bound[i];
+      m.area += a;
+    }
+  m.B /= m.area;
+  m.bound /= m.area;
+  return m;
+}
+
+// A rectangle [x0, x1] x [y0, y1] in the plane z, facing +z (up) or -z.
+std::vector<V> rect(double x0, double x1, double y0, double y1, double z, bool up) {
+  if (up) return {V(x0, y0, z), V(x1, y0, z), V(x1, y1, z), V(x0, y1, z)};
+  return {V(x0, y0, z), V(x0, y1, z), V(x1, y1, z), V(x1, y0, z)};
+}
+
+// Emitter (E = 1, rho = 0) and a receiver with rho = 1/2: the receiver's mean B is half its
+// mean factor to the emitter, G / (2 A_receiver).
+void expect_receiver(const Scene& s, double G, double epsilon, bool informative = true) {
+  const HierarchicalResult r = solve_hierarchical(s, options(epsilon));
+  const Mean m = surface_mean(r, 1);
+  const double exact = 0.5 * G / m.area;
+  EXPECT_NEAR(m.B, exact, m.bound + 1e-12 * exact)
+      << "leaves " << r.stats.leaves << " links " << r.stats.links;
+  // The bound must stay informative: it is dominated by the visibility term F / (rays + 1)
+  // of every link (1/17 of the transfer at 16 rays), so it sits near 6 % of the value.
+  if (informative) {
+    EXPECT_LT(m.bound, 0.25 * exact);
+  }
 }
 
 TEST(Hierarchical, ParallelSquaresMatchClosedForm) {
-  const Scene s = parallel_plates(1, 1, 1);
-  HierarchicalOptions o;
-  o.epsilon = 1e-4;
-  const HierarchicalResult r = solve_hierarchical(s, o);
-  const double exact = 0.5 * parallel_rectangles_factor(1, 1, 1);
-  EXPECT_NEAR(surface_mean(r, 1), exact, 1e-3);
+  Scene s;
+  add_polygon(s, "emitter", mat("e", 0, 1), rect(0, 1, 0, 1, 0, true));
+  add_polygon(s, "receiver", mat("r", 0.5, 0), rect(0, 1, 0, 1, 1, false));
+  expect_receiver(s, parallel_rectangles_factor(1, 1, 1), 1e-4);
 }
 
-}  // namespace
-}  // namespace lambert
-namespace lambert {
-namespace {
-// Unit cube, faces wound to face inward.
-Scene closed_cube(double rho, double e) {
+TEST(Hierarchical, SmallOffsetReceiverCloseAboveALargeEmitter) {
+  // 1:100 areas, the receiver 0.1 above the emitter near its corner: the factor varies
+  // strongly over the emitter, which the receiver sees almost entirely.
   Scene s;
-  const Material m = mat("wall", rho, e);
-  using V = Eigen::Vector3d;
-  add_polygon(s, "bottom", m, {V(0, 0, 0), V(1, 0, 0), V(1, 1, 0), V(0, 1, 0)});
-  add_polygon(s, "top", m, {V(0, 0, 1), V(0, 1, 1), V(1, 1, 1), V(1, 0, 1)});
-  add_polygon(s, "front", m, {V(0, 0, 0), V(0, 0, 1), V(1, 0, 1), V(1, 0, 0)});
-  add_polygon(s, "back", m, {V(0, 1, 0), V(1, 1, 0), V(1, 1, 1), V(0, 1, 1)});
-  add_polygon(s, "left", m, {V(0, 0, 0), V(0, 1, 0), V(0, 1, 1), V(0, 0, 1)});
-  add_polygon(s, "right", m, {V(1, 0, 0), V(1, 0, 1), V(1, 1, 1), V(1, 1, 0)});
+  add_polygon(s, "emitter", mat("e", 0, 1), rect(0, 1, 0, 1, 0, true));
+  add_polygon(s, "receiver", mat("r", 0.5, 0), rect(0.8, 0.9, 0.05, 0.15, 0.1, false));
+  expect_receiver(s, parallel_rectangles_G(0.8, 0.9, 0.05, 0.15, 0, 1, 0, 1, 0.1), 1e-5);
+}
+
+TEST(Hierarchical, ThinPerpendicularReceiverTouchingTheEmitter) {
+  // A 1 x 0.05 strip standing on the edge of a 1 x 1 emitter (shared edge, 1:20 areas).
+  Scene s;
+  add_polygon(s, "emitter", mat("e", 0, 1), rect(0, 1, 0, 1, 0, true));
+  add_polygon(s, "receiver", mat("r", 0.5, 0),
+              {V(0, 0, 0), V(0, 1, 0), V(0, 1, 0.05), V(0, 0, 0.05)});
+  // G = A_emitter F(emitter -> strip), Howell C-14 with common edge 1, widths 1 and 0.05.
+  // All of the strip lies within 20 leaf sizes of the shared edge, where the 2 x 2 Gauss
+  // rule errs low (F has a logarithmic edge singularity): -2.5 % here, each link within the
+  // threshold but one-signed. The bound (the sum over the strip's ~1500 links) holds and is
+  // loose, so it is not required to be informative.
+  expect_receiver(s, perpendicular_rectangles_factor(1, 1, 0.05), 1e-5, false);
+}
+
+// The inside of the unit cube, every face its own surface with material m(face).
+Scene cube(const std::function<Material(int)>& m) {
+  const std::vector<std::vector<V>> faces = {
+      {V(0, 0, 0), V(1, 0, 0), V(1, 1, 0), V(0, 1, 0)},   // bottom (faces +z)
+      {V(0, 0, 1), V(0, 1, 1), V(1, 1, 1), V(1, 0, 1)},   // top
+      {V(0, 0, 0), V(0, 0, 1), V(1, 0, 1), V(1, 0, 0)},   // y = 0
+      {V(0, 1, 0), V(1, 1, 0), V(1, 1, 1), V(0, 1, 1)},   // y = 1
+      {V(0, 0, 0), V(0, 1, 0), V(0, 1, 1), V(0, 0, 1)},   // x = 0
+      {V(1, 0, 0), V(1, 0, 1), V(1, 1, 1), V(1, 1, 0)}};  // x = 1
+  Scene s;
+  for (int f = 0; f < 6; ++f) add_polygon(s, "face" + std::to_string(f), m(f), faces[f]);
   return s;
 }
+
+TEST(Hierarchical, UnitCubeOppositeAndAdjacentFactors) {
+  // Bottom emits; only the receiver under test reflects (so it gets exactly one bounce).
+  for (const auto& [receiver, F] : {std::pair{1, kCubeOpposite}, std::pair{2, kCubeAdjacent}}) {
+    const Scene s = cube([&](int f) {
+      return f == 0 ? mat("e", 0, 1) : mat("m" + std::to_string(f), f == receiver ? 0.5 : 0, 0);
+    });
+    const HierarchicalResult r = solve_hierarchical(s, options(1e-4));
+    const Mean m = surface_mean(r, receiver);
+    EXPECT_NEAR(m.B, 0.5 * F, m.bound + 1e-12) << "receiver face " << receiver;
+    EXPECT_LT(m.bound, 0.25 * 0.5 * F);  // see expect_receiver
+  }
+}
+
+TEST(Hierarchical, FurnaceGivesEOverOneMinusRho) {
+  // Closed cube, uniform rho = 0.5 and E = 1: B = E / (1 - rho) = 2 everywhere. The mean
+  // over the box errs by at most the mean one-bounce bound amplified by 1 / (1 - rho).
+  const Scene s = cube([](int) { return mat("wall", 0.5, 1.0); });
+  for (double epsilon : {1e-3, 1e-4}) {
+    const HierarchicalResult r = solve_hierarchical(s, options(epsilon));
+    double sum = 0, bound = 0, area = 0;
+    for (std::int32_t i = 0; i < r.mesh.size(); ++i) {
+      const double a = r.mesh.patches[i].area;
+      sum += a * r.B(i, 0);
+      bound += a * r.error_bound[i];
+      area += a;
+    }
+    EXPECT_NEAR(sum / area, 2.0, bound / area / (1 - 0.5)) << "epsilon " << epsilon;
+    // Energy: a closed box lets nothing escape but what its links miss (the same bound, in
+    // power: escaped = sent - received over links, each link's power error counted once).
+    EXPECT_NEAR(r.stats.energy[0].escaped, 0.0, bound / (1 - 0.5));
+    EXPECT_LT(r.stats.energy[0].relative_imbalance, 1e-9);
+  }
+}
+
 TEST(Hierarchical, BitwiseIdenticalForAnyThreadCount) {
-  HierarchicalOptions o;
-  o.epsilon = 1e-3;
+  // An occluded scene (a blocker between two plates) so rays decide links.
+  Scene s;
+  add_polygon(s, "emitter", mat("e", 0, 1), rect(0, 1, 0, 1, 0, true));
+  add_polygon(s, "receiver", mat("r", 0.5, 0), rect(0, 1, 0, 1, 1, false));
+  add_polygon(s, "blocker", mat("b", 0.3, 0), rect(0.2, 0.6, 0.3, 0.7, 0.5, true));
+  HierarchicalOptions o = options(1e-4);
   o.threads = 1;
-  const HierarchicalResult a = solve_hierarchical(closed_cube(0.5, 1.0), o);
+  const HierarchicalResult a = solve_hierarchical(s, o);
   o.threads = 2;
-  const HierarchicalResult b = solve_hierarchical(closed_cube(0.5, 1.0), o);
+  const HierarchicalResult b = solve_hierarchical(s, o);
   ASSERT_EQ(a.B.rows(), b.B.rows());
   EXPECT_EQ(a.stats.links, b.stats.links);
   EXPECT_EQ(a.stats.rays, b.stats.rays);
+  EXPECT_GT(a.stats.rays, 0);
   for (Eigen::Index i = 0; i < a.B.rows(); ++i)
     for (int c = 0; c < 3; ++c) ASSERT_EQ(a.B(i, c), b.B(i, c)) << "leaf " << i;
 }
 
-TEST(Hierarchical, FurnaceExplore) {
-  for (double eps : {1e-2, 1e-3, 1e-4}) {
-    HierarchicalOptions o;
-    o.epsilon = eps;
-    const HierarchicalResult r = solve_hierarchical(closed_cube(0.5, 1.0), o);
-    printf("eps %g mean %.6f leaves %lld links %lld esc %g/%g\n", eps, surface_mean(r, 0), (long long)r.stats.leaves, (long long)r.stats.links, r.stats.energy[0].escaped, r.stats.energy[0].emitted);
+TEST(Hierarchical, LeavesTileTheScene) {
+  // Leaves cover every face exactly (areas add up) and carry their face's material.
+  const Scene s =
+      cube([](int f) { return mat("m" + std::to_string(f), 0.1 * f, f == 0 ? 1.0 : 0.0); });
+  const HierarchicalResult r = solve_hierarchical(s, options(1e-4));
+  double area = 0;
+  for (const Patch& p : r.mesh.patches) {
+    area += p.area;
+    EXPECT_DOUBLE_EQ(p.rho[0], 0.1 * p.surface);
   }
+  // Areas of 4^k sub-elements of unit squares are exact in binary.
+  EXPECT_EQ(area, 6.0);
+  EXPECT_GT(r.stats.leaves, 6);
 }
+
+TEST(Hierarchical, HangingVerticesOfTheLeafMeshAreFoundAndAnchored) {
+  // Adaptive refinement leaves T-vertices; the vertex field anchors them (no cracks).
+  Scene s;
+  add_polygon(s, "emitter", mat("e", 0, 1), rect(0, 1, 0, 1, 0, true));
+  add_polygon(s, "receiver", mat("r", 0.5, 0), rect(0.8, 0.9, 0.05, 0.15, 0.1, false));
+  const HierarchicalResult r = solve_hierarchical(s, options(1e-4));
+  const VertexField field = build_shading_vertices(r.mesh);
+  EXPECT_FALSE(find_hanging_vertices(r.mesh, field).empty());
+}
+
+TEST(Hierarchical, NoEmitterGivesZero) {
+  const Scene s = cube([](int) { return mat("wall", 0.5, 0.0); });
+  const HierarchicalResult r = solve_hierarchical(s, options(1e-4));
+  EXPECT_TRUE(r.stats.converged);
+  EXPECT_EQ(r.B.cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(Hierarchical, RefusesBadOptions) {
+  const Scene s = cube([](int) { return mat("wall", 0.5, 1.0); });
+  for (double e : {0.0, -1.0, 1.0, std::nan("")}) {
+    HierarchicalOptions o;
+    o.epsilon = e;
+    EXPECT_THROW(solve_hierarchical(s, o), UsageError) << e;
+  }
+  HierarchicalOptions o;
+  o.link_rays = 0;
+  EXPECT_THROW(solve_hierarchical(s, o), UsageError);
+  o = HierarchicalOptions{};
+  o.min_area = -1;
+  EXPECT_THROW(solve_hierarchical(s, o), UsageError);
+}
+
+TEST(Hierarchical, MemoryLimitIsAnError) {
+  const Scene s = cube([](int) { return mat("wall", 0.5, 1.0); });
+  HierarchicalOptions o = options(1e-6);
+  o.memory_limit = 64 * 1024;
+  EXPECT_THROW(solve_hierarchical(s, o), Error);
+}
+
 }  // namespace
 }  // namespace lambert

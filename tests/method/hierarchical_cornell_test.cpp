@@ -59,12 +59,25 @@ TEST(HierarchicalCornell, DISABLED_MatrixTrend) {
   }
 }
 
-TEST(HierarchicalCornell, DISABLED_Explore) {
+TEST(HierarchicalCornell, Explore) {
   Scene scene = load_obj(builtin_cornell_box_path());
   if (std::getenv("NO_BLOCKS")) {
     std::vector<Face> keep;
     for (auto& f : scene.faces) if (scene.surfaces[f.surface].name.find("block") == std::string::npos) keep.push_back(f);
     scene.faces = keep;
+  }
+  if (const char* recv = std::getenv("PAIR")) {  // PAIR=emitter,receiver
+    const std::string spec = recv;
+    const std::string em = spec.substr(0, spec.find(',')), rc = spec.substr(spec.find(',') + 1);
+    for (auto& f : scene.faces) f.rho.reset();
+    for (auto& s : scene.surfaces) {
+      Material mat;
+      mat.name = s.name;
+      if (s.name == em) mat.emission.setConstant(em == "light" ? 17.0 : 1.0);
+      if (rc.find(s.name) != std::string::npos) mat.rho.setConstant(0.5);
+      scene.materials.push_back(mat);
+      s.material = scene.materials.size() - 1;
+    }
   }
   if (std::getenv("DIRECT_ONLY")) {
     for (auto& f : scene.faces) f.rho.reset();
@@ -72,7 +85,7 @@ TEST(HierarchicalCornell, DISABLED_Explore) {
     for (auto& s : scene.surfaces) if (s.name == "floor") { Material mat = scene.materials[s.material]; mat.rho = Eigen::Vector3d(0.5,0.5,0.5); mat.name="x"; scene.materials.push_back(mat); s.material = scene.materials.size()-1; }
   }
   const auto ref = matrix_means(scene, 2000);
-  for (double eps : {1e-3, 1e-4, 1e-5}) {
+  for (double eps : {std::getenv("EPS") ? std::atof(std::getenv("EPS")) : 1e-3, 1e-4, 1e-5}) {
     HierarchicalOptions o;
     o.epsilon = eps;
     const HierarchicalResult r = solve_hierarchical(scene, o);
