@@ -30,7 +30,11 @@
 // run with the nearest leaf count. Last, per surface, the signed difference of the finest run
 // of each method.
 //
-// Usage: hierarchical_bench [--sections family,cornell] [--sizes 1000,10000,100000,1000000]
+// Furnace: the closed unit cube, E = 1 and rho = 1/2 on every face (B = 2 exactly), at
+// --epsilons: the escaped share of the emitted power (0 for exact factors) and the worst
+// per-surface |B - 2| / 2.
+//
+// Usage: hierarchical_bench [--sections family,cornell,furnace] [--sizes 1000,10000,100000,1000000]
 //   [--epsilon E] [--link-rays K] [--family-matrix-patches N] [--family-rays K]
 //   [--epsilons 1e-2,1e-3,1e-4,1e-5] [--patches 100,300,1000,3000] [--ref-patches N]
 //   [--samples S] [--seed S] [-j N]
@@ -55,6 +59,7 @@
 #include "core/log.hpp"
 #include "core/parallel.hpp"
 #include "core/timer.hpp"
+#include "geometry/analytic.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/hierarchical/hierarchical.hpp"
 #include "io/obj_loader.hpp"
@@ -68,7 +73,7 @@ namespace {
 constexpr double kTargetError = 0.015;
 
 struct Settings {
-  std::vector<std::string> sections = {"family", "cornell"};
+  std::vector<std::string> sections = {"family", "cornell", "furnace"};
   std::vector<double> sizes = {1000, 10000, 100000, 1000000};  // ~2 min in all
   double epsilon = HierarchicalOptions{}.epsilon;
   int link_rays = HierarchicalOptions{}.link_rays;
@@ -470,6 +475,35 @@ void run_cornell(const Settings& s) {
   std::printf("\n");
 }
 
+// ---- furnace ----
+
+// The inside of the unit cube, every face emitting E = 1 with rho = 1/2: closed, so nothing
+// may escape, and B = E / (1 - rho) = 2 exactly on every surface. What escapes is transfer
+// the links' factors miss (their row sums fall short of 1).
+void run_furnace(const Settings& s) {
+  Scene cube = unit_cube();
+  for (Material& m : cube.materials) {
+    m.rho = Eigen::Vector3d::Constant(0.5);
+    m.emission = Eigen::Vector3d::Constant(1.0);
+  }
+  std::printf("== furnace: closed unit cube, E = 1, rho = 0.5 everywhere (B = 2 exactly) ==\n");
+  std::printf("  %-14s %9s %8s %9s %12s %14s\n", "setting", "seconds", "leaves", "links", "escaped",
+              "worst |B-2|/2");
+  for (const double eps : s.epsilons) {
+    Timer t;
+    const HierarchicalResult h = solve_hierarchical(cube, hierarchical_options(s, eps));
+    const double seconds = t.seconds();
+    double worst = 0.0;
+    for (const SurfaceRadiosity& a : surface_averages(h.mesh, h.B))
+      worst = std::max(worst, (a.average.array() / 2.0 - 1.0).abs().maxCoeff());
+    const HierarchicalEnergy& e = h.stats.energy[1];
+    std::printf("  epsilon %-6.0e %9.3f %8lld %9.3g %11.3e%% %14.3e\n", eps, seconds,
+                static_cast<long long>(h.stats.leaves), static_cast<double>(h.stats.links),
+                100 * e.escaped / e.emitted, worst);
+  }
+  std::printf("\n");
+}
+
 // ---- command line ----
 
 std::vector<std::string> split(const char* text) {
@@ -522,7 +556,7 @@ bool parse(int argc, char** argv, Settings& s) {
       return false;
   }
   for (const std::string& sec : s.sections)
-    if (sec != "family" && sec != "cornell") return false;
+    if (sec != "family" && sec != "cornell" && sec != "furnace") return false;
   return true;
 }
 
@@ -533,7 +567,7 @@ int main(int argc, char** argv) {
   Settings s;
   if (!parse(argc, argv, s)) {
     std::fprintf(stderr,
-                 "usage: hierarchical_bench [--sections family,cornell] [--sizes N,N,...] "
+                 "usage: hierarchical_bench [--sections family,cornell,furnace] [--sizes N,N,...] "
                  "[--epsilon E] [--link-rays K] [--family-matrix-patches N] [--family-rays K] "
                  "[--epsilons E,E,...] [--patches N,N,...] [--ref-patches N] [--samples S] "
                  "[--seed S] [-j N]\n");
@@ -545,6 +579,7 @@ int main(int argc, char** argv) {
     for (const std::string& sec : s.sections) {
       if (sec == "family") run_family(s);
       if (sec == "cornell") run_cornell(s);
+      if (sec == "furnace") run_furnace(s);
     }
   } catch (const Error& e) {
     std::fprintf(stderr, "hierarchical_bench: %s\n", e.what());
