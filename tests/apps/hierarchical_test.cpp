@@ -161,10 +161,10 @@ TEST(HierarchicalSolve, SurfaceAveragesAgreeWithTheMatrixMethodWithinBothErrors)
     EXPECT_EQ(code, kExitOk) << name;
     return averages(read_json(dir.file(name + ".json")).at("surfaces"));
   };
-  const auto m1 = solve({"--patches", "150", "--samples", "4"}, "m1");
-  const auto m4 = solve({"--patches", "600", "--samples", "4"}, "m4");
-  const auto h1 = solve({"--method", "hierarchical", "--epsilon", "1e-2"}, "h1");
-  const auto h4 = solve({"--method", "hierarchical", "--epsilon", "2.5e-3"}, "h4");
+  const auto m1 = solve({"--patches", "500", "--samples", "4"}, "m1");
+  const auto m4 = solve({"--patches", "2000", "--samples", "4"}, "m4");
+  const auto h1 = solve({"--method", "hierarchical", "--epsilon", "1e-4"}, "h1");
+  const auto h4 = solve({"--method", "hierarchical", "--epsilon", "2.5e-5"}, "h4");
   ASSERT_EQ(m1.size(), 8u);
   for (const auto& [name, m] : m4) {
     ASSERT_TRUE(h1.count(name) && h4.count(name) && m1.count(name)) << name;
