@@ -122,6 +122,13 @@ TEST(HierarchicalRun, CornellBoxWritesEveryFileWithABalancedReport) {
   EXPECT_GE(leaves, h.at("faces").get<std::int64_t>());
   EXPECT_GT(h.at("links").get<std::int64_t>(), 0);
   EXPECT_GT(h.at("rays").get<std::int64_t>(), 0);
+  // Per-surface one-bounce error bounds: one per surface, finite, positive where the surface
+  // receives light through links (every surface of the box does).
+  ASSERT_EQ(h.at("surface_error_bounds").size(), 8u);
+  for (const auto& b : h.at("surface_error_bounds")) {
+    const double v = b.at("error_bound").get<double>();
+    EXPECT_TRUE(std::isfinite(v) && v > 0.0) << b.at("name");
+  }
   EXPECT_EQ(report.at("rays_total").get<std::int64_t>(),
             h.at("rays").get<std::int64_t>() + report.at("render").at("rays").get<std::int64_t>());
   expect_balanced(report.at("energy_balance"), leaves);
