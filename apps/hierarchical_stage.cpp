@@ -28,6 +28,7 @@ HierarchicalRun solve_scene_hierarchical(Scene scene, const HierarchicalOptions&
   run.loaded.mesh = std::move(result.mesh);
   run.loaded.max_edge = 0.0;
   run.B = std::move(result.B);
+  run.error_bound = std::move(result.error_bound);
   run.stats = result.stats;
   run.options = options;
   const HierarchicalStats& st = run.stats;
@@ -52,6 +53,16 @@ SolveStatus hierarchical_status(const HierarchicalStats& stats) {
 Json hierarchical_json(const HierarchicalRun& run) {
   const HierarchicalOptions& o = run.options;
   const HierarchicalStats& st = run.stats;
+  const PatchMesh& mesh = run.loaded.mesh;
+  std::vector<double> bound(mesh.surface_names.size(), 0.0), area(bound.size(), 0.0);
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    bound[mesh.patches[i].surface] += mesh.patches[i].area * run.error_bound[i];
+    area[mesh.patches[i].surface] += mesh.patches[i].area;
+  }
+  Json bounds = Json::array();
+  for (std::size_t s = 0; s < bound.size(); ++s)
+    bounds.push_back({{"name", mesh.surface_names[s]},
+                      {"error_bound", area[s] > 0 ? bound[s] / area[s] : 0.0}});
   return {{"status", to_string(hierarchical_status(st))},
           {"options",
            {{"epsilon", o.epsilon},
@@ -79,7 +90,8 @@ Json hierarchical_json(const HierarchicalRun& run) {
            {{"build", st.build_seconds},
             {"refine", st.refine_seconds},
             {"solve", st.solve_seconds},
-            {"total", run.seconds}}}};
+            {"total", run.seconds}}},
+          {"surface_error_bounds", bounds}};
 }
 
 Json hierarchical_energy_json(const HierarchicalEnergy& e) {

@@ -19,6 +19,7 @@ namespace lambert {
 struct HierarchicalRun {
   LoadedScene loaded;  ///< the scene and the leaf mesh (max_edge 0: the mesh is adaptive)
   Eigen::MatrixX3d B;  ///< leaves x 3
+  Eigen::VectorXd error_bound;  ///< per leaf (HierarchicalResult::error_bound)
   HierarchicalStats stats;
   HierarchicalOptions options;  ///< as used (min_area as requested; stats.min_area as used)
   double seconds = 0.0;         ///< wall time of solve_hierarchical
@@ -34,7 +35,8 @@ SolveStatus hierarchical_status(const HierarchicalStats& stats);
 /// {status, options {epsilon, min_area (requested; 0 = auto), link_rays, tol, max_iterations,
 /// max_passes, seed, memory_limit}, faces, elements, clusters, leaves, links, cluster_links,
 /// rays, passes, iterations, converged, change, memory_bytes, min_area (used), seconds
-/// {build, refine, solve, total}}.
+/// {build, refine, solve, total}, surface_error_bounds [{name, error_bound}]: per surface the
+/// area-weighted mean of the leaves' one-bounce error bounds (W/m^2, brightest channel)}.
 Json hierarchical_json(const HierarchicalRun& run);
 
 /// One channel's power bookkeeping in energy_json's keys that apply: {emitted, absorbed,

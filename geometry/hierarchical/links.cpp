@@ -169,8 +169,38 @@ Action element_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, cons
     centroid += points[k].weight * ends / per_point;
     centroid_weight += points[k].weight;
   }
+  // The corners' visible fractions shape the irradiance the link spreads over p (so light
+  // is not pushed into the parts of p that a blocker hides, where it would be absorbed
+  // unseen: the floor under a block); they count towards partial visibility too.
+  double corner_vis[4] = {1, 1, 1, 1};
+  for (int k = 0; k < gp.n; ++k) {
+    if (!(corner_f[k] > 0.0)) continue;
+    const ff::KernelSampler sampler(gp.p[k], gp.normal, gq);
+    if (sampler.empty()) continue;
+    const std::uint64_t stream = hash_keys(ctx.seed, link_key(p, q), 4 + k);
+    const Kronecker4 seq(stream);
+    Rng rng(mix64(stream));
+    int seen = 0;
+    for (int r = 0; r < per_point; ++r) {
+      bool gave_up = false;
+      const Eigen::Vector3d y = sampler.sample(seq.get(r, 0), seq.get(r, 1), seq.get(r, 2), rng, gave_up);
+      exhausted += gave_up;
+      seen += ff::visible(ctx.bvh, gp.p[k], gp.normal, y, gq.normal, ctx.offset);
+    }
+    traced += per_point;
+    partial |= seen > 0 && seen < per_point;
+    points_seen += seen > 0;
+    points_blocked += seen < per_point;
+    corner_vis[k] = static_cast<double>(seen) / per_point;
+  }
   rays += traced;
   partial |= points_seen > 0 && points_blocked > 0;
+  {
+    double mean = 0.0;
+    for (int k = 0; k < gp.n; ++k) mean += mu[k] * corner_f[k] * corner_vis[k];
+    if (mean > 0.0)
+      for (int k = 0; k < 4; ++k) shape[k] = corner_f[k] * corner_vis[k] / mean;
+  }
   const double vis = weight > 0.0 ? seen_weight / weight : 0.0;
   link.p = p;
   link.q = q;

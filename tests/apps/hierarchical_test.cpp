@@ -122,6 +122,13 @@ TEST(HierarchicalRun, CornellBoxWritesEveryFileWithABalancedReport) {
   EXPECT_GE(leaves, h.at("faces").get<std::int64_t>());
   EXPECT_GT(h.at("links").get<std::int64_t>(), 0);
   EXPECT_GT(h.at("rays").get<std::int64_t>(), 0);
+  // Per-surface one-bounce error bounds: one per surface, finite, positive where the surface
+  // receives light through links (every surface of the box does).
+  ASSERT_EQ(h.at("surface_error_bounds").size(), 8u);
+  for (const auto& b : h.at("surface_error_bounds")) {
+    const double v = b.at("error_bound").get<double>();
+    EXPECT_TRUE(std::isfinite(v) && v > 0.0) << b.at("name");
+  }
   EXPECT_EQ(report.at("rays_total").get<std::int64_t>(),
             h.at("rays").get<std::int64_t>() + report.at("render").at("rays").get<std::int64_t>());
   expect_balanced(report.at("energy_balance"), leaves);
@@ -161,10 +168,10 @@ TEST(HierarchicalSolve, SurfaceAveragesAgreeWithTheMatrixMethodWithinBothErrors)
     EXPECT_EQ(code, kExitOk) << name;
     return averages(read_json(dir.file(name + ".json")).at("surfaces"));
   };
-  const auto m1 = solve({"--patches", "150", "--samples", "4"}, "m1");
-  const auto m4 = solve({"--patches", "600", "--samples", "4"}, "m4");
-  const auto h1 = solve({"--method", "hierarchical", "--epsilon", "1e-2"}, "h1");
-  const auto h4 = solve({"--method", "hierarchical", "--epsilon", "2.5e-3"}, "h4");
+  const auto m1 = solve({"--patches", "500", "--samples", "4"}, "m1");
+  const auto m4 = solve({"--patches", "2000", "--samples", "4"}, "m4");
+  const auto h1 = solve({"--method", "hierarchical", "--epsilon", "1e-4"}, "h1");
+  const auto h4 = solve({"--method", "hierarchical", "--epsilon", "2.5e-5"}, "h4");
   ASSERT_EQ(m1.size(), 8u);
   for (const auto& [name, m] : m4) {
     ASSERT_TRUE(h1.count(name) && h4.count(name) && m1.count(name)) << name;

@@ -125,7 +125,9 @@ TEST(Hierarchical, UnitCubeOppositeAndAdjacentFactors) {
     const HierarchicalResult r = solve_hierarchical(s, options(1e-4));
     const Mean m = surface_mean(r, receiver);
     EXPECT_NEAR(m.B, 0.5 * F, m.bound + 1e-12) << "receiver face " << receiver;
-    EXPECT_LT(m.bound, 0.25 * 0.5 * F);  // see expect_receiver
+    // Looser than expect_receiver's: rays from corners on the cube's edges graze the
+    // neighbouring faces, so links there count as partially visible (err includes F0).
+    EXPECT_LT(m.bound, 0.5 * 0.5 * F);
   }
 }
 

@@ -2,7 +2,6 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
-#include <cstdlib>
 
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/hierarchical/hierarchical.hpp"
@@ -49,61 +48,49 @@ std::vector<Eigen::Vector3d> matrix_means(const Scene& scene, std::int64_t patch
   return surface_means(mesh, sol.B);
 }
 
-TEST(HierarchicalCornell, DISABLED_MatrixTrend) {
+// The worst per-surface, per-channel relative difference of the hierarchical solution from
+// the matrix method's (hybrid, 2000 patches, Gauss-Seidel to 1e-10) falls as epsilon falls,
+// and at epsilon = 1e-5 (6.7k leaves) it is within 1 %, the bound. That bound is
+// the size of the reference's own discretisation error (its per-surface averages move by up
+// to 0.9 % from 2000 to 8000 patches, measured), so the methods agree as far as the
+// reference can tell; hybrid's visibility noise on surface averages is < 1e-3 relative.
+TEST(HierarchicalCornell, AgreesWithTheMatrixMethodAndConvergesAsEpsilonFalls) {
   const Scene scene = load_obj(builtin_cornell_box_path());
-  for (long n : {500L, 2000L, 8000L}) {
-    const auto m = matrix_means(scene, n);
-    std::printf("matrix %ld:", n);
-    for (auto& v : m) std::printf(" %.6g", v[0]);
-    std::printf("\n");
-  }
-}
-
-TEST(HierarchicalCornell, Explore) {
-  Scene scene = load_obj(builtin_cornell_box_path());
-  if (std::getenv("NO_BLOCKS")) {
-    std::vector<Face> keep;
-    for (auto& f : scene.faces) if (scene.surfaces[f.surface].name.find("block") == std::string::npos) keep.push_back(f);
-    scene.faces = keep;
-  }
-  if (const char* recv = std::getenv("PAIR")) {  // PAIR=emitter,receiver
-    const std::string spec = recv;
-    const std::string em = spec.substr(0, spec.find(',')), rc = spec.substr(spec.find(',') + 1);
-    for (auto& f : scene.faces) f.rho.reset();
-    for (auto& s : scene.surfaces) {
-      Material mat;
-      mat.name = s.name;
-      if (s.name == em) mat.emission.setConstant(em == "light" ? 17.0 : 1.0);
-      if (rc.find(s.name) != std::string::npos) mat.rho.setConstant(0.5);
-      scene.materials.push_back(mat);
-      s.material = scene.materials.size() - 1;
-    }
-  }
-  if (std::getenv("DIRECT_ONLY")) {
-    for (auto& f : scene.faces) f.rho.reset();
-    for (std::size_t m = 0; m < scene.materials.size(); ++m) scene.materials[m].rho.setZero();
-    for (auto& s : scene.surfaces) if (s.name == "floor") { Material mat = scene.materials[s.material]; mat.rho = Eigen::Vector3d(0.5,0.5,0.5); mat.name="x"; scene.materials.push_back(mat); s.material = scene.materials.size()-1; }
-  }
   const auto ref = matrix_means(scene, 2000);
-  for (double eps : {std::getenv("EPS") ? std::atof(std::getenv("EPS")) : 1e-3, 1e-4, 1e-5}) {
+  std::vector<double> worst;
+  for (double eps : {1e-3, 1e-4, 1e-5}) {
     HierarchicalOptions o;
     o.epsilon = eps;
+    o.tol = 1e-9;
     const HierarchicalResult r = solve_hierarchical(scene, o);
     const auto m = surface_means(r.mesh, r.B);
-    double worst = 0;
+    ASSERT_EQ(m.size(), ref.size());
+    double w = 0;
     for (std::size_t s = 0; s < m.size(); ++s)
       for (int c = 0; c < 3; ++c)
-        if (ref[s][c] > 0) {
-          worst = std::max(worst, std::abs(m[s][c] / ref[s][c] - 1));
-          if (c == 0) std::printf("  %-12s %.5g %.5g %+.4f\n", r.mesh.surface_names[s].c_str(), m[s][c], ref[s][c], m[s][c] / ref[s][c] - 1);
-        }
-    const auto& st = r.stats;
-    std::printf("eps %g: leaves %lld links %lld (cl %lld) rays %lld passes %d it %d conv %d  t %.2f+%.2f+%.2f  worst %.4f imb %.2e esc %.3g/%.3g\n",
-                eps, (long long)st.leaves, (long long)st.links, (long long)st.cluster_links,
-                (long long)st.rays, st.passes, st.iterations, st.converged, st.build_seconds,
-                st.refine_seconds, st.solve_seconds, worst, st.energy[0].relative_imbalance,
-                st.energy[0].escaped, st.energy[0].emitted);
+        if (ref[s][c] > 0) w = std::max(w, std::abs(m[s][c] / ref[s][c] - 1));
+    worst.push_back(w);
+    // The energy balance is an identity of the link bookkeeping: emitted - absorbed -
+    // escaped is the residual of the last sweep, <= tol x max B per leaf, relative to E.
+    EXPECT_LT(r.stats.energy[0].relative_imbalance, 1e-6);
   }
+  EXPECT_LT(worst[1], worst[0]);
+  EXPECT_LT(worst[2], worst[1]);
+  EXPECT_LE(worst[2], 0.01) << "worst per-surface difference at epsilon 1e-5";
+}
+
+TEST(HierarchicalCornell, BitwiseIdenticalForAnyThreadCount) {
+  const Scene scene = load_obj(builtin_cornell_box_path());
+  HierarchicalOptions o;
+  o.epsilon = 1e-3;
+  o.threads = 1;
+  const HierarchicalResult a = solve_hierarchical(scene, o);
+  o.threads = 2;
+  const HierarchicalResult b = solve_hierarchical(scene, o);
+  ASSERT_EQ(a.B.rows(), b.B.rows());
+  EXPECT_EQ(a.stats.rays, b.stats.rays);
+  for (Eigen::Index i = 0; i < a.B.rows(); ++i)
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(a.B(i, c), b.B(i, c)) << "leaf " << i;
 }
 
 }  // namespace
