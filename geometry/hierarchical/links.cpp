@@ -13,10 +13,19 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// Corner visibility is sampled this fraction of the way from the corner to the centroid:
+/// A link's corner values are taken this fraction of the way from the corner to the centroid:
 /// far above the ray offset (1e-6 of the scene) for any element lambert builds (>= 1e-5 of
 /// the scene's area, so >= ~3e-3 of its size), and close enough to the corner to stand for it.
 constexpr double kCornerInset = 1e-2;
+
+/// Where corner k's value is taken: just inside the corner. A corner on an edge shared with
+/// the source lies in the source's plane, where the contour formula counts it as behind the
+/// source (0, not the limit 1/2 from inside), and a corner on an edge shared with any face,
+/// lifted along its normal, lies in that face's plane, where rays graze it and count as
+/// blocked: either would zero the irradiance a link spreads to that corner.
+Eigen::Vector3d corner_point(const ff::PatchGeom& g, int k) {
+  return g.p[k] + kCornerInset * (g.centroid - g.p[k]);
+}
 
 std::uint64_t link_key(std::int32_t p, std::int32_t q) {
   return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(p)) << 32) |
@@ -129,7 +138,7 @@ Action element_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, cons
   const std::array<double, 4> mu = corner_masses(gp);
   double corner_mean = 0.0;
   for (int k = 0; k < gp.n; ++k) {
-    corner_f[k] = ff::point_to_patch(gp.p[k], gp.normal, gq);
+    corner_f[k] = ff::point_to_patch(corner_point(gp, k), gp.normal, gq);
     corner_mean += mu[k] * corner_f[k];
   }
   double shape[4];
@@ -180,10 +189,7 @@ Action element_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, cons
   double corner_vis[4] = {1, 1, 1, 1};
   for (int k = 0; k < gp.n; ++k) {
     if (!(corner_f[k] > 0.0)) continue;
-    // Rays leave from a point just inside the corner (a fraction kCornerInset of the way to
-    // the centroid): a corner on an edge the element shares with a neighbouring face, lifted
-    // along its normal, lies in that face's plane, where rays graze it and count as blocked.
-    const Eigen::Vector3d x = gp.p[k] + kCornerInset * (gp.centroid - gp.p[k]);
+    const Eigen::Vector3d x = corner_point(gp, k);
     const ff::KernelSampler sampler(x, gp.normal, gq);
     if (sampler.empty()) continue;
     const std::uint64_t stream = hash_keys(ctx.seed, link_key(p, q), 4 + k);
