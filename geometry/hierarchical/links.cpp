@@ -76,159 +76,157 @@ Action decide(const LinkContext& ctx, const Link& link, const SourceB& b_q) {
   return split_choice(ctx, link.p, link.q);
 }
 
-// Element p <- element q: the exact unoccluded factor (adaptive quadrature of the contour
-// formula over p) times the visible fraction at p's Gauss points (header).
-Action element_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, const SourceB& b_q,
-                    Link& link, std::int64_t& rays) {
-  const ff::PatchGeom& gp = ctx.h.geom(p);
-  const ff::PatchGeom& gq = ctx.h.geom(q);
-  if (!ff::can_exchange(gp, gq, ctx.plane_eps)) return Action::Drop;
-  // Unoccluded factor: the 2 x 2 Gauss rule over p (relative error ~ (diameter / 2
-  // distance)^4 for separated pairs, bounded by the interpolant check below elsewhere; at
-  // shared edges it errs low by a few % of the factor of elements that the oracle has
-  // already split to min_area, 0.1 % of the furnace's power at epsilon 1e-4), or, where no
-  // Gauss point sees q although p and q can exchange (p mostly behind q's plane), the
-  // adaptive quadrature of quadrature.hpp.
-  thread_local std::vector<ff::QuadCell> cells;
-  cells.clear();
-  double unoccluded = 0.0;
-  // Visibility points: p's 2 x 2 Gauss points weighted by w F(x -> q), or, when q is seen
-  // from none of them (p mostly behind q's plane), the centroids of the quadrature cells
-  // with the largest shares.
+// What p sees of q without occlusion: the mean factor F0 = (1/A_p) ∫_p F(x -> q) dA by
+// the 2 x 2 Gauss rule over p (relative error ~ (diameter / 2 distance)^4 for separated
+// pairs; at shared edges it errs low, on elements the oracle has split towards min_area:
+// 0.02 % of a closed cube's power at epsilon 1e-4), or by the adaptive quadrature of
+// quadrature.hpp where no Gauss point sees q although p and q can exchange (p mostly behind
+// q's plane). Also the points visibility is sampled from (the Gauss points weighted by
+// w F(x -> q), or the centroids of the largest quadrature cells) and the test points of the
+// corner interpolant (the Gauss points and the parametric centre).
+struct Unoccluded {
+  double mean = 0.0;
   struct Point {
     Eigen::Vector3d x;
     double weight;
-  };
-  Point points[4];
+  } points[4];
   int count = 0;
-  // Test points of the interpolant: the Gauss points and the parametric centre.
   double test_f[5];
   std::array<double, 4> test_w[5];
+};
+
+Unoccluded unoccluded_factor(const ff::PatchGeom& gp, const ff::PatchGeom& gq) {
+  Unoccluded u;
   const ff::GaussRule rule = ff::gauss_legendre(2);
   for (int a = 0; a < rule.n; ++a)
     for (int b = 0; b < rule.n; ++b) {
       double jacobian = 0.0;
       const Eigen::Vector3d x = ff::quadrature_point(gp, rule.x[a], rule.x[b], jacobian);
       const double f = ff::point_to_patch(x, gp.normal, gq);
-      test_f[2 * a + b] = f;
-      test_w[2 * a + b] = corner_weights(gp, rule.x[a], rule.x[b]);
+      u.test_f[2 * a + b] = f;
+      u.test_w[2 * a + b] = corner_weights(gp, rule.x[a], rule.x[b]);
       const double w = rule.w[a] * rule.w[b] * jacobian;
-      unoccluded += w * f / gp.area;
-      if (f > 0.0) points[count++] = {x, w * f};
+      u.mean += w * f / gp.area;
+      if (f > 0.0) u.points[u.count++] = {x, w * f};
     }
-  if (count == 0) {
-    unoccluded = ff::integrate_unoccluded(gp, gq, ff::kEstimatorAccuracy, cells) / gp.area;
-    if (!(unoccluded > 0.0)) return Action::Drop;
+  if (u.count == 0) {
+    thread_local std::vector<ff::QuadCell> cells;
+    u.mean = ff::integrate_unoccluded(gp, gq, ff::kEstimatorAccuracy, cells) / gp.area;
     std::vector<std::size_t> order(cells.size());
     for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
     const std::size_t keep = std::min<std::size_t>(4, order.size());
     std::partial_sort(order.begin(), order.begin() + keep, order.end(),
                       [&](std::size_t x, std::size_t y) { return cells[x].G > cells[y].G; });
     for (std::size_t k = 0; k < keep; ++k)
-      points[count++] = {cells[order[k]].g.centroid, cells[order[k]].G};
+      u.points[u.count++] = {cells[order[k]].g.centroid, cells[order[k]].G};
   }
-  {
-    double jacobian = 0.0;
-    const double u = gp.n == 3 ? 2.0 / 3.0 : 0.5, v = gp.n == 3 ? 0.5 : 0.5;
-    test_f[4] = ff::point_to_patch(ff::quadrature_point(gp, u, v, jacobian), gp.normal, gq);
-    test_w[4] = corner_weights(gp, u, v);
+  double jacobian = 0.0;
+  const double cu = gp.n == 3 ? 2.0 / 3.0 : 0.5, cv = 0.5;  // the centroid's parameters
+  u.test_f[4] = ff::point_to_patch(ff::quadrature_point(gp, cu, cv, jacobian), gp.normal, gq);
+  u.test_w[4] = corner_weights(gp, cu, cv);
+  return u;
+}
+
+// Visibility from x to q: `rays` rays to points of q drawn with the kernel's density (the
+// count_visible kernel, keeping the sampled ends, whose mean is the kernel centroid on q).
+struct Visibility {
+  int seen = 0, traced = 0;
+  Eigen::Vector3d ends = Eigen::Vector3d::Zero();  ///< sum of the sampled points of q
+};
+
+Visibility trace_from(const LinkContext& ctx, const Eigen::Vector3d& x, const Eigen::Vector3d& nx,
+                      const ff::PatchGeom& gq, int rays, std::uint64_t stream) {
+  Visibility v;
+  const ff::KernelSampler sampler(x, nx, gq);
+  if (sampler.empty()) return v;
+  const Kronecker4 seq(stream);
+  Rng rng(mix64(stream));
+  for (int r = 0; r < rays; ++r) {
+    bool gave_up = false;  // never seen in practice (KernelSampler)
+    const Eigen::Vector3d y = sampler.sample(seq.get(r, 0), seq.get(r, 1), seq.get(r, 2), rng, gave_up);
+    v.ends += y;
+    v.seen += ff::visible(ctx.bvh, x, nx, y, gq.normal, ctx.offset);
   }
-  // The corner interpolant, scaled to the exact mean (uniform if no corner sees q).
-  double corner_f[4] = {0, 0, 0, 0};
+  v.traced = rays;
+  return v;
+}
+
+// Element p <- element q (header): F = F0 vis, corner values shaped by the corners' exact
+// factors and visible fractions, error from the interpolant's deviation and visibility.
+Action element_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, const SourceB& b_q,
+                    Link& link, std::int64_t& rays) {
+  const ff::PatchGeom& gp = ctx.h.geom(p);
+  const ff::PatchGeom& gq = ctx.h.geom(q);
+  if (!ff::can_exchange(gp, gq, ctx.plane_eps)) return Action::Drop;
+  const Unoccluded u = unoccluded_factor(gp, gq);
+  if (!(u.mean > 0.0)) return Action::Drop;
+  const int per_point = std::max(1, ctx.rays / 4);
+  int traced = 0, points_seen = 0, points_blocked = 0;
+  auto count = [&](const Visibility& v) {
+    traced += v.traced;
+    points_seen += v.seen > 0;
+    points_blocked += v.seen < v.traced;
+  };
+  // Visibility at the sample points: the mean visible fraction and the kernel centroid.
+  double seen_weight = 0.0, weight = 0.0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (int k = 0; k < u.count; ++k) {
+    const Visibility v = trace_from(ctx, u.points[k].x, gp.normal, gq, per_point,
+                                    hash_keys(ctx.seed, link_key(p, q), k));
+    if (v.traced == 0) continue;
+    count(v);
+    seen_weight += u.points[k].weight * v.seen / v.traced;
+    weight += u.points[k].weight;
+    centroid += u.points[k].weight * v.ends / v.traced;
+  }
+  // The corners' factors and visible fractions shape the irradiance the link spreads over
+  // p, so light is not pushed into the parts of p that q does not reach or a blocker hides
+  // (where it would be absorbed unseen: the floor under a block).
   const std::array<double, 4> mu = corner_masses(gp);
-  double corner_mean = 0.0;
+  double corner_f[4] = {0, 0, 0, 0}, corner_vis[4] = {1, 1, 1, 1};
   for (int k = 0; k < gp.n; ++k) {
     corner_f[k] = ff::point_to_patch(corner_point(gp, k), gp.normal, gq);
-    corner_mean += mu[k] * corner_f[k];
+    if (!(corner_f[k] > 0.0)) continue;
+    const Visibility v = trace_from(ctx, corner_point(gp, k), gp.normal, gq, per_point,
+                                    hash_keys(ctx.seed, link_key(p, q), 4 + k));
+    if (v.traced == 0) continue;
+    count(v);
+    corner_vis[k] = static_cast<double>(v.seen) / v.traced;
   }
-  double shape[4];
-  for (int k = 0; k < 4; ++k) shape[k] = corner_mean > 0.0 ? corner_f[k] / corner_mean : 1.0;
+  rays += traced;
+  // The interpolant of the unoccluded corner factors (scaled to F0) against the exact factor
+  // at the test points and corners.
+  double f_mean = 0.0, fv_mean = 0.0;
+  for (int k = 0; k < gp.n; ++k) {
+    f_mean += mu[k] * corner_f[k];
+    fv_mean += mu[k] * corner_f[k] * corner_vis[k];
+  }
   double dev = 0.0;
   for (int t = 0; t < 5; ++t) {
     double interpolated = 0.0;
-    for (int k = 0; k < gp.n; ++k) interpolated += test_w[t][k] * shape[k] * unoccluded;
-    dev = std::max(dev, std::abs(test_f[t] - interpolated));
+    for (int k = 0; k < gp.n; ++k)
+      interpolated += u.test_w[t][k] * (f_mean > 0.0 ? corner_f[k] / f_mean : 1.0) * u.mean;
+    dev = std::max(dev, std::abs(u.test_f[t] - interpolated));
   }
-  for (int k = 0; k < gp.n; ++k) dev = std::max(dev, std::abs(corner_f[k] - shape[k] * unoccluded));
-  const int per_point = std::max(1, ctx.rays / 4);
-  double seen_weight = 0.0, weight = 0.0;
-  int traced = 0, points_seen = 0, points_blocked = 0, exhausted = 0;
-  bool partial = false;
-  // Rays drawn with the kernel's density from each point (the count_visible kernel, with the
-  // sampled ends kept): their mean end is the kernel centroid y* on q, where the link reads
-  // q's linear radiosity (offset from q's centroid, Link::d).
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  double centroid_weight = 0.0;
-  for (int k = 0; k < count; ++k) {
-    const ff::KernelSampler sampler(points[k].x, gp.normal, gq);
-    if (sampler.empty()) continue;
-    const std::uint64_t stream = hash_keys(ctx.seed, link_key(p, q), k);
-    const Kronecker4 seq(stream);
-    Rng rng(mix64(stream));
-    int seen = 0;
-    Eigen::Vector3d ends = Eigen::Vector3d::Zero();
-    for (int r = 0; r < per_point; ++r) {
-      bool gave_up = false;
-      const Eigen::Vector3d y = sampler.sample(seq.get(r, 0), seq.get(r, 1), seq.get(r, 2), rng, gave_up);
-      exhausted += gave_up;
-      ends += y;
-      seen += ff::visible(ctx.bvh, points[k].x, gp.normal, y, gq.normal, ctx.offset);
-    }
-    traced += per_point;
-    partial |= seen > 0 && seen < per_point;
-    points_seen += seen > 0;
-    points_blocked += seen < per_point;
-    seen_weight += points[k].weight * seen / per_point;
-    weight += points[k].weight;
-    centroid += points[k].weight * ends / per_point;
-    centroid_weight += points[k].weight;
-  }
-  // The corners' visible fractions shape the irradiance the link spreads over p (so light
-  // is not pushed into the parts of p that a blocker hides, where it would be absorbed
-  // unseen: the floor under a block); they count towards partial visibility too.
-  double corner_vis[4] = {1, 1, 1, 1};
-  for (int k = 0; k < gp.n; ++k) {
-    if (!(corner_f[k] > 0.0)) continue;
-    const Eigen::Vector3d x = corner_point(gp, k);
-    const ff::KernelSampler sampler(x, gp.normal, gq);
-    if (sampler.empty()) continue;
-    const std::uint64_t stream = hash_keys(ctx.seed, link_key(p, q), 4 + k);
-    const Kronecker4 seq(stream);
-    Rng rng(mix64(stream));
-    int seen = 0;
-    for (int r = 0; r < per_point; ++r) {
-      bool gave_up = false;
-      const Eigen::Vector3d y = sampler.sample(seq.get(r, 0), seq.get(r, 1), seq.get(r, 2), rng, gave_up);
-      exhausted += gave_up;
-      seen += ff::visible(ctx.bvh, x, gp.normal, y, gq.normal, ctx.offset);
-    }
-    traced += per_point;
-    partial |= seen > 0 && seen < per_point;
-    points_seen += seen > 0;
-    points_blocked += seen < per_point;
-    corner_vis[k] = static_cast<double>(seen) / per_point;
-  }
-  rays += traced;
-  partial |= points_seen > 0 && points_blocked > 0;
-  {
-    double mean = 0.0;
-    for (int k = 0; k < gp.n; ++k) mean += mu[k] * corner_f[k] * corner_vis[k];
-    if (mean > 0.0)
-      for (int k = 0; k < 4; ++k) shape[k] = corner_f[k] * corner_vis[k] / mean;
-  }
+  for (int k = 0; k < gp.n && f_mean > 0.0; ++k)
+    dev = std::max(dev, std::abs(corner_f[k] - corner_f[k] / f_mean * u.mean));
   const double vis = weight > 0.0 ? seen_weight / weight : 0.0;
   link.p = p;
   link.q = q;
-  link.F = static_cast<float>(unoccluded * vis);
-  const Eigen::Vector3d d =
-      centroid_weight > 0.0 ? Eigen::Vector3d(centroid / centroid_weight - gq.centroid)
-                            : Eigen::Vector3d::Zero();
+  link.F = static_cast<float>(u.mean * vis);
+  for (int k = 0; k < 4; ++k) {
+    const double shape = fv_mean > 0.0 ? corner_f[k] * corner_vis[k] / fv_mean : 1.0;
+    link.c[k] = static_cast<float>(u.mean * vis * shape);
+  }
+  const Eigen::Vector3d d = weight > 0.0 ? Eigen::Vector3d(centroid / weight - gq.centroid)
+                                         : Eigen::Vector3d::Zero();
   for (int k = 0; k < 3; ++k) link.d[k] = static_cast<float>(d[k]);
-  for (int k = 0; k < 4; ++k) link.c[k] = static_cast<float>(unoccluded * vis * shape[k]);
-  // Visibility is uncertain by 1 where the shadow boundary crosses the link, else by the
-  // chance that `traced` rays all agree while the true fraction is not 0 or 1 (~1/(n+1)).
+  // Visibility is uncertain by 1 where the shadow boundary crosses the link (rays disagree),
+  // else by the chance that `traced` rays all agree while the true fraction is not 0 or 1
+  // (~1/(n+1)).
+  const bool partial = points_seen > 0 && points_blocked > 0;
   const double vis_uncertainty = partial ? 1.0 : 1.0 / (traced + 1);
-  link.err = static_cast<float>(gp.area * (dev * vis + unoccluded * vis_uncertainty));
+  link.err = static_cast<float>(gp.area * (dev * vis + u.mean * vis_uncertainty));
   return decide(ctx, link, b_q);
 }
 
