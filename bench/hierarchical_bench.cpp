@@ -37,7 +37,7 @@
 // Usage: hierarchical_bench [--sections family,cornell,furnace] [--sizes 1000,10000,100000,1000000]
 //   [--epsilon E] [--link-rays K] [--family-matrix-patches N] [--family-rays K]
 //   [--epsilons 1e-2,1e-3,1e-4,1e-5] [--patches 100,300,1000,3000] [--ref-patches N]
-//   [--samples S] [--seed S] [-j N]
+//   [--samples S] [--seed S] [-j N] [--plot cornell.png]
 // The machine is shared: compare ratios, and rerun for medians.
 
 #include <sys/resource.h>
@@ -63,6 +63,7 @@
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/hierarchical/hierarchical.hpp"
 #include "io/obj_loader.hpp"
+#include "io/plot.hpp"
 #include "solvers/radiosity.hpp"
 
 using namespace lambert;
@@ -85,6 +86,7 @@ struct Settings {
   int samples = 4;
   std::uint64_t seed = 1;
   int threads = 0;
+  std::string plot;  ///< --plot PNG: the Cornell section's error against time
 };
 
 // ---- per-surface comparison ----
@@ -458,6 +460,32 @@ void print_surfaces(const Reference& ref, const Point& matrix, const Point& hier
   }
 }
 
+// Worst per-surface error against seconds for both methods, the reference's own error and
+// RenderPark's figure (1.5 % in 1.6 s on this machine), log-log.
+void write_cornell_plot(const std::string& path, const std::vector<Point>& matrix,
+                        const std::vector<Point>& hier, const Reference& ref) {
+  Plot plot;
+  plot.title = "Cornell box: worst per-surface error vs time";
+  plot.x_label = "seconds (wall, 2 threads)";
+  plot.y_label = "worst per-surface relative error";
+  plot.log_x = plot.log_y = plot.markers = true;
+  double t_min = 1e9, t_max = 0.0;
+  for (const auto* runs : {&matrix, &hier}) {
+    PlotSeries series{runs == &matrix ? "matrix (hybrid, patches)" : "hierarchical (epsilon)", {}, {}};
+    for (const Point& p : *runs) {
+      series.x.push_back(p.seconds);
+      series.y.push_back(p.error);
+      t_min = std::min(t_min, p.seconds);
+      t_max = std::max(t_max, p.seconds);
+    }
+    plot.series.push_back(series);
+  }
+  plot.series.push_back({"RenderPark (1.6 s, 1.5 %)", {1.6}, {kTargetError}});
+  plot.series.push_back({"reference's own error", {t_min, t_max}, {ref.own.worst, ref.own.worst}});
+  write_plots_png(path, {plot});
+  std::printf("wrote %s\n", path.c_str());
+}
+
 void run_cornell(const Settings& s) {
   const Scene scene = load_obj(builtin_cornell_box_path());
   std::printf("== Cornell box: reference = hybrid, %d samples, gauss-seidel 1e-10 ==\n", s.samples);
@@ -472,6 +500,7 @@ void run_cornell(const Settings& s) {
   print_time_to_target("hierarchical", hier, ref.own.worst);
   print_equal_error(ref, hier);
   if (!matrix.empty() && !hier.empty()) print_surfaces(ref, matrix.back(), hier.back());
+  if (!s.plot.empty()) write_cornell_plot(s.plot, matrix, hier, ref);
   std::printf("\n");
 }
 
@@ -552,6 +581,8 @@ bool parse(int argc, char** argv, Settings& s) {
       s.seed = std::strtoull(v, nullptr, 10);
     else if (!std::strcmp(k, "-j"))
       s.threads = std::atoi(v);
+    else if (!std::strcmp(k, "--plot"))
+      s.plot = v;
     else
       return false;
   }
@@ -570,7 +601,7 @@ int main(int argc, char** argv) {
                  "usage: hierarchical_bench [--sections family,cornell,furnace] [--sizes N,N,...] "
                  "[--epsilon E] [--link-rays K] [--family-matrix-patches N] [--family-rays K] "
                  "[--epsilons E,E,...] [--patches N,N,...] [--ref-patches N] [--samples S] "
-                 "[--seed S] [-j N]\n");
+                 "[--seed S] [-j N] [--plot PNG]\n");
     return 2;
   }
   s.threads = resolve_threads(s.threads);
