@@ -1,5 +1,7 @@
 #include "apps/hierarchical_stage.hpp"
 
+#include "geometry/formfactors/analysis.hpp"
+
 #include <sstream>
 #include <utility>
 
@@ -39,6 +41,11 @@ HierarchicalRun solve_scene_hierarchical(Scene scene, const HierarchicalOptions&
            format_si(static_cast<double>(st.rays)) + " rays, " + std::to_string(st.passes) +
            " passes, " + std::to_string(st.iterations) + " sweeps in " +
            format_duration(run.seconds) + ", " + format_bytes(st.memory_bytes));
+  if (!st.blind_emitters.empty()) {
+    LightingProblems problems;
+    problems.blind_emitters = st.blind_emitters;
+    for (const std::string& line : lighting_warnings(run.loaded.mesh, problems)) log_warn(line);
+  }
   if (!st.converged)
     log_warn("the hierarchical sweeps did not converge (last relative change " + number(st.change) +
              " > tol " + number(options.tol) + " after " + std::to_string(st.iterations) +

@@ -375,6 +375,26 @@ void energy_balance(const Hierarchy& h, const State& s, HierarchicalStats& st) {
   }
 }
 
+/// Emitting surfaces whose faces can exchange light with no other face (HierarchicalStats).
+std::vector<std::int32_t> blind_emitters(const Hierarchy& h, double plane_eps) {
+  const PatchMesh& faces = h.faces();
+  std::vector<std::int32_t> emitting;
+  for (std::int32_t f = 0; f < faces.size(); ++f)
+    if (faces.patches[f].emission.maxCoeff() > 0.0) emitting.push_back(f);
+  if (static_cast<double>(emitting.size()) * faces.size() > kBlindCheckPairs) return {};
+  std::vector<char> sees(faces.surface_names.size(), 0), emits(sees.size(), 0);
+  for (const std::int32_t f : emitting) {
+    const std::int32_t s = faces.patches[f].surface;
+    emits[s] = 1;
+    for (std::int32_t g = 0; g < faces.size() && !sees[s]; ++g)
+      if (g != f && ff::can_exchange(h.geom(f), h.geom(g), plane_eps)) sees[s] = 1;
+  }
+  std::vector<std::int32_t> out;
+  for (std::size_t s = 0; s < sees.size(); ++s)
+    if (emits[s] && !sees[s]) out.push_back(static_cast<std::int32_t>(s));
+  return out;
+}
+
 }  // namespace
 
 HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOptions& o) {
@@ -387,6 +407,7 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
   const Bvh bvh(h.faces(), threads);
   st.faces = h.faces().size();
   st.clusters = h.clusters();
+  st.blind_emitters = blind_emitters(h, ff::kPlaneEps * h.faces().scale);
   st.build_seconds = timer.seconds();
 
   double total_area = 0.0;

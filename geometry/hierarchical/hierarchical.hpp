@@ -31,6 +31,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "geometry/mesh.hpp"
 #include "geometry/scene.hpp"
@@ -76,7 +77,15 @@ struct HierarchicalStats {
   double min_area = 0.0;      ///< the element area bound used
   double build_seconds = 0.0, refine_seconds = 0.0, solve_seconds = 0.0;
   std::array<HierarchicalEnergy, 3> energy;
+  /// Emitting surfaces none of whose faces can exchange light with any other face (each
+  /// behind the other's plane): their light leaves the scene unseen (inverted winding?).
+  /// Checked for at most kBlindCheckPairs face pairs (beyond that none are listed).
+  std::vector<std::int32_t> blind_emitters;
 };
+
+/// Face pairs the blind-emitter check examines at most (emitting faces x faces, each pair a
+/// few dot products: ~0.1 s).
+constexpr std::int64_t kBlindCheckPairs = 100000000;
 
 /// The leaves as a patch mesh (vertices shared within a surface by exact position; hanging
 /// vertices where neighbours were split to different depths) and their radiosity.

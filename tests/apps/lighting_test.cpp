@@ -266,3 +266,37 @@ TEST(LosslessSurfaces, AnOpenLosslessBoxSolvesAndLosesEverythingThroughTheOpenin
 }
 
 }  // namespace lambert
+
+namespace lambert {
+namespace {
+
+// The hierarchical method has no F to inspect; it checks the emitting faces' geometry
+// instead and says the same thing.
+TEST(LightingWarnings, HierarchicalNamesALightFacingOutOfTheBox) {
+  testing::TempDir dir;
+  const std::string obj = write_obj(dir, "box", open_box_light_facing_up());
+  for (const char* command : {"run", "solve"}) {
+    std::vector<std::string> args = {command, obj, "--method", "hierarchical", "--epsilon", "1e-2"};
+    if (std::string(command) == "run")
+      args.insert(args.end(), {"-o", dir.file("out"), "--size", "16x16", "--antialias", "1"});
+    else
+      args.insert(args.end(), {"-o", dir.file("B.csv")});
+    const auto [code, err] = run_captured(args);
+    EXPECT_EQ(code, kExitOk) << err;
+    EXPECT_EQ(count(err, "warning: emitter 'light' sees nothing from its front side"), 1)
+        << command << '\n' << err;
+    EXPECT_EQ(count(err, "warning:"), 1) << command << '\n' << err;
+  }
+}
+
+TEST(LightingWarnings, HierarchicalSaysNothingForAWorkingScene) {
+  testing::TempDir dir;
+  const std::string obj = write_obj(dir, "cube", cube());
+  const auto [code, err] = run_captured(
+      {"solve", obj, "--method", "hierarchical", "--epsilon", "1e-2", "-o", dir.file("B.csv")});
+  EXPECT_EQ(code, kExitOk) << err;
+  EXPECT_EQ(count(err, "warning:"), 0) << err;
+}
+
+}  // namespace
+}  // namespace lambert
