@@ -44,16 +44,21 @@ void check_options(const HierarchicalOptions& o) {
   if (o.max_passes < 1) throw UsageError("the number of refinement passes must be >= 1");
 }
 
-/// A field given by its values at an element's corners, per channel.
-using Corners = std::array<Eigen::Vector3d, 4>;
-const Corners kNoCorners = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
-                            Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+/// The irradiance a node gathers or inherits, per channel: at an element, its values at the
+/// corners ([0, 4): linear on triangles, bilinear on quads); at a cluster, the irradiance
+/// per unit projected area arriving from each of the six axis directions (the bins of
+/// Node::facing). An element below a cluster receives sum_b E_b max(0, n · e_b).
+using Field = std::array<Eigen::Vector3d, 6>;
+const Field kNoField = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                        Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                        Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+using Corners = Field;  // an element's field: entries 0..3
 
 /// The per-node state of the solution: radiosity B (area average below the node), the
 /// irradiance gathered over the node's own links, and for leaves the total irradiance.
 struct State {
   std::vector<Eigen::Vector3d> B, H;
-  std::vector<Corners> gathered;  ///< at an element's corners (clusters: uniform, [0])
+  std::vector<Field> gathered;  ///< over the node's own links
   std::vector<Eigen::Vector3d> lo, hi;  ///< per channel min and max of the leaves' B below
   std::vector<Eigen::Matrix3d> grad;    ///< elements: gradient of B (row = channel), in plane
   /// B of node q read at offset d from its centroid (its linear fit, kept within [lo, hi]).
@@ -69,7 +74,7 @@ struct State {
     grad.resize(n, Eigen::Matrix3d::Zero());
     hi.resize(n, Eigen::Vector3d::Zero());
     B.resize(n, Eigen::Vector3d::Zero());
-    gathered.resize(n, kNoCorners);
+    gathered.resize(n, kNoField);
     H.resize(n, Eigen::Vector3d::Zero());
   }
 };
@@ -110,33 +115,44 @@ Eigen::Matrix3d plane_gradient(const Eigen::Vector3d& n, const Eigen::Vector3d* 
 /// bilinear fields, the children being sub-triangles and parameter sub-squares).
 Corners child_corners(const Corners& c, int n, int k) {
   auto m = [&](int a, int b) -> Eigen::Vector3d { return 0.5 * (c[a] + c[b]); };
+  const Eigen::Vector3d o = Eigen::Vector3d::Zero();
   if (n == 3) {
     switch (k) {
-      case 0: return {c[0], m(0, 1), m(2, 0), Eigen::Vector3d::Zero()};
-      case 1: return {m(0, 1), c[1], m(1, 2), Eigen::Vector3d::Zero()};
-      case 2: return {m(2, 0), m(1, 2), c[2], Eigen::Vector3d::Zero()};
-      default: return {m(1, 2), m(2, 0), m(0, 1), Eigen::Vector3d::Zero()};
+      case 0: return {c[0], m(0, 1), m(2, 0), o, o, o};
+      case 1: return {m(0, 1), c[1], m(1, 2), o, o, o};
+      case 2: return {m(2, 0), m(1, 2), c[2], o, o, o};
+      default: return {m(1, 2), m(2, 0), m(0, 1), o, o, o};
     }
   }
   const Eigen::Vector3d centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
   switch (k) {
-    case 0: return {c[0], m(0, 1), centre, m(3, 0)};
-    case 1: return {m(0, 1), c[1], m(1, 2), centre};
-    case 2: return {centre, m(1, 2), c[2], m(2, 3)};
-    default: return {m(3, 0), centre, m(2, 3), c[3]};
+    case 0: return {c[0], m(0, 1), centre, m(3, 0), o, o};
+    case 1: return {m(0, 1), c[1], m(1, 2), centre, o, o};
+    case 2: return {centre, m(1, 2), c[2], m(2, 3), o, o};
+    default: return {m(3, 0), centre, m(2, 3), c[3], o, o};
   }
 }
 
-/// Push-pull: irradiance down (a cluster spreads what it and its ancestors gathered
-/// uniformly over its area; an element adds its own gathered corner field to the inherited
-/// one and hands each child the interpolated field), B = E + rho mean(H) at the leaves,
-/// area-averaged B up. Returns the largest change of a leaf's B (any channel).
-double push_pull(const Hierarchy& h, std::int32_t i, const Corners& down, State& s) {
+/// The irradiance an element with unit normal n receives from a cluster's directional field.
+Eigen::Vector3d facing_irradiance(const Field& E, const Eigen::Vector3d& n) {
+  Eigen::Vector3d H = Eigen::Vector3d::Zero();
+  for (int a = 0; a < 3; ++a) {
+    H += std::max(0.0, n[a]) * E[2 * a];
+    H += std::max(0.0, -n[a]) * E[2 * a + 1];
+  }
+  return H;
+}
+
+/// Push-pull: irradiance down (a cluster hands the directional field it and its ancestors
+/// gathered to its children, which take what their faces' orientation lets them; an element
+/// adds its own gathered corner field to the inherited one and hands each child the
+/// interpolated field), B = E + rho mean(H) at the leaves, area-averaged B up. Returns the
+/// largest change of a leaf's B (any channel).
+double push_pull(const Hierarchy& h, std::int32_t i, const Field& down, State& s) {
   const hr::Node& n = h.node(i);
-  Corners H;
-  const int corners = n.cluster ? 1 : h.geom(i).n;
-  for (int k = 0; k < 4; ++k) H[k] = n.cluster ? down[0] + s.gathered[i][0]
-                                               : down[k] + s.gathered[i][k];
+  Field H;
+  for (int k = 0; k < 6; ++k) H[k] = down[k] + s.gathered[i][k];
+  const int corners = n.cluster ? 0 : h.geom(i).n;
   if (n.child_count == 0) {
     const Patch& face = h.faces().patches[n.face];
     const std::array<double, 4> mu = hr::corner_masses(h.geom(i));
@@ -165,8 +181,15 @@ double push_pull(const Hierarchy& h, std::int32_t i, const Corners& down, State&
   Eigen::Vector3d hi = Eigen::Vector3d::Zero();
   for (int k = 0; k < n.child_count; ++k) {
     const std::int32_t c = h.child(i, k);
-    const Corners down_c = n.cluster ? Corners{H[0], H[0], H[0], H[0]}
-                                     : child_corners(H, corners, k);
+    Field down_c = kNoField;
+    if (!n.cluster) {
+      down_c = child_corners(H, corners, k);
+    } else if (h.node(c).cluster) {
+      down_c = H;
+    } else {
+      const Eigen::Vector3d e = facing_irradiance(H, h.geom(c).normal);
+      for (int j = 0; j < 4; ++j) down_c[j] = e;
+    }
     change = std::max(change, push_pull(h, c, down_c, s));
     sum += h.node(c).area * s.B[c];
     lo = lo.cwiseMin(s.lo[c]);
@@ -204,18 +227,31 @@ struct LinkTable {
   }
 };
 
-/// gathered[p] = sum over p's links of c_pq B_q (per corner), in link order (deterministic).
-void gather(const LinkTable& t, State& s, int threads) {
-  std::fill(s.gathered.begin(), s.gathered.end(), kNoCorners);
+/// gathered[p] = sum over p's links of c_pq B_q (per corner; q read at the link's point); for
+/// a cluster p, the power F_pq B_q A_p of each link split by the link's orientation bins, as
+/// irradiance per unit projected area of the faces in each bin. In link order
+/// (deterministic).
+void gather(const Hierarchy& h, const LinkTable& t, State& s, int threads) {
+  std::fill(s.gathered.begin(), s.gathered.end(), kNoField);
   const std::int64_t runs = static_cast<std::int64_t>(t.starts.size()) - 1;
   parallel_for(runs, kGatherChunk, threads, [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t r = begin; r < end; ++r) {
-      Corners sum = kNoCorners;
+      const std::int32_t p = t.links[t.starts[r]].p;
+      const hr::Node& np = h.node(p);
+      Field sum = kNoField;
       for (std::int64_t k = t.starts[r]; k < t.starts[r + 1]; ++k) {
-        const Eigen::Vector3d b = s.read(t.links[k].q, t.links[k].d);
-        for (int c = 0; c < 4; ++c) sum[c] += static_cast<double>(t.links[k].c[c]) * b;
+        const Link& l = t.links[k];
+        const Eigen::Vector3d b = s.read(l.q, l.d);
+        if (!np.cluster) {
+          for (int c = 0; c < 4; ++c) sum[c] += static_cast<double>(l.c[c]) * b;
+          continue;
+        }
+        const Eigen::Vector3d power = static_cast<double>(l.F) * np.area * b;
+        for (int bin = 0; bin < 6; ++bin)
+          if (l.bins[bin] > 0.0f && np.facing[bin] > 0.0)
+            sum[bin] += power * (static_cast<double>(l.bins[bin]) / np.facing[bin]);
       }
-      s.gathered[t.links[t.starts[r]].p] = sum;
+      s.gathered[p] = sum;
     }
   });
 }
@@ -429,7 +465,7 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
 
   State s;
   s.resize(h.nodes().size());
-  push_pull(h, h.root(), kNoCorners, s);  // B = E
+  push_pull(h, h.root(), kNoField, s);  // B = E
 
   LinkTable table;
   std::vector<std::pair<std::int32_t, std::int32_t>> pending;
@@ -498,8 +534,8 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
     double max_b = 0.0;
     st.converged = false;
     for (int it = 1; it <= o.max_iterations; ++it) {
-      gather(table, s, threads);
-      const double change = push_pull(h, h.root(), kNoCorners, s);
+      gather(h, table, s, threads);
+      const double change = push_pull(h, h.root(), kNoField, s);
       ++st.iterations;
       max_b = 0.0;
       for (std::int32_t i = 0; i < h.size(); ++i)

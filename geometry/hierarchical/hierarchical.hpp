@@ -13,8 +13,9 @@
 // irradiance, W/m^2) and its error per unit source radiosity. Element-element links use the
 // exact point-to-patch factor at 2x2 Gauss points of p times the visible fraction from
 // kernel-sampled Embree rays (the hybrid kernel on element geometry); links that involve a
-// cluster use the isotropic conservative bound A_p A_q / (π r_min^2) (r_min the distance of
-// the bounding spheres) and an area-sampled Monte Carlo estimate of the transfer. The
+// cluster use the isotropic conservative bound min(A_p A_q / (π d^2), A_p, A_q) (d the
+// distance of the bounding boxes) and an area-sampled Monte Carlo estimate of the transfer,
+// handed to a receiving cluster's faces by their orientation (links.hpp). The
 // refinement oracle (BF refinement against the current B) refines a link while
 // max_c B_q,c x err_pq > epsilon x (total emitted power, max channel).
 //

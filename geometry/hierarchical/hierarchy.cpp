@@ -63,6 +63,15 @@ std::array<double, 4> corner_weights(const ff::PatchGeom& g, double u, double v)
   return {(1 - u) * (1 - v), u * (1 - v), u * v, (1 - u) * v};
 }
 
+std::array<double, 6> facing(const Eigen::Vector3d& normal, double area) {
+  std::array<double, 6> f{};
+  for (int a = 0; a < 3; ++a) {
+    f[2 * a] = area * std::max(0.0, normal[a]);
+    f[2 * a + 1] = area * std::max(0.0, -normal[a]);
+  }
+  return f;
+}
+
 double box_distance_squared(const Eigen::AlignedBox3d& a, const Eigen::AlignedBox3d& b) {
   double d2 = 0.0;
   for (int k = 0; k < 3; ++k) {
@@ -82,6 +91,7 @@ Hierarchy::Hierarchy(const PatchMesh& faces) : faces_(faces) {
     node.face = i;
     node.area = geom_[i].area;
     node.box = box_of(geom_[i]);
+    node.facing = facing(geom_[i].normal, node.area);
   }
   std::vector<std::int32_t> elements(n);
   std::iota(elements.begin(), elements.end(), 0);
@@ -112,6 +122,7 @@ std::int32_t Hierarchy::build_clusters(std::vector<std::int32_t>& elements, std:
   c.child_count = 2;
   c.area = nodes_[left].area + nodes_[right].area;
   c.box = nodes_[left].box.merged(nodes_[right].box);
+  for (int b = 0; b < 6; ++b) c.facing[b] = nodes_[left].facing[b] + nodes_[right].facing[b];
   nodes_.push_back(c);
   geom_.emplace_back();
   nodes_[left].parent = id;
@@ -158,6 +169,7 @@ void Hierarchy::split_element(std::int32_t i) {
     n.depth = static_cast<std::int8_t>(parent.depth + 1);
     n.area = kid.area;
     n.box = box_of(kid);
+    n.facing = facing(kid.normal, kid.area);
     nodes_.push_back(n);
     geom_.push_back(kid);
   }

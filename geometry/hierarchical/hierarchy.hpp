@@ -34,6 +34,10 @@ struct Node {
   std::int32_t face = -1;         ///< elements: the face (patch of the face mesh) it lies on
   double area = 0.0;              ///< total surface area below the node
   Eigen::AlignedBox3d box;        ///< bounding box of the surfaces below
+  /// Projected front area below the node towards the six axis directions +x, -x, +y, -y,
+  /// +z, -z: sum over its faces of A max(0, ±n_a). A cluster receiving light from direction
+  /// e_b hands it on in proportion to these (oriented push, hierarchical.cpp).
+  std::array<double, 6> facing{};
 };
 
 /// The hierarchy over one scene's faces.
@@ -90,6 +94,9 @@ std::array<double, 4> corner_masses(const ff::PatchGeom& g);
 /// Interpolation weights of the corners at parameter (u, v) of ff::quadrature_point
 /// (triangles: the collapsed map, (1-u, u(1-v), uv); quads: bilinear).
 std::array<double, 4> corner_weights(const ff::PatchGeom& g, double u, double v);
+
+/// A max(0, ±n_a) for the six axis directions (Node::facing) of a planar element.
+std::array<double, 6> facing(const Eigen::Vector3d& normal, double area);
 
 /// Squared distance between two boxes (0 when they overlap or touch).
 double box_distance_squared(const Eigen::AlignedBox3d& a, const Eigen::AlignedBox3d& b);

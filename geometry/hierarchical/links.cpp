@@ -232,10 +232,10 @@ Action element_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, cons
 
 // Monte Carlo transfer between two nodes, one of them a cluster (header).
 double cluster_transfer(const LinkContext& ctx, std::int32_t p, std::int32_t q,
-                        std::int64_t& rays) {
+                        std::int64_t& rays, float* bins) {
   const Kronecker4 sx(hash_keys(ctx.seed, link_key(p, q), 1));
   const Kronecker4 sy(hash_keys(ctx.seed, link_key(p, q), 2));
-  double sum = 0.0;
+  double sum = 0.0, share[6] = {0, 0, 0, 0, 0, 0};
   for (int s = 0; s < ctx.rays; ++s) {
     Eigen::Vector3d nx, ny;
     const Eigen::Vector3d x = ctx.h.sample_point(p, sx.get(s, 0), sx.get(s, 1), sx.get(s, 2), nx);
@@ -246,8 +246,13 @@ double cluster_transfer(const LinkContext& ctx, std::int32_t p, std::int32_t q,
     const double cx = nx.dot(r), cy = -ny.dot(r);
     if (cx <= 0.0 || cy <= 0.0) continue;
     ++rays;
-    if (ff::visible(ctx.bvh, x, nx, y, ny, ctx.offset)) sum += cx * cy / (kPi * r2 * r2);
+    if (!ff::visible(ctx.bvh, x, nx, y, ny, ctx.offset)) continue;
+    const double k = cx * cy / (kPi * r2 * r2);
+    sum += k;
+    // Where it arrived: the receiving face's orientation, n_a^2 to the bin of n_a's sign.
+    for (int a = 0; a < 3; ++a) share[nx[a] >= 0.0 ? 2 * a : 2 * a + 1] += k * nx[a] * nx[a];
   }
+  for (int b = 0; b < 6; ++b) bins[b] = sum > 0.0 ? static_cast<float>(share[b] / sum) : 0.0f;
   return ctx.h.node(p).area * ctx.h.node(q).area * sum / ctx.rays;
 }
 
@@ -265,7 +270,7 @@ Action cluster_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, cons
   link.err = static_cast<float>(t_max);
   const Action action = decide(ctx, link, b_q);
   if (action != Action::Accept) return action;
-  const double t = std::min(cluster_transfer(ctx, p, q, rays), t_max);
+  const double t = std::min(cluster_transfer(ctx, p, q, rays, link.bins), t_max);
   link.F = static_cast<float>(t / np.area);
   for (float& c : link.c) c = link.F;
   return Action::Accept;

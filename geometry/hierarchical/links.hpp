@@ -29,7 +29,8 @@
 // conservative for any orientation, which is why the root cluster can link to itself. err =
 // T_max. An accepted cluster link is estimated by Monte Carlo: link_rays pairs (x, y)
 // uniform in area below p and q, T ≈ A_p A_q mean(cos+_x cos+_y V / (π r^2)), capped at
-// T_max. A cluster receiver spreads what it gathers uniformly over its area (push).
+// T_max. A cluster receiver hands what it gathers to the faces below it by orientation:
+// the samples record which way the receiving faces turned (Link::bins).
 // Pairs with an element whose plane has the other end's box entirely behind it are dropped.
 //
 // Refinement splits the larger end that can be split (clusters: by box diagonal, elements:
@@ -46,7 +47,7 @@
 
 namespace lambert::hr {
 
-/// One link p <- q (44 bytes).
+/// One link p <- q (68 bytes).
 struct Link {
   std::int32_t p = 0;  ///< receiver node
   std::int32_t q = 0;  ///< source node
@@ -60,6 +61,11 @@ struct Link {
   /// units; 0 for cluster links). The transfer uses B_q + grad B_q · d, q's linear fit,
   /// which removes the first-order error of transferring q's average.
   float d[3] = {0, 0, 0};
+  /// A cluster receiver: the shares of the transfer that arrived on faces turned towards
+  /// +x, -x, +y, -y, +z, -z (n_a^2 of each Monte Carlo sample's receiving normal, to the
+  /// bin of n_a's sign); the push hands each share to the faces in that bin by their
+  /// projected area (Node::facing).
+  float bins[6] = {0, 0, 0, 0, 0, 0};
 };
 
 /// What to do with a link.
