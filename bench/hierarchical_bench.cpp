@@ -36,7 +36,7 @@
 //
 // Usage: hierarchical_bench [--sections family,cornell,furnace] [--sizes 1000,10000,100000,1000000]
 //   [--epsilon E] [--link-rays K] [--family-matrix-patches N] [--family-rays K]
-//   [--epsilons 1e-2,1e-3,1e-4,1e-5] [--patches 100,300,1000,3000] [--ref-patches N]
+//   [--epsilons 1e-2,1e-3,1e-4,3e-5,1e-5] [--patches 100,300,1000,3000] [--ref-patches N]
 //   [--samples S] [--seed S] [-j N] [--plot cornell.png]
 // The machine is shared: compare ratios, and rerun for medians.
 
@@ -80,7 +80,7 @@ struct Settings {
   int link_rays = HierarchicalOptions{}.link_rays;
   std::int64_t family_matrix_patches = 20000;
   int family_rays = 2048;
-  std::vector<double> epsilons = {1e-2, 1e-3, 1e-4, 1e-5};
+  std::vector<double> epsilons = {1e-2, 1e-3, 1e-4, 3e-5, 1e-5};
   std::vector<double> patches = {100, 300, 1000, 3000};
   std::int64_t ref_patches = 10000;
   int samples = 4;
