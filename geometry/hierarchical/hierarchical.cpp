@@ -66,9 +66,13 @@ struct State {
     const Eigen::Vector3d offset(d[0], d[1], d[2]);
     return (B[q] + grad[q] * offset).cwiseMax(lo[q]).cwiseMin(hi[q]);
   }
+  /// What the oracle knows of q's radiosity.
   hr::SourceB source(std::int32_t q) const {
     return {B[q].maxCoeff(), (hi[q] - lo[q]).maxCoeff(), hi[q].maxCoeff()};
   }
+  /// Bytes of state per node (for the memory count).
+  static constexpr double kBytesPerNode =
+      4 * sizeof(Eigen::Vector3d) + sizeof(Eigen::Matrix3d) + sizeof(Field);
   void resize(std::size_t n) {
     lo.resize(n, Eigen::Vector3d::Zero());
     grad.resize(n, Eigen::Matrix3d::Zero());
@@ -307,7 +311,7 @@ void split_nodes(Hierarchy& h, const std::vector<Refinement>& r, State& s) {
 double memory_bytes(const Hierarchy& h, const LinkTable& t, std::size_t pending) {
   return h.bytes() + static_cast<double>(t.links.capacity()) * sizeof(Link) +
          static_cast<double>(pending) * (sizeof(Link) + sizeof(Refinement)) +
-         static_cast<double>(h.nodes().capacity()) * 3 * sizeof(Eigen::Vector3d) +
+         static_cast<double>(h.nodes().capacity()) * State::kBytesPerNode +
          static_cast<double>(h.faces().size()) * 256.0;  // the face BVH, ~2 nodes per face
 }
 
