@@ -1,5 +1,7 @@
 #include "apps/hierarchical_stage.hpp"
 
+#include "apps/problem.hpp"
+
 #include "geometry/formfactors/analysis.hpp"
 
 #include <sstream>
@@ -60,16 +62,10 @@ SolveStatus hierarchical_status(const HierarchicalStats& stats) {
 Json hierarchical_json(const HierarchicalRun& run) {
   const HierarchicalOptions& o = run.options;
   const HierarchicalStats& st = run.stats;
-  const PatchMesh& mesh = run.loaded.mesh;
-  std::vector<double> bound(mesh.surface_names.size(), 0.0), area(bound.size(), 0.0);
-  for (std::int32_t i = 0; i < mesh.size(); ++i) {
-    bound[mesh.patches[i].surface] += mesh.patches[i].area * run.error_bound[i];
-    area[mesh.patches[i].surface] += mesh.patches[i].area;
-  }
   Json bounds = Json::array();
-  for (std::size_t s = 0; s < bound.size(); ++s)
-    bounds.push_back({{"name", mesh.surface_names[s]},
-                      {"error_bound", area[s] > 0 ? bound[s] / area[s] : 0.0}});
+  for (const SurfaceRadiosity& b :
+       surface_averages(run.loaded.mesh, run.error_bound.replicate(1, 3)))
+    bounds.push_back({{"name", b.name}, {"error_bound", b.average[0]}});
   return {{"status", to_string(hierarchical_status(st))},
           {"options",
            {{"epsilon", o.epsilon},

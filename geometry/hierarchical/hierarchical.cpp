@@ -151,8 +151,11 @@ Eigen::Vector3d facing_irradiance(const Field& E, const Eigen::Vector3d& n) {
 /// gathered to its children, which take what their faces' orientation lets them; an element
 /// adds its own gathered corner field to the inherited one and hands each child the
 /// interpolated field), B = E + rho mean(H) at the leaves, area-averaged B up. Returns the
-/// largest change of a leaf's B (any channel).
-double push_pull(const Hierarchy& h, std::int32_t i, const Field& down, State& s) {
+/// largest change of a leaf's B and the largest leaf B (any channel).
+struct Sweep {
+  double change = 0.0, max_b = 0.0;
+};
+Sweep push_pull(const Hierarchy& h, std::int32_t i, const Field& down, State& s) {
   const hr::Node& n = h.node(i);
   Field H;
   for (int k = 0; k < 6; ++k) H[k] = down[k] + s.gathered[i][k];
@@ -177,9 +180,9 @@ double push_pull(const Hierarchy& h, std::int32_t i, const Field& down, State& s
     const ff::PatchGeom& g = h.geom(i);
     s.grad[i] = plane_gradient(g.normal, g.p.data(), bk, mu.data(), corners);
     s.H[i] = mean;
-    return change;
+    return {change, b.maxCoeff()};
   }
-  double change = 0.0;
+  Sweep sweep;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = Eigen::Vector3d::Zero();
@@ -194,7 +197,9 @@ double push_pull(const Hierarchy& h, std::int32_t i, const Field& down, State& s
       const Eigen::Vector3d e = facing_irradiance(H, h.geom(c).normal);
       for (int j = 0; j < 4; ++j) down_c[j] = e;
     }
-    change = std::max(change, push_pull(h, c, down_c, s));
+    const Sweep child = push_pull(h, c, down_c, s);
+    sweep.change = std::max(sweep.change, child.change);
+    sweep.max_b = std::max(sweep.max_b, child.max_b);
     sum += h.node(c).area * s.B[c];
     lo = lo.cwiseMin(s.lo[c]);
     hi = hi.cwiseMax(s.hi[c]);
@@ -213,7 +218,7 @@ double push_pull(const Hierarchy& h, std::int32_t i, const Field& down, State& s
     }
     s.grad[i] = plane_gradient(h.geom(i).normal, x, v, w, n.child_count);
   }
-  return change;
+  return sweep;
 }
 
 /// Links sorted by receiver, with the start of each receiver's run.
@@ -295,17 +300,19 @@ void split_nodes(Hierarchy& h, const std::vector<Refinement>& r, State& s) {
   }
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  const std::int32_t first_new = h.size();
   for (const std::int32_t i : nodes) {
     if (h.node(i).cluster || h.node(i).child_count > 0) continue;
     if (h.size() > std::numeric_limits<std::int32_t>::max() - 8)
       throw Error("hierarchical: more than 2^31 nodes; raise --epsilon or --min-area");
     h.split_element(i);
-    s.resize(h.nodes().size());
-    for (int k = 0; k < 4; ++k) {
-      const std::int32_t c = h.child(i, k);
-      s.B[c] = s.lo[c] = s.hi[c] = s.B[i];
-    }
   }
+  s.resize(h.nodes().size());
+  for (const std::int32_t i : nodes)
+    for (int k = 0; k < h.node(i).child_count && !h.node(i).cluster; ++k) {
+      const std::int32_t c = h.child(i, k);
+      if (c >= first_new) s.B[c] = s.lo[c] = s.hi[c] = s.B[i];
+    }
 }
 
 double memory_bytes(const Hierarchy& h, const LinkTable& t, std::size_t pending) {
@@ -535,16 +542,12 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
 
     Timer solve_timer;
     s.resize(h.nodes().size());
-    double max_b = 0.0;
     st.converged = false;
     for (int it = 1; it <= o.max_iterations; ++it) {
       gather(h, table, s, threads);
-      const double change = push_pull(h, h.root(), kNoField, s);
+      const Sweep sweep = push_pull(h, h.root(), kNoField, s);
       ++st.iterations;
-      max_b = 0.0;
-      for (std::int32_t i = 0; i < h.size(); ++i)
-        if (h.is_leaf(i) && !h.node(i).cluster) max_b = std::max(max_b, s.B[i].maxCoeff());
-      st.change = max_b > 0 ? change / max_b : 0.0;
+      st.change = sweep.max_b > 0 ? sweep.change / sweep.max_b : 0.0;
       if (st.change <= o.tol) {
         st.converged = true;
         break;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <utility>
 
 #include "core/error.hpp"
 #include "geometry/polygon.hpp"
@@ -81,7 +82,7 @@ double box_distance_squared(const Eigen::AlignedBox3d& a, const Eigen::AlignedBo
   return d2;
 }
 
-Hierarchy::Hierarchy(const PatchMesh& faces) : faces_(faces) {
+Hierarchy::Hierarchy(PatchMesh faces) : faces_(std::move(faces)) {
   const std::int32_t n = faces_.size();
   if (n == 0) throw SceneError("the scene has no faces");
   geom_ = ff::patch_geometry(faces_);

@@ -44,7 +44,7 @@ struct Node {
 class Hierarchy {
  public:
   /// Root elements from the patches of `faces` (one per face), clusters above them.
-  explicit Hierarchy(const PatchMesh& faces);
+  explicit Hierarchy(PatchMesh faces);
 
   const PatchMesh& faces() const { return faces_; }
   const std::vector<Node>& nodes() const { return nodes_; }

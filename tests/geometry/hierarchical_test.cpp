@@ -148,6 +148,9 @@ TEST(Hierarchical, FurnaceGivesEOverOneMinusRho) {
     // Energy: a closed box lets nothing escape but what its links miss (the same bound, in
     // power: escaped = sent - received over links, each link's power error counted once).
     EXPECT_NEAR(r.stats.energy[0].escaped, 0.0, bound / (1 - 0.5));
+    // The imbalance emitted - absorbed - escaped is sum A (E + rho H - B), the last sweep's
+    // residual: each leaf's B changed by at most tol x max B = 1e-12 x 2, so relative to the
+    // emitted power (= total area x E) it is <= 2e-12 x rho, plus rounding; 1e-9 is margin.
     EXPECT_LT(r.stats.energy[0].relative_imbalance, 1e-9);
   }
 }
@@ -186,14 +189,27 @@ TEST(Hierarchical, LeavesTileTheScene) {
   EXPECT_GT(r.stats.leaves, 6);
 }
 
-TEST(Hierarchical, HangingVerticesOfTheLeafMeshAreFoundAndAnchored) {
+TEST(Hierarchical, HangingVerticesOfTheLeafMeshAreFoundAndOnTheirCoarseEdges) {
   // Adaptive refinement leaves T-vertices; the vertex field anchors them (no cracks).
   Scene s;
   add_polygon(s, "emitter", mat("e", 0, 1), rect(0, 1, 0, 1, 0, true));
   add_polygon(s, "receiver", mat("r", 0.5, 0), rect(0.8, 0.9, 0.05, 0.15, 0.1, false));
   const HierarchicalResult r = solve_hierarchical(s, options(1e-4));
-  const VertexField field = build_shading_vertices(r.mesh);
-  EXPECT_FALSE(find_hanging_vertices(r.mesh, field).empty());
+  const std::vector<HangingVertex> hanging =
+      find_hanging_vertices(r.mesh, build_shading_vertices(r.mesh));
+  ASSERT_FALSE(hanging.empty());
+  // Each hanging vertex's value lies on its coarse edge's interpolant: v = v_a + t (v_b - v_a)
+  // to rounding (a few ulps of the field's magnitude; 1e-12 relative leaves margin).
+  const VertexField field =
+      interpolate_to_vertices(r.mesh, r.B, VertexInterpolation::AreaWeighted);
+  const double scale = field.values.cwiseAbs().maxCoeff();
+  for (const HangingVertex& hv : hanging) {
+    const Eigen::Vector3d va = field.values.row(hv.a), vb = field.values.row(hv.b);
+    const Eigen::Vector3d expected = va + hv.t * (vb - va);
+    EXPECT_LE((field.values.row(hv.vertex).transpose() - expected).cwiseAbs().maxCoeff(),
+              1e-12 * scale)
+        << "shading vertex " << hv.vertex;
+  }
 }
 
 TEST(Hierarchical, NoEmitterGivesZero) {
