@@ -8,6 +8,40 @@ Material grey() { return {"grey", Eigen::Vector3d::Constant(0.5), Eigen::Vector3
 Material lamp() { return {"lamp", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Ones()}; }
 }  // namespace
 
+PartialShadowGeometry partial_shadow_geometry() {
+  PartialShadowGeometry g;
+  g.floor = {{0, 0, 0}, {4, 0, 0}, {4, 4, 0}, {0, 4, 0}};            // faces +z
+  g.light = {{1.5, 1.5, 3}, {1.5, 2.5, 3}, {2.5, 2.5, 3}, {2.5, 1.5, 3}};  // faces -z
+  g.blocker = {{1.6, 1.3, 1.5}, {2.6, 1.3, 1.5}, {2.6, 2.1, 1.5}, {1.6, 2.1, 1.5}};  // +z
+  return g;
+}
+
+Scene partial_shadow_scene() {
+  const PartialShadowGeometry g = partial_shadow_geometry();
+  Scene s;
+  add_polygon(s, "floor", grey(), g.floor);
+  add_polygon(s, "light", {"light", Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()}, g.light);
+  add_polygon(s, "blocker", {"black", Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}, g.blocker);
+  s.camera = framing_camera({0, 0, 0}, {4, 4, 3});
+  return s;
+}
+
+std::pair<std::vector<double>, std::vector<double>> partial_shadow_lines() {
+  const double H = 3.0, hb = 1.5;
+  std::pair<std::vector<double>, std::vector<double>> lines;
+  auto project = [&](std::initializer_list<double> light, std::initializer_list<double> blocker,
+                     std::vector<double>& out) {
+    for (double s : light)
+      for (double b : blocker) {
+        const double c = s + (b - s) * H / (H - hb);
+        if (c > 0 && c < 4) out.push_back(c);
+      }
+  };
+  project({1.5, 2.5}, {1.6, 2.6}, lines.first);
+  project({1.5, 2.5}, {1.3, 2.1}, lines.second);
+  return lines;
+}
+
 Scene parallel_squares(double d) {
   Scene s;
   add_polygon(s, "a", lamp(), {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});  // faces +z

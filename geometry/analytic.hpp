@@ -3,7 +3,9 @@
 // the tests and by `lambert accuracy`. All lengths in metres (unitless), surfaces named
 // "a" and "b" where a pair is involved.
 
+#include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "geometry/scene.hpp"
@@ -38,6 +40,24 @@ constexpr double kCubeAdjacent = 0.20004377607540316;
 Scene coaxial_disks(double r1, double r2, double h, int segments = 64);
 /// Exact F from disk 1 to disk 2 (Howell C-41).
 double coaxial_disks_factor(double r1, double r2, double h);
+
+/// The partial-shadow scene: a grey floor [0, 4]² at z = 0 facing +z ("floor", rho 0.5), a
+/// black square light [1.5, 2.5]² at z = 3 facing -z ("light", rho 0, E = 1) and a black
+/// rectangular blocker [1.6, 2.6] x [1.3, 2.1] at z = 1.5 facing +z ("blocker", rho 0), off
+/// centre so that umbra, penumbra and full light all reach the floor. Since nothing but the
+/// floor reflects, the floor's radiosity is exactly B(x) = 0.5 x F_{dx->light, visible}
+/// (shadowed_point_factor), its D1/D2 lines are the lines x = c or y = c of
+/// partial_shadow_lines, and it has no D0 line.
+Scene partial_shadow_scene();
+/// The light, blocker and floor of partial_shadow_scene as polygons.
+struct PartialShadowGeometry {
+  std::vector<Eigen::Vector3d> light, blocker, floor;
+};
+PartialShadowGeometry partial_shadow_geometry();
+/// The positions c of its D1/D2 lines on the floor, in x (first) and y (second): every
+/// light corner coordinate projected through every blocker edge coordinate,
+/// s + (b - s) H / (H - h_b), that falls inside the floor.
+std::pair<std::vector<double>, std::vector<double>> partial_shadow_lines();
 
 /// An analytic case: its scene and the exact factor from surface "a" to surface "b".
 struct AnalyticCase {

@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/sampling.hpp"
+#include "geometry/discontinuity.hpp"
 #include "geometry/polygon.hpp"
 
 namespace lambert {
@@ -128,6 +129,8 @@ std::int64_t count_patches(const SurfaceElements& s, double max_edge) {
   return total;
 }
 
+}  // namespace
+
 Patch make_patch(const PatchMesh& mesh, std::array<std::int32_t, 4> v, int n) {
   Patch p;
   p.vertices = v;
@@ -153,6 +156,8 @@ Patch make_patch(const PatchMesh& mesh, std::array<std::int32_t, 4> v, int n) {
   p.normal = nrm.normalized();
   return p;
 }
+
+namespace {
 
 // Emits the patches of one surface into `mesh`.
 void subdivide(const SurfaceElements& s, double max_edge, std::int32_t surface,
@@ -315,6 +320,22 @@ PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options) {
     throw UsageError("meshing with max edge " + shortest(max_edge) + " would make " +
                      std::to_string(plan.patches) + " patches (limit " +
                      std::to_string(kMaxPatches) + "): choose a larger --max-edge");
+
+  if (options.discontinuity) {
+    DiscontinuityOptions d;
+    d.secondary_sources = options.discontinuity_sources;
+    d.piece = max_edge / 2.0;  // 0 (one element per face): discontinuity.hpp's default
+    d.threads = options.threads;
+    const std::vector<DiscontinuitySegment> lines = discontinuity_segments(scene, d);
+    PatchMesh mesh = mesh_scene_constrained(scene, max_edge, lines);
+    if (options.max_edge <= 0 && options.target_patches > 0 && max_edge > 0 && mesh.size() > 0) {
+      // Patches scale as 1 / max_edge^2 away from the constraints: one correction step.
+      const double h = max_edge * std::sqrt(static_cast<double>(mesh.size()) /
+                                            static_cast<double>(options.target_patches));
+      mesh = mesh_scene_constrained(scene, h, lines);
+    }
+    return mesh;
+  }
 
   PatchMesh mesh;
   for (const auto& s : scene.surfaces) mesh.surface_names.push_back(s.name);

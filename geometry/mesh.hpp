@@ -47,6 +47,12 @@ constexpr std::int64_t kMaxPatches = 100000000;
 struct MeshOptions {
   double max_edge = 0.0;            ///< longest allowed patch edge, scene units
   std::int64_t target_patches = 0;  ///< approximate total patch count
+  /// Discontinuity meshing (discontinuity.hpp): constrained Delaunay triangles whose edges
+  /// follow the D0 and D1/D2 lines of the emitters (and of the `discontinuity_sources`
+  /// brightest other surfaces), instead of the uniform subdivision.
+  bool discontinuity = false;
+  int discontinuity_sources = 0;
+  int threads = 0;  ///< for the discontinuity lines' visibility rays (0 = all cores)
 };
 
 /// What mesh_scene will build, computed without building it (O(faces) per trial edge).
@@ -64,7 +70,15 @@ double mesh_peak_bytes(std::int64_t patches);
 /// n = ceil(L / max_edge) segments, raised until every triangle has equal counts on its
 /// three edges and every quad on opposite edges (a monotone fixpoint), so neighbours agree.
 /// Throws UsageError if the mesh would exceed kMaxPatches. Complexity O(faces + patches).
+/// With options.discontinuity, every surface is meshed by mesh_scene_constrained with the
+/// edge bound planned as above (for a patch target, corrected once by the ratio of the
+/// patches made to the target: the target is met approximately).
 PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options);
+
+/// A patch over mesh vertices v[0..n) (n = 3 or 4, counter-clockwise about the front
+/// normal): its area, unit normal and area centroid; rho, emission and surface are left to
+/// the caller.
+Patch make_patch(const PatchMesh& mesh, std::array<std::int32_t, 4> v, int n);
 
 /// A stable 64-bit hash of the meshed geometry (vertices, patches, surfaces), which is all
 /// F depends on; materials may change without invalidating a saved F.

@@ -8,6 +8,9 @@
 
 namespace lambert {
 
+/// A polygon in 3-D as its corners in order.
+using Polygon3 = std::vector<Eigen::Vector3d>;
+
 /// Newell's normal of a polygon: a vector of length 2*area along the front normal
 /// (counter-clockwise winding), robust for any simple planar polygon. Its length
 /// overflows for coordinates beyond ~1e154; polygon_area does not.

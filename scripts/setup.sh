@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 preset="${1:-release}"
 
 packages=(build-essential cmake pkg-config libembree-dev libeigen3-dev libopenexr-dev
-          libgtest-dev libcli11-dev zlib1g-dev nlohmann-json3-dev)
+          libgtest-dev libcli11-dev zlib1g-dev nlohmann-json3-dev libcgal-dev)
 # The fuzz preset builds with clang and links libFuzzer (from libclang-rt).
 [[ "$preset" == fuzz ]] && packages+=(clang libclang-rt-14-dev)
 missing=()

@@ -59,7 +59,7 @@ int clip_to_horizon(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const P
   return m;
 }
 
-double contour_factor(const Eigen::Vector3d& nx, const Eigen::Vector3d* r, int m) {
+double contour_sum(const Eigen::Vector3d& nx, const Eigen::Vector3d* r, int m) {
   double sum = 0.0;
   for (int k = 0; k < m; ++k) {
     const Eigen::Vector3d& a = r[k];
@@ -69,7 +69,11 @@ double contour_factor(const Eigen::Vector3d& nx, const Eigen::Vector3d* r, int m
     if (cn <= 0.0) continue;
     sum += std::atan2(cn, a.dot(b)) * nx.dot(c) / cn;
   }
-  return std::max(0.0, -sum / (2.0 * M_PI));
+  return sum;
+}
+
+double contour_factor(const Eigen::Vector3d& nx, const Eigen::Vector3d* r, int m) {
+  return std::max(0.0, -contour_sum(nx, r, m) / (2.0 * M_PI));
 }
 
 double point_to_patch(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& g) {

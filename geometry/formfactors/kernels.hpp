@@ -69,6 +69,11 @@ int clip_to_horizon(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const P
 /// respected, and is 0 when x lies behind the polygon's plane (only its front receives).
 double point_to_patch(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& g);
 
+/// The signed sum Σ_k θ_k n_x · (r_k × r_{k+1}) / |r_k × r_{k+1}| over one closed loop r[0..m)
+/// (relative to x): -1/(2π) times it is the loop's factor, and loops add (holes wound
+/// the other way subtract).
+double contour_sum(const Eigen::Vector3d& nx, const Eigen::Vector3d* r, int m);
+
 /// The contour sum of point_to_patch over a polygon already clipped to x's horizon, given
 /// by its corners r[0..m) relative to x.
 double contour_factor(const Eigen::Vector3d& nx, const Eigen::Vector3d* r, int m);

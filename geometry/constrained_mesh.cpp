@@ -1,0 +1,493 @@
+// Constrained Delaunay meshing of each planar part of every surface (CGAL Mesh_2), with the
+// discontinuity lines as constraints (see discontinuity.hpp).
+
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Delaunay_mesh_face_base_2.h>
+#include <CGAL/Delaunay_mesh_size_criteria_2.h>
+#include <CGAL/Delaunay_mesh_vertex_base_2.h>
+#include <CGAL/Delaunay_mesher_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "geometry/discontinuity.hpp"
+#include "geometry/polygon.hpp"
+
+namespace lambert {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Vb = CGAL::Delaunay_mesh_vertex_base_2<K>;
+using Fb = CGAL::Delaunay_mesh_face_base_2<K>;
+using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
+// Exact_predicates_tag: constraints may cross (discontinuity lines do); crossing points are
+// constructed in double, every predicate is exact. Nearly coincident constraints (the same
+// wedge line found from two events, a line ending on another) would make features at the
+// rounding scale, which Delaunay refinement cannot resolve: clean_segments merges them first.
+using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
+using Criteria = CGAL::Delaunay_mesh_size_criteria_2<CDT>;
+using Mesher = CGAL::Delaunay_mesher_2<CDT, Criteria>;
+using Point2 = K::Point_2;
+
+// CGAL's shape bound: the squared sine of the smallest allowed angle, sin²(20.7°) = 0.125.
+const double kShapeBound = std::pow(std::sin(kMinAngleDegrees * M_PI / 180.0), 2.0);
+// Faces whose normals agree this closely and whose planes are this close (relative to the
+// scene's size) are one planar part of a surface, meshed by one triangulation.
+constexpr double kSameNormal = 1e-12;
+constexpr double kSamePlane = 1e-9;
+// A vertex this close (relative to the edge's length) to a crease edge lies on it.
+constexpr double kOnEdge = 1e-9;
+// Constraint features closer than this (relative to the part's extent) are merged.
+constexpr double kSnap = 1e-6;
+
+using Key3 = std::array<double, 3>;
+Key3 key(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
+
+struct Triangle {
+  std::array<Eigen::Vector3d, 3> p;
+  std::int32_t face = 0;
+};
+
+// A planar part of a surface: its faces and its frame (u x v = w, the front normal).
+struct Part {
+  std::vector<std::int32_t> faces;
+  Eigen::Vector3d o, u, v, w;
+  Point2 to2d(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d r = p - o;
+    return {r.dot(u), r.dot(v)};
+  }
+};
+
+Polygon3 face_polygon(const Scene& scene, std::int32_t f) {
+  Polygon3 poly;
+  for (auto v : scene.faces[f].vertices) poly.push_back(scene.vertices[v]);
+  return poly;
+}
+
+std::vector<Part> planar_parts(const Scene& scene, std::int32_t surface, double scale) {
+  std::vector<Part> parts;
+  for (size_t f = 0; f < scene.faces.size(); ++f) {
+    if (scene.faces[f].surface != surface) continue;
+    const Polygon3 poly = face_polygon(scene, static_cast<std::int32_t>(f));
+    if (!(polygon_area(poly) > 0.0)) continue;
+    const Eigen::Vector3d n = newell_normal(poly).normalized();
+    Part* part = nullptr;
+    for (auto& p : parts) {
+      bool coplanar = p.w.dot(n) > 1.0 - kSameNormal;
+      for (const auto& c : poly) coplanar = coplanar && std::abs((c - p.o).dot(p.w)) <= kSamePlane * scale;
+      if (coplanar) {
+        part = &p;
+        break;
+      }
+    }
+    if (!part) {
+      Part p;
+      p.o = poly[0];
+      p.w = n;
+      Eigen::Vector3d e = Eigen::Vector3d::Zero();
+      for (const auto& c : poly)
+        if ((c - poly[0]).squaredNorm() > e.squaredNorm()) e = c - poly[0];
+      p.u = (e - e.dot(n) * n).normalized();
+      p.v = n.cross(p.u);
+      parts.push_back(p);
+      part = &parts.back();
+    }
+    part->faces.push_back(static_cast<std::int32_t>(f));
+  }
+  return parts;
+}
+
+// Constraint segments in a part's plane, cleaned so that no two features are closer than
+// `snap` unless they coincide: endpoints within `snap` of an earlier point are that point,
+// segments on one line (both ends within `snap` of it) are replaced by the chain of their
+// sorted endpoints, each link kept where some segment covers it, and a segment passing
+// within `snap` of another's endpoint is split there. Face edges come first, so their
+// corners are kept exactly.
+std::vector<std::array<Point2, 2>> clean_segments(const std::vector<std::array<Point2, 2>>& in,
+                                                  double snap) {
+  constexpr double kSameDirection = 1e-6;  // angle bucket (radians)
+  // Points, found by a hash grid of cell `snap` (the 3 x 3 cells around a point).
+  std::vector<Eigen::Vector2d> points;
+  std::map<std::pair<long long, long long>, std::vector<size_t>> grid;
+  auto cell = [&](double x) { return static_cast<long long>(std::floor(x / snap)); };
+  auto snapped = [&](const Point2& p) {
+    const Eigen::Vector2d q(p.x(), p.y());
+    const long long cx = cell(q.x()), cy = cell(q.y());
+    for (long long i = cx - 1; i <= cx + 1; ++i)
+      for (long long j = cy - 1; j <= cy + 1; ++j) {
+        const auto it = grid.find({i, j});
+        if (it == grid.end()) continue;
+        for (size_t k : it->second)
+          if ((points[k] - q).norm() <= snap) return points[k];
+      }
+    grid[{cx, cy}].push_back(points.size());
+    points.push_back(q);
+    return q;
+  };
+  struct Seg {
+    Eigen::Vector2d a, b;
+  };
+  std::vector<Seg> segs;
+  for (const auto& s : in) {
+    const Eigen::Vector2d a = snapped(s[0]), b = snapped(s[1]);
+    if (a != b) segs.push_back({a, b});
+  }
+  // Lines by (direction angle in (-π/2, π/2], offset) buckets; neighbours are checked.
+  auto line_of = [&](const Seg& g, double& angle, double& offset) {
+    Eigen::Vector2d d = (g.b - g.a).normalized();
+    if (d.x() < 0 || (d.x() == 0 && d.y() < 0)) d = -d;
+    angle = std::atan2(d.y(), d.x());
+    offset = Eigen::Vector2d(-d.y(), d.x()).dot(g.a);
+  };
+  std::map<std::pair<long long, long long>, std::vector<size_t>> lines;
+  auto bucket = [&](double angle, double offset) {
+    return std::make_pair(static_cast<long long>(std::floor(angle / kSameDirection)), cell(offset));
+  };
+  for (size_t i = 0; i < segs.size(); ++i) {
+    double angle, offset;
+    line_of(segs[i], angle, offset);
+    lines[bucket(angle, offset)].push_back(i);
+  }
+  std::vector<char> used(segs.size(), 0);
+  std::vector<std::array<Point2, 2>> out;
+  for (size_t i = 0; i < segs.size(); ++i) {
+    if (used[i]) continue;
+    const Eigen::Vector2d o = segs[i].a, d = (segs[i].b - segs[i].a).normalized();
+    const Eigen::Vector2d nrm(-d.y(), d.x());
+    double angle, offset;
+    line_of(segs[i], angle, offset);
+    std::vector<size_t> group;
+    auto visit = [&](double ang, double off) {
+      const auto [ba, bo] = bucket(ang, off);
+      for (long long x = ba - 1; x <= ba + 1; ++x)
+        for (long long y = bo - 1; y <= bo + 1; ++y) {
+          const auto it = lines.find({x, y});
+          if (it == lines.end()) continue;
+          for (size_t j : it->second) {
+            if (used[j]) continue;
+            if (std::abs(nrm.dot(segs[j].a - o)) > snap || std::abs(nrm.dot(segs[j].b - o)) > snap) continue;
+            used[j] = 1;
+            group.push_back(j);
+          }
+        }
+    };
+    visit(angle, offset);
+    if (std::abs(angle) > M_PI / 2 - 1e-6) visit(angle > 0 ? angle - M_PI : angle + M_PI, -offset);
+    std::vector<std::pair<double, Eigen::Vector2d>> ends;
+    for (size_t j : group)
+      for (const auto& p : {segs[j].a, segs[j].b}) ends.push_back({d.dot(p - o), p});
+    std::sort(ends.begin(), ends.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    std::vector<std::pair<double, Eigen::Vector2d>> chain;
+    for (const auto& e : ends)
+      if (chain.empty() || e.first - chain.back().first > snap) chain.push_back(e);
+    for (size_t k = 0; k + 1 < chain.size(); ++k) {
+      const double mid = 0.5 * (chain[k].first + chain[k + 1].first);
+      bool covered = false;
+      for (size_t j : group) {
+        const double ta = d.dot(segs[j].a - o), tb = d.dot(segs[j].b - o);
+        covered = covered || (mid > std::min(ta, tb) && mid < std::max(ta, tb));
+      }
+      if (covered)
+        out.push_back({Point2(chain[k].second.x(), chain[k].second.y()),
+                       Point2(chain[k + 1].second.x(), chain[k + 1].second.y())});
+    }
+  }
+  // T-junctions: split a segment whose interior passes within `snap` of an endpoint.
+  std::vector<Eigen::Vector2d> ends;
+  for (const auto& s : out)
+    for (const auto& p : s) ends.emplace_back(p.x(), p.y());
+  std::sort(ends.begin(), ends.end(), [](const auto& a, const auto& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+  std::vector<std::array<Point2, 2>> split;
+  for (const auto& s : out) {
+    const Eigen::Vector2d a(s[0].x(), s[0].y()), b(s[1].x(), s[1].y());
+    const Eigen::Vector2d d = b - a;
+    const double len2 = d.squaredNorm();
+    std::vector<std::pair<double, Eigen::Vector2d>> cuts;
+    const double xlo = std::min(a.x(), b.x()) - snap, xhi = std::max(a.x(), b.x()) + snap;
+    const double ylo = std::min(a.y(), b.y()) - snap, yhi = std::max(a.y(), b.y()) + snap;
+    auto first = std::lower_bound(ends.begin(), ends.end(), Eigen::Vector2d(xlo, -INFINITY),
+                                  [](const auto& p, const auto& q) { return p.x() < q.x(); });
+    for (auto it = first; it != ends.end() && it->x() <= xhi; ++it) {
+      const Eigen::Vector2d& p = *it;
+      if (p.y() < ylo || p.y() > yhi || p == a || p == b) continue;
+      const double t = (p - a).dot(d) / len2;
+      if (t <= 0 || t >= 1 || (a + t * d - p).norm() > snap) continue;
+      cuts.push_back({t, p});
+    }
+    std::sort(cuts.begin(), cuts.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    Eigen::Vector2d from = a;
+    for (const auto& c : cuts) {
+      split.push_back({Point2(from.x(), from.y()), Point2(c.second.x(), c.second.y())});
+      from = c.second;
+    }
+    split.push_back({Point2(from.x(), from.y()), s[1]});
+  }
+  return split;
+}
+
+// Triangles of one planar part, meshed by a refined constrained Delaunay triangulation.
+std::vector<Triangle> mesh_part(const Scene& scene, const Part& part, double max_edge,
+                                const std::vector<const DiscontinuitySegment*>& lines) {
+  CDT cdt;
+  std::map<std::pair<double, double>, Eigen::Vector3d> corners;  // exact 3-D input corners
+  // Each face as triangles in 2-D, for the point-in-face tests.
+  std::vector<std::vector<std::array<Point2, 3>>> face_tris;
+  std::vector<std::array<Point2, 2>> segments;  // face edges first, then the lines
+  for (auto f : part.faces) {
+    const Polygon3 poly = face_polygon(scene, f);
+    std::vector<Point2> pts;
+    for (const auto& c : poly) {
+      pts.push_back(part.to2d(c));
+      corners.emplace(std::make_pair(CGAL::to_double(pts.back().x()), CGAL::to_double(pts.back().y())), c);
+    }
+    for (size_t k = 0; k < pts.size(); ++k) segments.push_back({pts[k], pts[(k + 1) % pts.size()]});
+    std::vector<std::array<Point2, 3>> tris;
+    if (poly.size() == 3) tris.push_back({pts[0], pts[1], pts[2]});
+    else
+      for (const auto& t : triangulate(poly)) tris.push_back({pts[t[0]], pts[t[1]], pts[t[2]]});
+    face_tris.push_back(std::move(tris));
+  }
+  for (const auto* s : lines) segments.push_back({part.to2d(s->a), part.to2d(s->b)});
+  double extent = 0;
+  for (const auto& s : segments) extent = std::max({extent, std::abs(s[0].x()), std::abs(s[0].y())});
+  for (const auto& s : clean_segments(segments, kSnap * std::max(extent, 1e-300))) {
+    cdt.insert_constraint(s[0], s[1]);
+  }
+  // The face containing a point (exact orientation tests against its triangles), or -1.
+  auto face_at = [&](const Point2& c) -> int {
+    for (size_t f = 0; f < face_tris.size(); ++f) {
+      for (const auto& t : face_tris[f]) {
+        const auto o = CGAL::orientation(t[0], t[1], t[2]);
+        if (o == CGAL::COLLINEAR) continue;
+        if (CGAL::orientation(t[0], t[1], c) != -o && CGAL::orientation(t[1], t[2], c) != -o &&
+            CGAL::orientation(t[2], t[0], c) != -o)
+          return static_cast<int>(f);
+      }
+    }
+    return -1;
+  };
+  auto centroid = [](CDT::Face_handle fh) {
+    return CGAL::centroid(fh->vertex(0)->point(), fh->vertex(1)->point(), fh->vertex(2)->point());
+  };
+  // Seeds: one point in each region (faces connected across unconstrained edges) that lies
+  // outside every face (holes, concavities, the rest of the convex hull); the mesher
+  // refines the other regions.
+  std::vector<Point2> seeds;
+  std::set<CDT::Face_handle> seen;
+  for (auto start : cdt.finite_face_handles()) {
+    if (seen.count(start)) continue;
+    const bool inside = face_at(centroid(start)) >= 0;
+    if (!inside) seeds.push_back(centroid(start));
+    std::vector<CDT::Face_handle> stack{start};
+    seen.insert(start);
+    while (!stack.empty()) {
+      const auto fh = stack.back();
+      stack.pop_back();
+      for (int i = 0; i < 3; ++i) {
+        const auto nb = fh->neighbor(i);
+        if (fh->is_constrained(i) || cdt.is_infinite(nb) || seen.count(nb)) continue;
+        seen.insert(nb);
+        stack.push_back(nb);
+      }
+    }
+  }
+  Mesher mesher(cdt, Criteria(kShapeBound, max_edge));
+  mesher.set_seeds(seeds.begin(), seeds.end(), /*mark=*/false);
+  mesher.init(/*domain_specified=*/false);
+  // A vertex budget: the size bound alone needs about 2 A / (h² sin 60°) vertices; beyond
+  // 16 times that (and 64 per input vertex), the refinement is chasing features at the
+  // rounding scale (constraints crossing at tiny angles, self-intersecting faces), and stops
+  // with a warning: the mesh is still valid and conforming, some triangles are thin.
+  double area = 0;
+  for (auto fh : cdt.finite_face_handles())
+    if (fh->is_in_domain()) area += std::abs(CGAL::to_double(cdt.triangle(fh).area()));
+  const double budget = 64.0 * static_cast<double>(cdt.number_of_vertices()) + 1000.0 +
+                        (max_edge > 0 ? 16.0 * 2.0 * area / (max_edge * max_edge * 0.866) : 0.0);
+  while (!mesher.is_refinement_done()) {
+    if (static_cast<double>(cdt.number_of_vertices()) > budget) {
+      log_warn("discontinuity meshing: stopped refining a plane of surface '" +
+               scene.surfaces[scene.faces[part.faces[0]].surface].name + "' at " +
+               std::to_string(cdt.number_of_vertices()) +
+               " vertices (constraints meet at angles or distances too small to resolve); some "
+               "triangles there are thinner than the " + std::to_string(kMinAngleDegrees).substr(0, 4) +
+               " degree bound");
+      break;
+    }
+    mesher.step_by_step_refine_mesh();
+  }
+
+  std::vector<Triangle> out;
+  for (auto fh : cdt.finite_face_handles()) {
+    if (!fh->is_in_domain()) continue;
+    const int f = face_at(centroid(fh));
+    if (f < 0) continue;
+    Triangle t;
+    t.face = part.faces[f];
+    for (int k = 0; k < 3; ++k) {
+      const Point2& q = fh->vertex(k)->point();
+      const double x = CGAL::to_double(q.x()), y = CGAL::to_double(q.y());
+      const auto it = corners.find({x, y});
+      t.p[k] = it != corners.end() ? it->second : Eigen::Vector3d(part.o + x * part.u + y * part.v);
+    }
+    out.push_back(t);
+  }
+  return out;
+}
+
+// Makes the triangles of a folded surface conforming across its creases: every vertex on a
+// crease edge (one shared by faces of two planar parts) is put on the edge exactly and
+// inserted into the triangles of the other side by fan splits.
+void conform_creases(const Scene& scene, const std::vector<Part>& parts, std::vector<Triangle>& tris) {
+  if (parts.size() < 2) return;
+  std::map<std::array<Key3, 2>, std::pair<int, std::array<Eigen::Vector3d, 2>>> edge_part;
+  std::vector<std::array<Eigen::Vector3d, 2>> creases;
+  std::map<std::array<Key3, 2>, char> is_crease;
+  for (size_t pi = 0; pi < parts.size(); ++pi) {
+    for (auto f : parts[pi].faces) {
+      const Polygon3 poly = face_polygon(scene, f);
+      for (size_t k = 0; k < poly.size(); ++k) {
+        Eigen::Vector3d a = poly[k], b = poly[(k + 1) % poly.size()];
+        if (key(b) < key(a)) std::swap(a, b);
+        const std::array<Key3, 2> e{key(a), key(b)};
+        const auto it = edge_part.emplace(e, std::make_pair(static_cast<int>(pi), std::array<Eigen::Vector3d, 2>{a, b}));
+        if (!it.second && it.first->second.first != static_cast<int>(pi) && !is_crease[e]) {
+          is_crease[e] = 1;
+          creases.push_back({a, b});
+        }
+      }
+    }
+  }
+  if (creases.empty()) return;
+  // Parameters of the vertices on each crease, merged across sides.
+  std::vector<std::vector<double>> us(creases.size());
+  std::map<Key3, std::vector<std::pair<int, double>>> on;  // vertex -> (crease, u)
+  auto param = [&](size_t c, const Eigen::Vector3d& x, double& u) {
+    const Eigen::Vector3d d = creases[c][1] - creases[c][0];
+    u = (x - creases[c][0]).dot(d) / d.squaredNorm();
+    return (x - creases[c][0] - u * d).norm() <= kOnEdge * d.norm() && u > -kOnEdge && u < 1 + kOnEdge;
+  };
+  for (const auto& t : tris) {
+    for (const auto& x : t.p) {
+      for (size_t c = 0; c < creases.size(); ++c) {
+        double u;
+        if (param(c, x, u)) us[c].push_back(std::clamp(u, 0.0, 1.0));
+      }
+    }
+  }
+  std::vector<std::vector<Eigen::Vector3d>> points(creases.size());
+  for (size_t c = 0; c < creases.size(); ++c) {
+    auto& u = us[c];
+    u.push_back(0.0);
+    u.push_back(1.0);
+    std::sort(u.begin(), u.end());
+    std::vector<double> merged;
+    for (double x : u)
+      if (merged.empty() || x - merged.back() > kOnEdge) merged.push_back(x);
+    merged.back() = 1.0;
+    u = merged;
+    for (double x : u)
+      points[c].push_back(x == 0.0   ? creases[c][0]
+                          : x == 1.0 ? creases[c][1]
+                                     : Eigen::Vector3d(creases[c][0] + x * (creases[c][1] - creases[c][0])));
+  }
+  // Snap every vertex on a crease to its canonical point and record (crease, index).
+  for (auto& t : tris) {
+    for (auto& x : t.p) {
+      for (size_t c = 0; c < creases.size(); ++c) {
+        double u;
+        if (!param(c, x, u)) continue;
+        const auto it = std::lower_bound(us[c].begin(), us[c].end(), std::clamp(u, 0.0, 1.0) - kOnEdge);
+        const int i = static_cast<int>(std::min<std::ptrdiff_t>(it - us[c].begin(), us[c].size() - 1));
+        x = points[c][i];
+        on[key(x)].push_back({static_cast<int>(c), static_cast<double>(i)});
+      }
+    }
+  }
+  // Fan-split triangles whose edge on a crease skips crease points.
+  std::vector<Triangle> work = std::move(tris), done;
+  while (!work.empty()) {
+    Triangle t = work.back();
+    work.pop_back();
+    bool split = false;
+    for (int k = 0; k < 3 && !split; ++k) {
+      const auto ia = on.find(key(t.p[k])), ib = on.find(key(t.p[(k + 1) % 3]));
+      if (ia == on.end() || ib == on.end()) continue;
+      for (const auto& [ca, ua] : ia->second) {
+        for (const auto& [cb, ub] : ib->second) {
+          if (ca != cb || std::abs(ua - ub) <= 1.0) continue;
+          const int c = ca, step = ub > ua ? 1 : -1;
+          const Eigen::Vector3d opposite = t.p[(k + 2) % 3];
+          for (int i = static_cast<int>(ua); i != static_cast<int>(ub); i += step)
+            work.push_back({{points[c][i], points[c][i + step], opposite}, t.face});
+          split = true;
+          break;
+        }
+        if (split) break;
+      }
+    }
+    if (!split) done.push_back(t);
+  }
+  tris = std::move(done);
+}
+
+}  // namespace
+
+PatchMesh mesh_scene_constrained(const Scene& scene, double max_edge,
+                                 const std::vector<DiscontinuitySegment>& constraints) {
+  PatchMesh mesh;
+  for (const auto& s : scene.surfaces) mesh.surface_names.push_back(s.name);
+  const auto [lo, hi] = scene.bounds();
+  mesh.max_edge = max_edge;
+  mesh.scale = scene.faces.empty() ? 1.0 : std::max((hi - lo).norm(), 1e-300);
+  std::vector<std::vector<const DiscontinuitySegment*>> by_face(scene.faces.size());
+  for (const auto& s : constraints) by_face.at(s.face).push_back(&s);
+  for (size_t s = 0; s < scene.surfaces.size(); ++s) {
+    const auto surface = static_cast<std::int32_t>(s);
+    const std::vector<Part> parts = planar_parts(scene, surface, mesh.scale);
+    std::vector<Triangle> tris;
+    for (const auto& part : parts) {
+      std::vector<const DiscontinuitySegment*> lines;
+      for (auto f : part.faces) lines.insert(lines.end(), by_face[f].begin(), by_face[f].end());
+      const auto part_tris = mesh_part(scene, part, max_edge, lines);
+      tris.insert(tris.end(), part_tris.begin(), part_tris.end());
+    }
+    conform_creases(scene, parts, tris);
+    // Weld by exact position within the surface and emit.
+    std::map<Key3, std::int32_t> ids;
+    const Material& mat = scene.material_of(surface);
+    for (const auto& t : tris) {
+      std::array<std::int32_t, 4> v{};
+      for (int k = 0; k < 3; ++k) {
+        const auto it = ids.emplace(key(t.p[k]), static_cast<std::int32_t>(mesh.vertices.size()));
+        if (it.second) {
+          mesh.vertices.push_back(t.p[k]);
+          mesh.vertex_surface.push_back(surface);
+        }
+        v[k] = it.first->second;
+      }
+      if (v[0] == v[1] || v[1] == v[2] || v[2] == v[0]) continue;
+      Patch p = make_patch(mesh, v, 3);
+      if (!(p.area > 0.0)) continue;
+      const Face& face = scene.faces[t.face];
+      p.rho = face.rho ? *face.rho : mat.rho;
+      p.emission = mat.emission;
+      p.surface = surface;
+      mesh.patches.push_back(p);
+      if (mesh.patches.size() > static_cast<size_t>(kMaxPatches))
+        throw UsageError("discontinuity meshing made more than " + std::to_string(kMaxPatches) +
+                         " patches: choose a larger --max-edge");
+    }
+  }
+  return mesh;
+}
+
+}  // namespace lambert

@@ -1,0 +1,126 @@
+// Discontinuity lines and the constrained Delaunay mesh (discontinuity.hpp).
+#include "geometry/discontinuity.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "geometry/analytic.hpp"
+#include "geometry/polygon.hpp"
+#include "common/mesh_checks.hpp"
+
+namespace lambert {
+namespace {
+
+using test::expect_conforming;
+using test::min_angle;
+using test::scene_face_area;
+
+TEST(DiscontinuityLines, LieOnTheAnalyticWedgesOfThePartialShadowScene) {
+  const Scene scene = partial_shadow_scene();
+  const auto [xs, ys] = partial_shadow_lines();
+  const auto segs = discontinuity_segments(scene, {});
+  std::set<double> seen_x, seen_y;
+  int on_floor = 0;
+  for (const auto& s : segs) {
+    if (s.face != 0) continue;  // the floor
+    ++on_floor;
+    EXPECT_EQ(s.order, 1);  // nothing touches the floor: no D0 line
+    EXPECT_NEAR(s.a.z(), 0.0, 1e-15);
+    EXPECT_NEAR(s.b.z(), 0.0, 1e-15);
+    // Each line is x = c or y = c for one of the analytic c, to 1e-9 relative (4: the
+    // floor's size; the construction's rounding is ~1e-15).
+    bool matched = false;
+    for (double c : xs)
+      if (std::abs(s.a.x() - c) <= 4e-9 && std::abs(s.b.x() - c) <= 4e-9) matched = true, seen_x.insert(c);
+    for (double c : ys)
+      if (std::abs(s.a.y() - c) <= 4e-9 && std::abs(s.b.y() - c) <= 4e-9) matched = true, seen_y.insert(c);
+    EXPECT_TRUE(matched) << "(" << s.a.transpose() << ") - (" << s.b.transpose() << ")";
+  }
+  EXPECT_GT(on_floor, 0);
+  EXPECT_EQ(seen_x.size(), xs.size());  // every analytic line was found
+  EXPECT_EQ(seen_y.size(), ys.size());
+}
+
+TEST(DiscontinuityMesh, FollowsTheLinesConformsAndPreservesArea) {
+  const Scene scene = partial_shadow_scene();
+  MeshOptions mo;
+  mo.max_edge = 0.3;
+  mo.discontinuity = true;
+  const PatchMesh m = mesh_scene(scene, mo);
+  expect_conforming(m);
+  std::vector<double> area(scene.surfaces.size(), 0);
+  for (const auto& p : m.patches) {
+    area[p.surface] += p.area;
+    EXPECT_EQ(p.vertex_count, 3);
+    for (int k = 0; k < 3; ++k)  // the edge bound (CGAL's size criterion, all edges)
+      EXPECT_LE((m.vertices[p.vertices[k]] - m.vertices[p.vertices[(k + 1) % 3]]).norm(), 0.3 * (1 + 1e-12));
+  }
+  // Area is preserved: the triangles tile each face (to rounding, 1e-12 relative).
+  for (size_t s = 0; s < area.size(); ++s)
+    EXPECT_NEAR(area[s], scene_face_area(scene, static_cast<int>(s)), 1e-12 * area[s]);
+  // No floor triangle straddles an analytic D1/D2 line where the line was found (the lines
+  // are patch edges): test each line at its extent, the union of its segments.
+  const auto [xs, ys] = partial_shadow_lines();
+  const auto segs = discontinuity_segments(scene, {});
+  int straddling = 0, checked = 0;
+  for (const auto& s : segs) {
+    if (s.face != 0) continue;
+    const bool vertical = std::abs(s.a.x() - s.b.x()) < 1e-9;
+    const double c = vertical ? s.a.x() : s.a.y();
+    const double lo = vertical ? std::min(s.a.y(), s.b.y()) : std::min(s.a.x(), s.b.x());
+    const double hi = vertical ? std::max(s.a.y(), s.b.y()) : std::max(s.a.x(), s.b.x());
+    for (const auto& p : m.patches) {
+      if (p.surface != 0) continue;
+      const double along = vertical ? p.centroid.y() : p.centroid.x();
+      if (along <= lo || along >= hi) continue;
+      double below = 0, above = 0;
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3d& v = m.vertices[p.vertices[k]];
+        const double d = (vertical ? v.x() : v.y()) - c;
+        below = std::min(below, d);
+        above = std::max(above, d);
+      }
+      ++checked;
+      if (below < -1e-9 && above > 1e-9) ++straddling;
+    }
+  }
+  EXPECT_GT(checked, 0);
+  EXPECT_EQ(straddling, 0);
+  // Quality: every triangle's smallest angle is at least the refinement bound, except where
+  // two constraints meet at a smaller angle (here all lines are axis-parallel or floor
+  // edges, so none: the bound holds everywhere, to rounding).
+  double worst = 180;
+  for (const auto& p : m.patches) worst = std::min(worst, min_angle(m, p));
+  EXPECT_GE(worst, kMinAngleDegrees - 1e-6);
+}
+
+TEST(DiscontinuityMesh, SelfIntersectingAndNonManifoldBlockersStillMesh) {
+  Scene scene = partial_shadow_scene();
+  const Material black{"black", Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  // A bow-tie face, three faces sharing one edge (non-manifold) and a fin piercing the floor.
+  add_polygon(scene, "bowtie", black, {{0.5, 0.5, 1}, {1.2, 1.2, 1}, {1.2, 0.5, 1}, {0.5, 1.2, 1}});
+  for (double ang : {0.0, 2.0, 4.0})
+    add_polygon(scene, "fan", black,
+                {{3, 3, 0.5}, {3, 3.8, 0.5}, {3 + 0.4 * std::cos(ang), 3.4, 0.5 + 0.4 * std::sin(ang)}});
+  add_polygon(scene, "fin", black, {{0.5, 3.0, -0.3}, {1.5, 3.0, -0.3}, {1.5, 3.0, 0.6}, {0.5, 3.0, 0.6}});
+  MeshOptions mo;
+  mo.max_edge = 0.4;
+  mo.discontinuity = true;
+  const PatchMesh m = mesh_scene(scene, mo);
+  ASSERT_GT(m.size(), 0);
+  for (const auto& p : m.patches) EXPECT_GT(p.area, 0.0);
+  expect_conforming(m, /*manifold=*/false);
+  // The fin pierces the floor: a D0 line along y = 3 on the floor.
+  bool pierced = false;
+  for (const auto& s : discontinuity_segments(scene, {}))
+    pierced = pierced || (s.order == 0 && s.face == 0 && std::abs(s.a.y() - 3) < 1e-12 &&
+                          std::abs(s.b.y() - 3) < 1e-12);
+  EXPECT_TRUE(pierced);
+}
+
+}  // namespace
+}  // namespace lambert
