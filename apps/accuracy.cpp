@@ -87,13 +87,6 @@ std::vector<double> surface_areas(const PatchMesh& mesh) {
   return a;
 }
 
-MeshOptions mesh_options(const SceneArgs& args) {
-  MeshOptions mo;
-  mo.max_edge = args.max_edge;
-  mo.target_patches = args.patches > 0 || args.max_edge > 0 ? args.patches : args.default_patches;
-  return mo;
-}
-
 // Meshes a built-in case after the plan's checks (load_scene does the same for files).
 PatchMesh mesh_case(const Scene& scene, const SceneArgs& args, const JobPlan& plan) {
   check_job_files({}, plan.outputs);

@@ -224,6 +224,15 @@ void add_scene_options(CLI::App* cmd, SceneArgs& args) {
   cmd->add_option("--patches", args.patches, "Approximate total number of patches")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{100000000}))
       ->excludes(edge);
+  auto* disc = cmd->add_flag(
+      "--discontinuity", args.discontinuity,
+      "Discontinuity meshing: constrained Delaunay triangles whose edges follow the contact "
+      "lines of blockers (D0) and the penumbra and umbra boundaries (D1/D2) of the emitters");
+  cmd->add_option("--discontinuity-sources", args.discontinuity_sources,
+                  "With --discontinuity, also trace the shadows of the N non-emitting surfaces "
+                  "that reflect the most direct light (default 0)")
+      ->check(CLI::Range(0, 1000))
+      ->needs(disc);
 }
 
 void add_run_options(CLI::App* cmd, RunArgs& args) {
@@ -302,15 +311,24 @@ Scene load_checked_scene(const SceneArgs& args, const JobPlan& plan) {
   return scene;
 }
 
-LoadedScene load_scene(const SceneArgs& args, const JobPlan& plan) {
-  LoadedScene out;
-  out.scene = load_checked_scene(args, plan);
+MeshOptions mesh_options(const SceneArgs& args) {
   MeshOptions mo;
   mo.max_edge = args.max_edge;
   mo.target_patches = args.patches > 0 || args.max_edge > 0 ? args.patches : args.default_patches;
+  mo.discontinuity = args.discontinuity;
+  mo.discontinuity_sources = args.discontinuity_sources;
+  return mo;
+}
+
+LoadedScene load_scene(const SceneArgs& args, const JobPlan& plan) {
+  LoadedScene out;
+  out.scene = load_checked_scene(args, plan);
+  MeshOptions mo = mesh_options(args);
   const MeshPlan mesh_plan = plan_mesh(out.scene, mo);
   if (mesh_plan.patches <= kMaxPatches) check_job_memory(mesh_plan.patches, plan);
-  mo.max_edge = mesh_plan.max_edge;  // planned: mesh_scene need not search again
+  // Planned: mesh_scene need not search again (discontinuity meshing plans its own
+  // correction from the target).
+  if (!mo.discontinuity) mo.max_edge = mesh_plan.max_edge;
   out.mesh = mesh_scene(out.scene, mo);
   out.max_edge = out.mesh.max_edge;
   return out;

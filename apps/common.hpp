@@ -24,6 +24,8 @@ struct SceneArgs {
   double max_edge = 0.0;             ///< --max-edge
   std::int64_t patches = 0;          ///< --patches
   std::int64_t default_patches = 0;  ///< used when neither is given
+  bool discontinuity = false;        ///< --discontinuity
+  int discontinuity_sources = 0;     ///< --discontinuity-sources
 };
 
 /// Threads, seed and verbosity.
@@ -36,8 +38,8 @@ struct RunArgs {
 };
 
 /// Adds the positional SCENE, the loading options (--strict, --default-reflectance,
-/// --max-reflectance, --vertex-colors-as-reflectance, --emit) and --max-edge / --patches to
-/// a subcommand.
+/// --max-reflectance, --vertex-colors-as-reflectance, --emit), --max-edge / --patches and
+/// --discontinuity / --discontinuity-sources to a subcommand.
 void add_scene_options(CLI::App* cmd, SceneArgs& args);
 /// Adds -j/--threads, --seed, -q/--quiet, -v/--verbose and --max-memory to a subcommand.
 void add_run_options(CLI::App* cmd, RunArgs& args);
@@ -118,6 +120,10 @@ void check_job_files(const std::vector<NamedFile>& inputs, const std::vector<Nam
 /// MemAvailable (no check where none is known; "0" = no check). When direct's factorisation
 /// alone is above the limit, the message is direct_refusal's.
 void check_job_memory(std::int64_t patches, const JobPlan& plan);
+
+/// The meshing options of the scene arguments (--max-edge, --patches or the default target,
+/// --discontinuity, --discontinuity-sources).
+MeshOptions mesh_options(const SceneArgs& args);
 
 /// Loads the scene (or the built-in Cornell box) with the loading options.
 Scene load_scene_file(const SceneArgs& args);

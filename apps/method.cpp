@@ -11,7 +11,8 @@ const std::vector<Method>& methods() {
   static const std::vector<Method> kMethods = {
       {"matrix",
        "mesh the scene, compute F, solve (I - rho F) B = E",
-       {"--patches", "--max-edge", "--estimator", "--samples", "--rays", "--threshold",
+       {"--patches", "--max-edge", "--discontinuity", "--discontinuity-sources", "--adapt",
+        "--adapt-patches", "--estimator", "--samples", "--rays", "--threshold",
         "--hemicube-res", "--reciprocity", "--symmetrize", "--ff"},
        {"--solver", "--solvers", "--omega", "--preconditioner", "--restart", "--ambient",
         "--radiosity"},

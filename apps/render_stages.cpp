@@ -65,6 +65,8 @@ Camera make_camera(const Scene& scene, const CameraArgs& args) {
 
 void add_shade_options(CLI::App* cmd, ShadeArgs& args) {
   cmd->add_flag("--flat", args.flat, "Per-patch (flat) shading instead of Gouraud");
+  cmd->add_flag("--wireframe", args.wireframe,
+                "Draw the patch edges (black, about one pixel wide) over the shading");
   cmd->add_option("--antialias", args.antialias, "K: K x K stratified samples per pixel")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
@@ -139,6 +141,7 @@ Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const Ve
   const Bvh& bvh = scene_bvh(scene, run.threads);
   RenderSettings settings;
   settings.flat = args.flat;
+  settings.wireframe = args.wireframe;
   settings.antialias = args.antialias;
   settings.seed = run.seed;
   settings.threads = run.threads;

@@ -29,9 +29,10 @@ void add_camera_options(CLI::App* cmd, CameraArgs& args);
 /// Throws UsageError for a malformed --size or a degenerate view.
 Camera make_camera(const Scene& scene, const CameraArgs& args);
 
-/// --flat, --antialias, --exposure, --vertex-interp.
+/// --flat, --wireframe, --antialias, --exposure, --vertex-interp.
 struct ShadeArgs {
   bool flat = false;
+  bool wireframe = false;  ///< --wireframe: patch edges drawn over the shading
   int antialias = 2;
   std::string exposure = "auto";  ///< "auto" or EV stops
   std::string vertex_interp = "conservative";

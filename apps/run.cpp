@@ -69,7 +69,7 @@ std::vector<double> as_vector(const Eigen::Vector3d& v) { return {v[0], v[1], v[
 std::string shade_settings(const RunOptions& o, const Camera& cam) {
   std::ostringstream ss;
   ss << " interp=" << o.shade.vertex_interp << " shading=" << (o.shade.flat ? "flat" : "gouraud")
-     << " antialias=" << o.shade.antialias << " render_seed=" << o.run.seed << " size=" << cam.width
+     << (o.shade.wireframe ? " wireframe=1" : "") << " antialias=" << o.shade.antialias << " render_seed=" << o.run.seed << " size=" << cam.width
      << "x" << cam.height;
   return ss.str();
 }

@@ -1,5 +1,6 @@
 #include "geometry/render.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -20,13 +21,25 @@ struct Sample {
 
 Sample trace(const PatchMesh& mesh, const Bvh& bvh, const Eigen::Vector3d& eye,
              const Eigen::Vector3d& dir, const Eigen::MatrixX3d& patch_B,
-             const VertexField& vertices, bool flat) {
+             const VertexField& vertices, bool flat, double wire_angle) {
   Sample s;
   const RayHit h = bvh.intersect(eye.cast<float>(), dir.cast<float>());
   if (h.patch < 0) return s;
   s.hit = true;
   const Patch& p = mesh.patches[h.patch];
   if (p.normal.dot(dir) >= 0) return s;  // back face: no radiosity leaves it
+  if (wire_angle > 0) {
+    // Distance from the hit to the patch's boundary against the pixel's footprint there.
+    const Eigen::Vector3d x = eye + h.t * dir;
+    const double cosine = std::max(0.25, -p.normal.dot(dir.normalized()));
+    const double width = 0.5 * wire_angle * h.t * dir.norm() / cosine;
+    for (int k = 0; k < p.vertex_count; ++k) {
+      const Eigen::Vector3d& a = mesh.vertices[p.vertices[k]];
+      const Eigen::Vector3d& b = mesh.vertices[p.vertices[(k + 1) % p.vertex_count]];
+      const double t = std::clamp((x - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+      if ((a + t * (b - a) - x).norm() < width) return s;  // on an edge: black
+    }
+  }
   if (flat) {
     s.B = patch_B.row(h.patch).transpose();
     return s;
@@ -56,6 +69,9 @@ Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
   img.rgb.assign(static_cast<size_t>(img.width) * img.height * 3, 0.0f);
   img.alpha.assign(static_cast<size_t>(img.width) * img.height, 0.0f);
   const int K = options.antialias;
+  // The angle one pixel subtends (radians), 0 without a wireframe.
+  const double wire_angle =
+      options.wireframe ? 2.0 * std::tan(camera.vfov_degrees * M_PI / 360.0) / camera.height : 0.0;
   const double inv_pi = 1.0 / M_PI;
   const double inv_samples = 1.0 / (K * K);
   std::unique_ptr<Progress> progress;
@@ -76,7 +92,7 @@ Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
             const double px = x + (sx + jx) / K;
             const double py = static_cast<double>(y) + (sy + jy) / K;
             const Sample s = trace(mesh, bvh, camera.eye, camera.ray_direction(px, py), patch_B,
-                                   vertices, options.flat);
+                                   vertices, options.flat, wire_angle);
             sum += s.B;
             hits += s.hit ? 1 : 0;
           }

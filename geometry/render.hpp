@@ -39,6 +39,10 @@ struct Image {
 /// Render settings.
 struct RenderSettings {
   bool flat = false;       ///< per-patch shading instead of Gouraud
+  /// Patch edges drawn black over the shading: a sample whose hit lies within 0.5 pixel
+  /// footprints (the pixel's width at the hit's distance, divided by the cosine to the
+  /// surface, at least 1/4) of its patch's boundary is black.
+  bool wireframe = false;
   int antialias = 2;       ///< K: K x K stratified samples per pixel (1 = pixel centres)
   std::uint64_t seed = 1;  ///< jitter seed (K > 1)
   int threads = 0;         ///< 0 = all cores
