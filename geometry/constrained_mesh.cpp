@@ -44,7 +44,7 @@ constexpr double kSamePlane = 1e-9;
 // A vertex this close (relative to the edge's length) to a crease edge lies on it.
 constexpr double kOnEdge = 1e-9;
 // Constraint features closer than this (relative to the part's extent) are merged.
-constexpr double kSnap = 1e-4;
+constexpr double kSnap = 1e-6;
 
 using Key3 = std::array<double, 3>;
 Key3 key(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
