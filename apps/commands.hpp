@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "apps/adapt_stage.hpp"
 #include "apps/common.hpp"
 #include "apps/ff_args.hpp"
 #include "apps/method.hpp"
@@ -46,6 +47,7 @@ struct SolveCommandOptions {
   MethodArgs method;
   FormFactorArgs ff;
   SolveOptions solve;
+  AdaptArgs adapt;
   std::string output = "radiosity.csv";  ///< per-patch CSV; summary JSON beside it
 };
 /// Registers `solve` on the app.
@@ -86,6 +88,7 @@ struct RenderOptions {
   MethodArgs method;
   FormFactorArgs ff;
   SolveOptions solver;
+  AdaptArgs adapt;
   CameraArgs camera;
   ShadeArgs shade;
   std::string radiosity;                ///< per-patch CSV from `solve`; empty = F + solve here
@@ -106,6 +109,7 @@ struct RunOptions {
   MethodArgs method;
   FormFactorArgs ff;
   SolveOptions solver;
+  AdaptArgs adapt;
   CameraArgs camera;
   ShadeArgs shade;
   std::string output_dir = "out";  ///< -o: output directory, created if needed

@@ -238,7 +238,7 @@ int run_matrix(const RunOptions& opts) {
   const RunPaths paths = prepare_outputs(opts, plan);
   plan_form_factors(plan, opts.ff, opts.run);
   plan.direct = opts.solver.solver == "direct";
-  const LoadedScene loaded = load_scene(opts.scene, plan);
+  LoadedScene loaded = load_scene(opts.scene, plan);
   const Camera camera = make_camera(loaded.scene, opts.camera);
   const double load_seconds = timer.seconds();
   log_info("      " + std::to_string(loaded.mesh.size()) + " patches on " +
@@ -255,11 +255,27 @@ int run_matrix(const RunOptions& opts) {
               (opts.ff.ff_file.empty() ? estimator + per : "from " + opts.ff.ff_file) + ")");
   RadiosityResult r;
   timer.reset();
-  const FormFactors F = obtain_form_factors(loaded, opts.ff, opts.run);
-  r.ff_seconds = timer.seconds();
-
-  stages.next("solving (I - rho F) B = E with " + opts.solver.solver);
-  solve_scene(loaded, F, opts.solver, opts.run, r);
+  std::vector<AdaptRound> rounds;
+  if (opts.adapt.active()) {
+    stages.next("adaptive meshing and solving with " + opts.solver.solver);
+    SolveOptions so = opts.solver;
+    set_memory_limit(so, opts.run.max_memory);
+    FormFactors F;
+    rounds = adapt_scene(loaded, opts.ff, so, opts.run, opts.adapt, F, r.solution);
+    r.ff_seconds = timer.seconds() - r.solution.seconds;
+    r.solve_seconds = r.solution.seconds;
+    r.ff_stats = F.stats;
+    r.ff_options = F.options;
+    r.ff_entries = F.F.nonZeros();
+    r.B = r.solution.B;
+    r.solved = true;
+    warn_about_lighting(loaded.mesh, F.F);
+  } else {
+    const FormFactors F = obtain_form_factors(loaded, opts.ff, opts.run);
+    r.ff_seconds = timer.seconds();
+    stages.next("solving (I - rho F) B = E with " + opts.solver.solver);
+    solve_scene(loaded, F, opts.solver, opts.run, r);
+  }
 
   MethodOutcome m{"matrix", loaded, r.B};
   std::ostringstream settings;
@@ -288,6 +304,16 @@ int run_matrix(const RunOptions& opts) {
                           {"status", to_string(r.solution.status)},
                           {"channels", channels}};
   for (const auto& e : r.solution.energy) m.energy.push_back(energy_json(e));
+  if (!rounds.empty()) {
+    m.sections["adapt"] = adapt_json(rounds);
+    const AdaptRound& last = rounds.back();
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "adapt      %zu rounds: %lld -> %lld patches, estimated error %.3g -> %.3g W/m^2",
+                  rounds.size() - 1, static_cast<long long>(rounds.front().patches),
+                  static_cast<long long>(last.patches), rounds.front().estimated_error,
+                  last.estimated_error);
+    m.summary.push_back(buf);
+  }
   m.seconds = {
       {"load_and_mesh", load_seconds}, {"form_factors", r.ff_seconds}, {"solve", r.solve_seconds}};
   m.time_labels = {"load+mesh", "form factors", "solve"};
@@ -390,6 +416,7 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& opts) {
   add_method_options(cmd, opts.method);
   add_ff_options(cmd, opts.ff);
   add_solve_options(cmd, opts.solver, true);
+  add_adapt_options(cmd, opts.adapt);
   add_camera_options(cmd, opts.camera);
   add_shade_options(cmd, opts.shade);
   cmd->add_option("-o,--output", opts.output_dir, "Output directory (created if needed)")

@@ -56,18 +56,28 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
   plan.outputs = {{"-o", opts.output}, {"the summary", summary_path(opts.output)}};
   plan_form_factors(plan, opts.ff, opts.run);
   plan.direct = opts.solve.solver == "direct";
-  const LoadedScene loaded = load_scene(opts.scene, plan);
+  LoadedScene loaded = load_scene(opts.scene, plan);
   const double load_seconds = total.seconds();
   const Timer ff_timer;
-  const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);
-  const double ff_seconds = ff_timer.seconds();
-  const RadiosityProblem problem = make_problem(loaded.mesh, ff.F);
-  warn_about_lighting(loaded.mesh, ff.F);
-  check_closed_lossless(loaded.mesh, ff);
   SolveOptions so = opts.solve;
   so.threads = opts.run.threads;
   set_memory_limit(so, opts.run.max_memory);
-  const RadiositySolution sol = solve_radiosity(problem, so);
+  FormFactors ff;
+  RadiositySolution sol;
+  std::vector<AdaptRound> rounds;
+  double ff_seconds = 0.0;
+  if (opts.adapt.active()) {
+    rounds = adapt_scene(loaded, opts.ff, so, opts.run, opts.adapt, ff, sol);
+    ff_seconds = ff_timer.seconds() - sol.seconds;
+    warn_about_lighting(loaded.mesh, ff.F);
+  } else {
+    ff = obtain_form_factors(loaded, opts.ff, opts.run);
+    ff_seconds = ff_timer.seconds();
+    const RadiosityProblem problem = make_problem(loaded.mesh, ff.F);
+    warn_about_lighting(loaded.mesh, ff.F);
+    check_closed_lossless(loaded.mesh, ff);
+    sol = solve_radiosity(problem, so);
+  }
 
   const std::string json_path = summary_path(opts.output);
   write_radiosity_csv(opts.output, loaded.mesh, sol.B);
@@ -102,6 +112,7 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
   Json& channels = j["channels"] = Json::array();
   for (int c = 0; c < 3; ++c) channels.push_back(channel_json(sol.channels[c], sol.energy[c], c));
   j["surfaces"] = surface_averages_json(surfaces);
+  if (!rounds.empty()) j["adapt"] = adapt_json(rounds);
   write_json_file(json_path, j);
 
   std::printf("solver %s: %s\n", so.solver.c_str(), to_string(sol.status));
@@ -185,6 +196,7 @@ CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts) {
   add_method_options(cmd, opts.method);
   add_ff_options(cmd, opts.ff);
   add_solve_options(cmd, opts.solve, true);
+  add_adapt_options(cmd, opts.adapt);
   cmd->add_option("-o,--output", opts.output,
                   "Per-patch radiosity CSV (patch,surface,area,R,G,B); the summary goes to the "
                   "same name with .json")

@@ -284,12 +284,12 @@ Inner run_gmres(const KrylovSystem& a, const Preconditioner& m, int restart, dou
 using InnerMethod = std::function<Inner(const KrylovSystem&, const Preconditioner&, double,
                                         Eigen::VectorXd&, Tracker&)>;
 
-// The shared driver: guess B = E, preconditioner setup, inner runs until the true residual
+// The shared driver: guess B = E (or the warm start), preconditioner setup, inner runs until the true residual
 // meets tol (see the header comment).
 ChannelReport run_krylov(const ChannelSystem& sys, const KrylovSystem& a, const SolveOptions& o,
                          const InnerMethod& method, Eigen::VectorXd& B) {
   ChannelReport report;
-  B = sys.E;
+  B = sys.guess;
   record(report, 0, sys.relative_residual_uncounted(B), 0.0);
   const Timer timer;
   Preconditioner m;

@@ -169,12 +169,15 @@ RadiositySolution solve_radiosity(const RadiosityProblem& problem, const SolveOp
   validate_options(options);
   validate_problem(problem);
   check_applicable(problem, options);
+  if (options.initial_guess.size() > 0 && options.initial_guess.rows() != problem.area.size())
+    throw UsageError("initial guess has " + std::to_string(options.initial_guess.rows()) +
+                     " rows for " + std::to_string(problem.area.size()) + " patches");
   const Timer timer;
   const Eigen::Index n = problem.area.size();
   RadiositySolution sol;
   sol.B = Eigen::MatrixX3d::Zero(n, 3);
   for (int c = 0; c < 3; ++c) {
-    const ChannelSystem system = make_channel_system(problem, c, options.threads);
+    const ChannelSystem system = make_channel_system(problem, c, options.threads, options.initial_guess);
     ChannelReport& report = sol.channels[c];
     Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
     if (system.e_norm == 0.0) {

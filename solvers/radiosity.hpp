@@ -46,6 +46,9 @@ struct SolveOptions {
   double memory_limit = 0.0;
   /// Where memory_limit comes from, for messages (e.g. "--max-memory 512M").
   std::string memory_limit_source;
+  /// The iterative solvers' initial guess B (N x 3; empty = E, the default): a warm start
+  /// from a previous solution (adaptive meshing). `direct` ignores it.
+  Eigen::MatrixX3d initial_guess;
 };
 
 /// Per-channel solver report.

@@ -39,10 +39,16 @@ ChannelReport solve_southwell(const ChannelSystem& system, const SolveOptions& o
   const Eigen::VectorXd& a = system.area;
   const Eigen::VectorXd& rho = system.rho;
   const double tol_abs = options.tol * system.e_norm;
-  B = Eigen::VectorXd::Zero(n);
+  // From B = 0 (r = E), or from a warm start's guess (r = E - K B).
   Eigen::VectorXd r = system.E;
+  B = Eigen::VectorXd::Zero(n);
+  if (system.warm) {
+    B = system.guess;
+    system.apply_k(B, r);
+    r = system.E - r;
+  }
   double sq = r.squaredNorm();  // ||r||^2, updated per shot, recomputed per sweep
-  record(report, 0, 1.0, 0.0);
+  record(report, 0, std::sqrt(sq) / system.e_norm, 0.0);
   const Timer timer;
   IndexedMaxHeap unshot(r.cwiseAbs().cwiseProduct(a));  // unshot power |r_j| A_j
   std::int64_t touched = 0;   // F entries read by shots

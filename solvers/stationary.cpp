@@ -7,7 +7,7 @@
 // Convergence: since ||diag(rho) F||_inf <= rho_max < 1 (row sums of F are <= 1), all three
 // converge for omega in (0, 1]; for omega > 1 SOR converges on the symmetrisable radiosity
 // systems (K is similar to an SPD matrix, Ostrowski-Reich). Cost per iteration: one pass
-// over F, O(nnz). Initial guess B = E.
+// over F, O(nnz). Initial guess B = E (or SolveOptions::initial_guess).
 //
 // Stopping rule (the one rule): ||E - K B||_2 / ||E||_2 <= tol on the true residual.
 // Jacobi gets the true residual of the current iterate for free (it is the update).
@@ -29,7 +29,7 @@ ChannelReport solve_jacobi(const ChannelSystem& system, const SolveOptions& opti
   ChannelReport report;
   const Timer timer;
   const Eigen::VectorXd d = 1.0 - system.rho.cwiseProduct(system.f_diag).array();
-  B = system.E;
+  B = system.guess;
   Eigen::VectorXd kb;
   for (int k = 0;; ++k) {
     system.apply_k(B, kb);
@@ -76,7 +76,7 @@ double sor_sweep(const ChannelSystem& s, double omega, Eigen::VectorXd& B) {
 ChannelReport sor_iterate(const ChannelSystem& system, const SolveOptions& options, double omega,
                           Eigen::VectorXd& B) {
   ChannelReport report;
-  B = system.E;
+  B = system.guess;
   record(report, 0, system.relative_residual_uncounted(B), 0.0);
   const Timer timer;
   double check_below = options.tol;  // sweep residual that triggers a true-residual check

@@ -26,7 +26,8 @@ double ChannelSystem::relative_residual(const Eigen::VectorXd& B) const {
   return relative_residual_uncounted(B);
 }
 
-ChannelSystem make_channel_system(const RadiosityProblem& problem, int channel, int threads) {
+ChannelSystem make_channel_system(const RadiosityProblem& problem, int channel, int threads,
+                                  const Eigen::MatrixX3d& initial_guess) {
   ChannelSystem s;
   s.F = problem.F.get();
   s.rho = problem.rho.col(channel);
@@ -36,6 +37,8 @@ ChannelSystem make_channel_system(const RadiosityProblem& problem, int channel, 
     s.e_scale = e_max;
     s.E /= e_max;
   }
+  s.warm = initial_guess.rows() == s.E.rows() && s.E.rows() > 0;
+  s.guess = s.warm ? Eigen::VectorXd(initial_guess.col(channel) / s.e_scale) : s.E;
   s.area = problem.area;
   s.f_diag = problem.F->diagonal();
   s.e_norm = s.E.norm();

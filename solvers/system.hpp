@@ -21,6 +21,8 @@ struct ChannelSystem {
   /// whose emission is at most 1 and B is multiplied back by e_scale. Unscaled, ||E||_2
   /// and ||r||_2 overflow to inf for any E above ~1e154 (their squares pass DBL_MAX).
   Eigen::VectorXd E;
+  Eigen::VectorXd guess;   ///< initial guess, scaled like E (E unless warm-started)
+  bool warm = false;       ///< the guess is a warm start (SolveOptions::initial_guess)
   double e_scale = 1.0;    ///< max_i |E_c,i| (1 when nothing is emitted)
   Eigen::VectorXd area;    ///< A per patch
   Eigen::VectorXd f_diag;  ///< F_ii (0 for planar patches; kept for generality)
@@ -39,8 +41,9 @@ struct ChannelSystem {
   double relative_residual_uncounted(const Eigen::VectorXd& B) const;
 };
 
-/// Builds channel c of the problem.
-ChannelSystem make_channel_system(const RadiosityProblem& problem, int channel, int threads);
+/// Builds channel c of the problem; `initial_guess` (N x 3, or empty for E) is its guess.
+ChannelSystem make_channel_system(const RadiosityProblem& problem, int channel, int threads,
+                                  const Eigen::MatrixX3d& initial_guess = Eigen::MatrixX3d());
 
 /// Appends history points to a report.
 inline void record(ChannelReport& report, int iteration, double residual, double seconds) {

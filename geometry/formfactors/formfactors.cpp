@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <memory>
 
 #include "core/error.hpp"
@@ -51,7 +52,9 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
       for (std::int64_t r = begin; r < end; ++r) {
         const auto i = static_cast<std::int32_t>(block_begin + r);
         std::int64_t row_rays = 0;
+        const bool all = options.only.empty();
         for (std::int32_t j = i + 1; j < n; ++j) {
+          if (!all && !options.only[i] && !options.only[j]) continue;
           if (!can_exchange(geom[i], geom[j], plane_eps)) continue;
           ++tested[i];
           const PairEstimate e = estimator(ctx, i, j);
@@ -262,6 +265,10 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
   }
   FormFactors out = e.compute(mesh, o, bvh);
   out.options = o;
+  if (!o.only.empty()) {
+    LAMBERT_CHECK(o.only.size() == mesh.patches.size(), "row flags do not match the mesh");
+    return out;  // partial: update_form_factors completes it
+  }
   if (o.reciprocity == "average") {
     Timer timer;
     std::vector<double> areas(mesh.patches.size());
@@ -278,6 +285,64 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
     out.stats.seconds += out.stats.reciprocity_seconds;
   }
   apply_threshold(out, o.threshold);
+  return out;
+}
+
+FormFactors update_form_factors(const PatchMesh& mesh, const std::vector<std::int32_t>& origin,
+                                const SparseF& old_F, const FormFactorOptions& options,
+                                const Bvh* bvh) {
+  const std::int32_t n = mesh.size();
+  LAMBERT_CHECK(static_cast<std::int32_t>(origin.size()) == n, "origin map does not match the mesh");
+  FormFactorOptions o = options;
+  o.with_stderr = false;
+  o.only.assign(n, 0);
+  for (std::int32_t i = 0; i < n; ++i) o.only[i] = origin[i] < 0;
+  FormFactors part = compute_form_factors(mesh, o, bvh);
+  const bool pairwise = estimator_count_option(part.options.estimator) == "samples";
+  // Both sides of a pair with a new patch: G from row i is A_i F_ij where row i was
+  // estimated (a pair estimator's every row; a row estimator's new rows).
+  auto estimated = [&](std::int32_t i) { return pairwise || origin[i] < 0; };
+  std::vector<double> area(n);
+  for (std::int32_t i = 0; i < n; ++i) area[i] = mesh.patches[i].area;
+  std::vector<Eigen::Triplet<double, std::int64_t>> entries;
+  std::vector<std::int32_t> new_of_old(old_F.rows(), -1);
+  for (std::int32_t i = 0; i < n; ++i)
+    if (origin[i] >= 0) new_of_old[origin[i]] = i;
+  for (std::int32_t i = 0; i < n; ++i) {
+    if (origin[i] < 0) continue;
+    for (SparseF::InnerIterator it(old_F, origin[i]); it; ++it) {
+      const std::int32_t j = new_of_old[it.col()];
+      if (j >= 0) entries.emplace_back(i, j, it.value());
+    }
+  }
+  // Pairs with a new patch: sum and count the sides' G, keyed by the unordered pair.
+  std::map<std::pair<std::int32_t, std::int32_t>, std::pair<double, int>> pairs;
+  for (std::int32_t i = 0; i < n; ++i) {
+    if (!estimated(i)) continue;
+    for (SparseF::InnerIterator it(part.F, i); it; ++it) {
+      const auto j = static_cast<std::int32_t>(it.col());
+      if (origin[i] >= 0 && origin[j] >= 0) continue;
+      auto& g = pairs[{std::min(i, j), std::max(i, j)}];
+      g.first += area[i] * it.value();
+      g.second += 1;
+    }
+  }
+  for (const auto& [key, g] : pairs) {
+    const auto [i, j] = key;
+    // Sides estimated but without an entry estimated G = 0: they count in the mean.
+    const int sides = (estimated(i) ? 1 : 0) + (estimated(j) ? 1 : 0);
+    const double G = g.first / std::max(sides, g.second);
+    if (!(G > 0.0)) continue;
+    entries.emplace_back(i, j, G / area[i]);
+    entries.emplace_back(j, i, G / area[j]);
+  }
+  FormFactors out;
+  out.options = part.options;
+  out.options.only.clear();
+  out.stats = part.stats;
+  out.F.resize(n, n);
+  out.F.setFromTriplets(entries.begin(), entries.end());
+  out.F.makeCompressed();
   return out;
 }
 

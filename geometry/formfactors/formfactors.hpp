@@ -37,6 +37,11 @@ struct FormFactorOptions {
   /// construction; the hemicube keeps its historical default, --symmetrize to average).
   std::string reciprocity = "auto";
   bool progress = true;              ///< draw a progress bar (when stderr is a terminal)
+  /// Incremental updates (adaptive meshing): when non-empty (one flag per patch), only the
+  /// pairs with a flagged patch are estimated (pair estimators: both entries of each such
+  /// pair; gather and hemicube: the flagged rows); everything else is left empty, and
+  /// reciprocity averaging and the threshold are not applied (see update_form_factors).
+  std::vector<char> only;
 };
 
 /// What a computation did (for diagnostics and reports).
@@ -130,5 +135,16 @@ class Bvh;
 /// hold the resolved ones), and reciprocity averaging is applied last. Throws UsageError for an unknown estimator or invalid settings.
 FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions& options,
                                  const Bvh* bvh = nullptr);
+
+/// F on a refined mesh from F on the mesh it was refined from: `origin[i]` is the old
+/// index of new patch i when it is unchanged (the same polygon), -1 when it is new. Entries
+/// between unchanged patches are copied from `old_F`; the pairs with a new patch are
+/// estimated (FormFactorOptions::only) and, where both sides are estimated (pair
+/// estimators; a row estimator's two new rows), their G = A F is averaged, so that
+/// A_i F_ij = A_j F_ji holds for them; a row estimator's new row also gives the unchanged
+/// row its column (F_ji = A_i F_ij / A_j). Cost: O(changed x N) estimates, not O(N²).
+FormFactors update_form_factors(const PatchMesh& mesh, const std::vector<std::int32_t>& origin,
+                                const SparseF& old_F, const FormFactorOptions& options,
+                                const Bvh* bvh = nullptr);
 
 }  // namespace lambert

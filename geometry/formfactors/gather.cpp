@@ -177,6 +177,10 @@ FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& optio
       hits.reserve(K);
       for (std::int64_t r = begin; r < end; ++r) {
         const auto i = static_cast<std::int32_t>(block + r);
+        if (!options.only.empty() && !options.only[i]) {
+          rows[r].clear();
+          continue;
+        }
         trace_row(geom, normals, bvh, i, K, options.seed, offset, hits);
         row_from_hits(hits, K, options.with_stderr, acc, touched, rows[r]);
         progress.advance(1, K);

@@ -334,6 +334,7 @@ FormFactors compute_hemicube(const PatchMesh& mesh, const FormFactorOptions& opt
     std::vector<double> acc(n, 0.0);
     for (std::int64_t ii = begin; ii < end; ++ii) {
       const auto i = static_cast<std::int32_t>(ii);
+      if (!options.only.empty() && !options.only[i]) continue;
       buf.pixels = 0;
       hemicube_row(geom, i, dF, offset, edge_eps, options.seed, buf, acc, rows[i]);
       rows[i].shrink_to_fit();

@@ -1,0 +1,37 @@
+#pragma once
+// Adaptive meshing: per-patch error estimates from a solution, and conforming refinement of
+// the worst patches by longest-edge bisection (Rivara's LEPP algorithm: a triangle is
+// bisected at its longest edge's midpoint together with the neighbours sharing that edge,
+// after their own longest-edge propagation, so no T-vertex is ever created within a
+// surface; angles stay bounded below by half the initial mesh's smallest angle).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "geometry/mesh.hpp"
+
+namespace lambert {
+
+/// The mesh with every quad split into two triangles along its shorter diagonal (triangles
+/// are copied); origin[i] is the patch of `mesh` new patch i comes from.
+struct RefinedMesh {
+  PatchMesh mesh;
+  std::vector<std::int32_t> origin;  ///< the old patch each new patch lies in
+  std::vector<char> changed;         ///< 1 when new patch i is not an old patch as it was
+};
+RefinedMesh triangulate_quads(const PatchMesh& mesh);
+
+/// Per-patch error estimate of a piecewise-constant solution B (N x 3): the patch's area
+/// times the largest jump of its mean radiosity (RGB average) to a neighbour sharing an
+/// edge within its surface, halved (the constant's error against a field that varies that
+/// much across the patch): e_i = A_i max_j |b_i - b_j| / 2 (W, scene units). Isolated
+/// patches get 0. O(N).
+std::vector<double> patch_errors(const PatchMesh& mesh, const Eigen::MatrixX3d& B);
+
+/// Bisects the `marked` triangles (and whatever conformity requires) once each. Every patch
+/// must be a triangle (triangulate_quads). Children keep their parent's reflectance,
+/// emission and surface; `origin` maps to the parent's index. Deterministic.
+RefinedMesh refine_marked(const PatchMesh& mesh, const std::vector<char>& marked);
+
+}  // namespace lambert
