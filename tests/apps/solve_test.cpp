@@ -398,3 +398,57 @@ TEST(SolveCommand, VertexColoursAsReflectanceChangeTheSolution) {
 }
 
 }  // namespace lambert
+
+namespace lambert {
+
+// --adapt refines and re-solves: the summary reports every round, the patch count grows
+// round by round while only the changed patches get new factors, the estimated error is
+// lower after the rounds than before, and the written CSV has the final mesh's rows.
+TEST(SolveCommand, AdaptReportsRoundsAndWritesTheRefinedMesh) {
+  testing::TempDir dir;
+  const std::string csv = dir.file("B.csv");
+  ASSERT_EQ(run({"solve", "-q", "--patches", "150", "--adapt", "2", "--estimator", "hybrid",
+                 "--samples", "16", "-o", csv}),
+            kExitOk);
+  const nlohmann::json json = read_json(dir.file("B.json"));
+  const auto& rounds = json.at("adapt");
+  ASSERT_EQ(rounds.size(), 3u);
+  for (size_t k = 1; k < rounds.size(); ++k) {
+    EXPECT_GT(rounds[k].at("patches").get<int>(), rounds[k - 1].at("patches").get<int>());
+    EXPECT_LT(rounds[k].at("changed").get<int>(), rounds[k].at("patches").get<int>());
+  }
+  EXPECT_LT(rounds.back().at("estimated_error").get<double>(), rounds[0].at("estimated_error").get<double>());
+  EXPECT_EQ(json.at("patches").get<int>(), rounds.back().at("patches").get<int>());
+  EXPECT_EQ(read_lines(csv).size(), json.at("patches").get<std::size_t>() + 1);
+  // A patch budget stops the rounds once reached.
+  ASSERT_EQ(run(with_fast({"solve", "--adapt-patches", "400", "-o", csv})), kExitOk);
+  EXPECT_GE(read_json(dir.file("B.json")).at("patches").get<int>(), 400);
+}
+
+// Adaptation computes F: a saved F cannot be used; --discontinuity-sources needs
+// --discontinuity; the hierarchical method refuses both (it meshes on its own).
+TEST(SolveCommand, AdaptAndDiscontinuityOptionMisuseIsAUsageError) {
+  testing::TempDir dir;
+  const std::string csv = dir.file("B.csv");
+  const std::string ff = dir.file("F.bin");
+  ASSERT_EQ(run(with_fast({"formfactors", "-o", ff})), kExitOk);
+  EXPECT_EQ(run({"solve", "-q", "--patches", "150", "--adapt", "1", "--ff", ff, "-o", csv}), kExitUsage);
+  EXPECT_EQ(run(with_fast({"solve", "--discontinuity-sources", "2", "-o", csv})), kExitUsage);
+  EXPECT_EQ(run({"solve", "-q", "--method", "hierarchical", "--discontinuity", "-o", csv}), kExitUsage);
+  EXPECT_EQ(run({"solve", "-q", "--method", "hierarchical", "--adapt", "2", "-o", csv}), kExitUsage);
+}
+
+// --discontinuity meshes with triangles along the shadow lines; with one secondary source
+// it traces more lines, hence at least as many patches at the same edge bound.
+TEST(SolveCommand, DiscontinuityMeshingSolvesTheCornellBox) {
+  testing::TempDir dir;
+  const std::string csv = dir.file("B.csv");
+  ASSERT_EQ(run({"solve", "-q", "--discontinuity", "--max-edge", "120", "--samples", "4", "-o", csv}), kExitOk);
+  const int n0 = read_json(dir.file("B.json")).at("patches").get<int>();
+  ASSERT_EQ(run({"solve", "-q", "--discontinuity", "--discontinuity-sources", "1", "--max-edge", "120",
+                 "--samples", "4", "-o", csv}),
+            kExitOk);
+  EXPECT_GE(read_json(dir.file("B.json")).at("patches").get<int>(), n0);
+}
+
+}  // namespace lambert

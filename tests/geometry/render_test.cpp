@@ -82,6 +82,33 @@ TEST(Render, UniformRadiosityGivesBOverPiInEveryPixelThatHits) {
   }
 }
 
+// The wireframe darkens only pixels near patch edges: with a uniform field, every pixel is
+// either its plain value (far from edges) or darker (a sample within half a pixel of an
+// edge is black), never brighter; darkened pixels exist and are a minority at 0.15 edges
+// (about 18 pixels across a patch here, two or three of them on its edges).
+TEST(Render, WireframeDarkensOnlyPixelsNearPatchEdges) {
+  const PatchMesh mesh = mesh_scene(open_box(), {0.15, 0});
+  const Bvh bvh(mesh);
+  const Eigen::MatrixX3d B = Eigen::RowVector3d(1.0, 1.0, 1.0).replicate(mesh.size(), 1);
+  const VertexField field = interpolate_to_vertices(mesh, B);
+  RenderSettings o;
+  o.antialias = 3;
+  o.progress = false;
+  const Image plain = render(mesh, bvh, box_camera(288, 240), B, field, o);
+  o.wireframe = true;
+  const Image wire = render(mesh, bvh, box_camera(288, 240), B, field, o);
+  int darker = 0, hits = 0;
+  for (int y = 0; y < wire.height; ++y)
+    for (int x = 0; x < wire.width; ++x) {
+      const float a = plain.pixel(x, y)[0], b = wire.pixel(x, y)[0];
+      EXPECT_LE(b, a * (1 + 1e-6f));
+      hits += a > 0;
+      darker += b < a * (1 - 1e-6f);
+    }
+  EXPECT_GT(darker, hits / 20);
+  EXPECT_LT(darker, hits * 3 / 4);
+}
+
 TEST(Render, GouraudReproducesALinearFieldAtTheHitPoint) {
   // Vertex values linear in position are reproduced exactly by barycentric/bilinear
   // interpolation on planar patches, so each centre-sampled pixel shows f(hit)/π.
