@@ -55,6 +55,7 @@ std::vector<AdaptRound> adapt_scene(LoadedScene& scene, const FormFactorArgs& ff
   std::vector<AdaptRound> out;
   Timer timer;
   ff = compute_form_factors(scene.mesh, fo, &scene_bvh(scene, run.threads));
+  check_closed_lossless(scene.mesh, ff);  // refinement keeps a closed lossless set closed
   solution = solve_on(scene, ff, so);
   std::int64_t changed_now = scene.mesh.size();  // patches whose factors this round computed
   for (int round = 0;; ++round) {
