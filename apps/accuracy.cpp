@@ -4,9 +4,10 @@
 // Reference: for a built-in analytic case (--case) the per-patch factors
 //   F_ij = (1/A_i) ∫_{A_i} F(x -> j) dA_x
 // with the exact point-to-patch factor F(x -> j) (Lambert's contour formula) integrated by
-// composite Gauss-Legendre quadrature (all analytic cases are unoccluded), plus the closed
-// form of the surface factor; for any other scene a high-sample `hybrid` run whose own
-// standard error is reported.
+// composite Gauss-Legendre quadrature (these cases are unoccluded), plus the closed form of
+// the surface factor; for the occluded partial_shadow case and any other scene a
+// high-sample `hybrid` run whose own standard error is reported (partial_shadow also has
+// an exact occluded surface factor, from the partial-shadow kernel).
 
 #include <algorithm>
 #include <cmath>
@@ -73,6 +74,7 @@ struct Study {
   Scene scene;
   PatchMesh mesh;
   std::vector<ExactPair> exact;  ///< empty for non-analytic scenes
+  bool occluded = false;  ///< blockers between the pairs: the per-patch reference is hybrid
 };
 
 std::int32_t surface_index(const PatchMesh& mesh, const std::string& name) {
@@ -117,6 +119,19 @@ Study make_study(const AccuracyOptions& opts, const JobPlan& plan) {
         const bool opposite = s.mesh.surface_names[g].substr(1) == s.mesh.surface_names[h].substr(1);
         s.exact.push_back({g, h, opposite ? kCubeOpposite : kCubeAdjacent});
       }
+    return s;
+  }
+  if (opts.analytic_case == "partial_shadow") {
+    // The floor-to-light factor past the blocker, exact (the partial-shadow kernel
+    // integrated cell by cell between the D1/D2 lines); per patch the hybrid reference.
+    s.scene = partial_shadow_scene();
+    s.mesh = mesh_case(s.scene, opts.scene, plan);
+    s.occluded = true;
+    const std::int32_t f = surface_index(s.mesh, "floor"), l = surface_index(s.mesh, "light");
+    const std::vector<double> area = surface_areas(s.mesh);
+    const double exact = partial_shadow_floor_light_factor();
+    s.exact.push_back({f, l, exact});
+    s.exact.push_back({l, f, exact * area[f] / area[l]});  // reciprocity
     return s;
   }
   for (auto& c : analytic_cases()) {
@@ -346,7 +361,7 @@ CLI::App* add_accuracy_command(CLI::App& app, AccuracyOptions& opts) {
   opts.scene.default_patches = 200;
   add_scene_options(cmd, opts.scene);
   cmd->add_option("--case", opts.analytic_case, "Built-in analytic case instead of SCENE")
-      ->check(CLI::IsMember({"parallel_squares", "perpendicular_squares", "unit_cube", "coaxial_disks"}));
+      ->check(CLI::IsMember({"parallel_squares", "perpendicular_squares", "unit_cube", "coaxial_disks", "partial_shadow"}));
   cmd->add_option("--estimators", opts.estimators,
                   "Estimator families to run (default: mc, hybrid, hemicube; gather on request)")
       ->delimiter(',')
@@ -393,7 +408,7 @@ int run_accuracy(const AccuracyOptions& opts) {
   plan.ff->with_stderr = true;
   const Study study = make_study(opts, plan);
   const PatchMesh& mesh = study.mesh;
-  const bool analytic = !study.exact.empty();
+  const bool analytic = !study.exact.empty() && !study.occluded;
   std::printf("%s: %zu surfaces, %d patches\n", study.name.c_str(), mesh.surface_names.size(),
               mesh.size());
 
@@ -431,6 +446,10 @@ int run_accuracy(const AccuracyOptions& opts) {
                 mesh.surface_names[study.exact[0].g].c_str(),
                 mesh.surface_names[study.exact[0].h].c_str(), study.exact[0].value);
   } else {
+    if (study.occluded)
+      std::printf("exact surface factor (partial-shadow kernel): F(%s->%s) = %.12f\n",
+                  mesh.surface_names[study.exact[0].g].c_str(),
+                  mesh.surface_names[study.exact[0].h].c_str(), study.exact[0].value);
     double max_se = 0.0, sum2 = 0.0;
     for (std::int64_t k = 0; k < ref.stderr_F.nonZeros(); ++k) {
       max_se = std::max(max_se, ref.stderr_F.valuePtr()[k]);
@@ -468,7 +487,7 @@ int run_accuracy(const AccuracyOptions& opts) {
   print_failure_modes(rows);
   write_table_csv(csv, study, rows);
   write_surfaces_csv(surf, rows, ref_row.surfaces);
-  const std::vector<Plot> plots = error_plots(rows, analytic);
+  const std::vector<Plot> plots = error_plots(rows, !study.exact.empty());
   write_plots_svg(svg, plots);
   write_plots_png(png, plots);
   std::printf("wrote %s, %s, %s, %s\n", csv.c_str(), surf.c_str(), svg.c_str(), png.c_str());

@@ -59,7 +59,13 @@ std::vector<AdaptRound> adapt_scene(LoadedScene& scene, const FormFactorArgs& ff
   solution = solve_on(scene, ff, so);
   std::int64_t changed_now = scene.mesh.size();  // patches whose factors this round computed
   for (int round = 0;; ++round) {
-    const std::vector<double> e = patch_errors(scene.mesh, solution.B);
+    // A discontinuity mesh is shaded with exact direct light at its vertices: its error is
+    // that field's (interpolation of H_d, jumps of the indirect part), not the constants'.
+    const std::vector<double> e =
+        scene.discontinuity
+            ? exact_direct_patch_errors(scene.scene, scene.mesh,
+                                        indirect_irradiance(scene.mesh, ff.F, solution.B), run.threads)
+            : patch_errors(scene.mesh, solution.B);
     AdaptRound r;
     r.round = round;
     r.patches = scene.mesh.size();

@@ -331,6 +331,7 @@ LoadedScene load_scene(const SceneArgs& args, const JobPlan& plan) {
   if (!mo.discontinuity) mo.max_edge = mesh_plan.max_edge;
   out.mesh = mesh_scene(out.scene, mo);
   out.max_edge = out.mesh.max_edge;
+  out.discontinuity = mo.discontinuity;
   return out;
 }
 

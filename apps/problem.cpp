@@ -6,6 +6,15 @@
 
 namespace lambert {
 
+Eigen::MatrixX3d indirect_irradiance(const PatchMesh& mesh, const SparseRowMatrix& F,
+                                     const Eigen::MatrixX3d& B) {
+  LAMBERT_CHECK(F.rows() == mesh.size() && F.cols() == mesh.size() && B.rows() == mesh.size(),
+                "form factors and radiosity do not match the mesh");
+  Eigen::MatrixX3d reflected = B;
+  for (std::int32_t i = 0; i < mesh.size(); ++i) reflected.row(i) -= mesh.patches[i].emission.transpose();
+  return F * reflected;
+}
+
 RadiosityProblem make_problem(const PatchMesh& mesh, const SparseRowMatrix& F) {
   const std::int32_t n = mesh.size();
   if (F.rows() != n || F.cols() != n)

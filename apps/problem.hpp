@@ -15,6 +15,12 @@ namespace lambert {
 /// F's size does not match the mesh.
 RadiosityProblem make_problem(const PatchMesh& mesh, const SparseRowMatrix& F);
 
+/// The indirect irradiance of every patch, I_i = Σ_j F_ij (B_j - E_j) (N x 3, W/m²): the
+/// light arriving after at least one reflection, for exact_direct_vertex_field
+/// (geometry/vertex_field.hpp). One sparse product, O(nnz).
+Eigen::MatrixX3d indirect_irradiance(const PatchMesh& mesh, const SparseRowMatrix& F,
+                                     const Eigen::MatrixX3d& B);
+
 /// Area-weighted average radiosity of each surface: sum_i A_i B_i / sum_i A_i over its patches.
 struct SurfaceRadiosity {
   std::string name;

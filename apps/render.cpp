@@ -30,10 +30,10 @@ std::string matrix_settings(const RenderOptions& o, const LoadedScene& s,
 
 // The settings line: the method's part, then shading and camera.
 std::string render_settings(const RenderOptions& o, const std::string& method_part,
-                            const Camera& cam) {
+                            const std::string& interp, const Camera& cam) {
   std::ostringstream ss;
   ss << method_part;
-  ss << " interp=" << o.shade.vertex_interp << " shading=" << (o.shade.flat ? "flat" : "gouraud")
+  ss << " interp=" << interp << " shading=" << (o.shade.flat ? "flat" : "gouraud")
      << (o.shade.wireframe ? " wireframe=1" : "") << " antialias=" << o.shade.antialias << " render_seed=" << o.run.seed << " size=" << cam.width
      << "x" << cam.height << " eye=" << cam.eye.x() << "," << cam.eye.y() << "," << cam.eye.z()
      << " look_at=" << cam.look_at.x() << "," << cam.look_at.y() << "," << cam.look_at.z()
@@ -48,9 +48,9 @@ std::string png_path(const RenderOptions& opts) {
 
 // Shades, renders and writes B on the loaded mesh; prints what was written.
 void render_and_write(const RenderOptions& opts, const LoadedScene& loaded,
-                      const Eigen::MatrixX3d& B, const Camera& camera,
-                      const std::string& method_settings) {
-  const ShadedField shaded = shade_vertices(loaded.mesh, B, opts.shade);
+                      const Eigen::MatrixX3d& B, const Eigen::MatrixX3d* indirect,
+                      const Camera& camera, const std::string& method_settings) {
+  const ShadedField shaded = shade_vertices(loaded, B, indirect, opts.shade, opts.run.threads);
   RenderStats stats;
   const Image image = render_scene(loaded, B, shaded.field, camera, opts.shade, opts.run, &stats);
   const double ev = choose_exposure(opts.shade, image);
@@ -60,12 +60,12 @@ void render_and_write(const RenderOptions& opts, const LoadedScene& loaded,
   paths.vertex_exr = opts.vertex_exr;
   paths.ply = opts.ply;
   const auto written = write_outputs(paths, loaded.mesh, shaded, image, ev,
-                                     render_settings(opts, method_settings, camera));
+                                     render_settings(opts, method_settings, shaded.interpolation, camera));
   const auto [power_after, power_before] = worst_power_error(shaded.power);
   std::printf("rendered %dx%d, %lld rays in %.2fs, exposure %+.3f EV\n", image.width, image.height,
               static_cast<long long>(stats.rays), stats.seconds, ev);
   std::printf("vertex power error (max over surfaces): %.3g (%s), %.3g before rescale\n",
-              power_after, opts.shade.vertex_interp.c_str(), power_before);
+              power_after, shaded.interpolation.c_str(), power_before);
   for (const auto& f : written) std::printf("wrote %s\n", f.c_str());
 }
 
@@ -84,8 +84,10 @@ int render_matrix(const RenderOptions& opts) {
   if (opts.radiosity.empty()) {
     plan_form_factors(plan, opts.ff, opts.run);
     plan.direct = opts.solver.solver == "direct";
-  } else
+  } else {
     plan.inputs.push_back({"--radiosity", opts.radiosity});
+    check_vertex_interp(opts.shade, false, "--radiosity");
+  }
   const LoadedScene loaded = load_scene(opts.scene, plan);
   const Camera camera = make_camera(loaded.scene, opts.camera);
   RadiosityResult r;
@@ -96,18 +98,20 @@ int render_matrix(const RenderOptions& opts) {
   } else {
     r = compute_radiosity(loaded, opts.ff, opts.solver, opts.run);
   }
-  render_and_write(opts, loaded, r.B, camera, matrix_settings(opts, loaded, r));
+  render_and_write(opts, loaded, r.B, r.solved ? &r.indirect : nullptr, camera,
+                   matrix_settings(opts, loaded, r));
   return r.solved && r.solution.status != SolveStatus::Converged ? kExitNotConverged : kExitOk;
 }
 
 // --method hierarchical: load (no meshing), solve hierarchically, render the leaves.
 int render_hierarchical(const RenderOptions& opts) {
+  check_vertex_interp(opts.shade, false, "--method hierarchical");
   Scene scene = load_checked_scene(opts.scene, render_plan(opts));
   const Camera camera = make_camera(scene, opts.camera);
   const HierarchicalRun h = solve_scene_hierarchical(
       std::move(scene), make_hierarchical_options(opts.method, opts.method.hierarchical.epsilon,
                                                   opts.solver, opts.run));
-  render_and_write(opts, h.loaded, h.B, camera, hierarchical_settings_text(h));
+  render_and_write(opts, h.loaded, h.B, nullptr, camera, hierarchical_settings_text(h));
   return hierarchical_status(h.stats) != SolveStatus::Converged ? kExitNotConverged : kExitOk;
 }
 

@@ -83,9 +83,17 @@ void add_shade_options(CLI::App* cmd, ShadeArgs& args) {
       ->capture_default_str();
   cmd->add_option("--vertex-interp", args.vertex_interp,
                   "Per-vertex reconstruction: conservative (area-weighted, rescaled per surface "
-                  "to conserve power) or area (area-weighted only)")
-      ->check(CLI::IsMember({"conservative", "area"}))
+                  "to conserve power), area (area-weighted only), exact-direct (exact direct "
+                  "light at each vertex plus the area-weighted indirect light), or auto "
+                  "(exact-direct on a --discontinuity mesh, else conservative)")
+      ->check(CLI::IsMember({"auto", "conservative", "area", "exact-direct"}))
       ->capture_default_str();
+}
+
+void check_vertex_interp(const ShadeArgs& args, bool has_form_factors, const std::string& why) {
+  if (args.vertex_interp == "exact-direct" && !has_form_factors)
+    throw UsageError("--vertex-interp exact-direct needs the form factors B is solved with (" +
+                     why + " gives B without them)");
 }
 
 void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOptions& solver,
@@ -103,6 +111,7 @@ void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOpti
   r.solution = solve_radiosity(problem, so);
   r.solve_seconds = solve_timer.seconds();
   r.B = r.solution.B;
+  r.indirect = indirect_irradiance(scene.mesh, F.F, r.B);
   r.solved = true;
   int iterations = 0;
   for (const auto& c : r.solution.channels) iterations = std::max(iterations, c.iterations);
@@ -123,12 +132,24 @@ RadiosityResult compute_radiosity(const LoadedScene& scene, const FormFactorArgs
   return r;
 }
 
-ShadedField shade_vertices(const PatchMesh& mesh, const Eigen::MatrixX3d& B,
-                           const ShadeArgs& args) {
+std::string resolve_vertex_interp(const ShadeArgs& args, const LoadedScene& scene,
+                                  const Eigen::MatrixX3d* indirect) {
+  if (args.vertex_interp != "auto") return args.vertex_interp;
+  return scene.discontinuity && indirect ? "exact-direct" : "conservative";
+}
+
+ShadedField shade_vertices(const LoadedScene& scene, const Eigen::MatrixX3d& B,
+                           const Eigen::MatrixX3d* indirect, const ShadeArgs& args, int threads) {
   const Timer timer;
   ShadedField s;
-  s.field =
-      interpolate_to_vertices(mesh, B, parse_vertex_interpolation(args.vertex_interp), &s.power);
+  s.interpolation = resolve_vertex_interp(args, scene, indirect);
+  if (s.interpolation == "exact-direct") {
+    LAMBERT_CHECK(indirect, "exact-direct vertex values without the indirect irradiance");
+    s.field = exact_direct_vertex_field(scene.scene, scene.mesh, B, *indirect, threads, &s.power);
+  } else {
+    s.field = interpolate_to_vertices(scene.mesh, B, parse_vertex_interpolation(s.interpolation),
+                                      &s.power);
+  }
   s.seconds = timer.seconds();
   return s;
 }

@@ -35,10 +35,15 @@ struct ShadeArgs {
   bool wireframe = false;  ///< --wireframe: patch edges drawn over the shading
   int antialias = 2;
   std::string exposure = "auto";  ///< "auto" or EV stops
-  std::string vertex_interp = "conservative";
+  /// auto (exact-direct on a --discontinuity mesh with F, else conservative), conservative,
+  /// area or exact-direct (geometry/vertex_field.hpp)
+  std::string vertex_interp = "auto";
 };
 /// Adds the shading options to a subcommand.
 void add_shade_options(CLI::App* cmd, ShadeArgs& args);
+/// Refuses --vertex-interp exact-direct before any work when B will not come with its F
+/// (`has_form_factors` false: --radiosity, --method hierarchical). Throws UsageError.
+void check_vertex_interp(const ShadeArgs& args, bool has_form_factors, const std::string& why);
 
 /// The radiosity B of every patch and how it was obtained.
 struct RadiosityResult {
@@ -48,6 +53,8 @@ struct RadiosityResult {
   FormFactorStats ff_stats;    ///< valid when solved (rays 0 when F was loaded)
   FormFactorOptions ff_options;  ///< valid when solved: the settings that made F (a loaded
                                  ///< file's own; see obtain_form_factors)
+  /// I = F (B - E) per patch (N x 3) when solved (problem.hpp), for exact-direct vertices.
+  Eigen::MatrixX3d indirect;
   std::int64_t ff_entries = 0;
   double ff_seconds = 0.0;
   double solve_seconds = 0.0;
@@ -66,10 +73,18 @@ RadiosityResult compute_radiosity(const LoadedScene& scene, const FormFactorArgs
 struct ShadedField {
   VertexField field;
   std::vector<SurfacePower> power;
+  std::string interpolation;  ///< the --vertex-interp used (auto resolved)
   double seconds = 0.0;
 };
-/// Interpolates B to the shading vertices with --vertex-interp.
-ShadedField shade_vertices(const PatchMesh& mesh, const Eigen::MatrixX3d& B, const ShadeArgs& args);
+/// --vertex-interp with auto resolved: exact-direct on a --discontinuity mesh when
+/// `indirect` is given, else conservative.
+std::string resolve_vertex_interp(const ShadeArgs& args, const LoadedScene& scene,
+                                  const Eigen::MatrixX3d* indirect);
+/// Interpolates B to the shading vertices with --vertex-interp. `indirect` (I = F (B - E),
+/// or null when B came without F) is needed for exact-direct, which auto picks on a
+/// --discontinuity mesh when it is given.
+ShadedField shade_vertices(const LoadedScene& scene, const Eigen::MatrixX3d& B,
+                           const Eigen::MatrixX3d* indirect, const ShadeArgs& args, int threads);
 
 /// Renders the scene through `camera` (with the run's shared BVH, scene_bvh).
 Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const VertexField& field,

@@ -51,6 +51,7 @@ struct MethodOutcome {
   std::string method;
   const LoadedScene& loaded;  ///< the mesh B lives on (and its BVH, for rendering)
   const Eigen::MatrixX3d& B;
+  const Eigen::MatrixX3d* indirect = nullptr;  ///< I = F (B - E) when B came with F
   std::string settings;            ///< the method's part of the settings line
   Json sections = Json::object();  ///< the method's report sections, in report order
   Json energy = Json::array();     ///< energy_balance: one object per channel
@@ -66,9 +67,9 @@ struct MethodOutcome {
 
 std::vector<double> as_vector(const Eigen::Vector3d& v) { return {v[0], v[1], v[2]}; }
 
-std::string shade_settings(const RunOptions& o, const Camera& cam) {
+std::string shade_settings(const RunOptions& o, const std::string& interp, const Camera& cam) {
   std::ostringstream ss;
-  ss << " interp=" << o.shade.vertex_interp << " shading=" << (o.shade.flat ? "flat" : "gouraud")
+  ss << " interp=" << interp << " shading=" << (o.shade.flat ? "flat" : "gouraud")
      << (o.shade.wireframe ? " wireframe=1" : "") << " antialias=" << o.shade.antialias << " render_seed=" << o.run.seed << " size=" << cam.width
      << "x" << cam.height;
   return ss.str();
@@ -117,10 +118,10 @@ Json report_json(const RunOptions& opts, const MethodOutcome& m, const Tail& t) 
                         {"relative_error", s.relative_error()},
                         {"area_weighted_relative_error", s.area_weighted_relative_error()}});
   j["vertex_power"] = {
-      {"interpolation", opts.shade.vertex_interp},
+      {"interpolation", t.shaded.interpolation},
       {"max_relative_error", after},
       {"area_weighted_max_relative_error", before},
-      {"tolerance", opts.shade.vertex_interp == "conservative" ? kPowerTolerance : before},
+      {"tolerance", t.shaded.interpolation == "conservative" ? kPowerTolerance : before},
       {"surfaces", surfaces}};
 
   j["render"] = {{"width", t.camera.width},
@@ -152,7 +153,7 @@ void print_summary(const RunOptions& opts, const MethodOutcome& m, const Tail& t
   std::printf(
       "vertices   power error per surface (max) %.2e with %s interpolation "
       "(area-weighted alone: %.2e)\n",
-      after, opts.shade.vertex_interp.c_str(), before);
+      after, t.shaded.interpolation.c_str(), before);
   std::printf("image      %dx%d, %d samples/pixel, exposure %+.2f EV\n", t.camera.width,
               t.camera.height, opts.shade.antialias * opts.shade.antialias, t.ev);
   std::string times;
@@ -169,8 +170,8 @@ void print_summary(const RunOptions& opts, const MethodOutcome& m, const Tail& t
 // The stages every method shares: per-vertex radiosity, render, write, report, summary.
 int finish_run(const RunOptions& opts, const RunPaths& paths, const MethodOutcome& m,
                const Camera& camera, Stages& stages) {
-  stages.next("per-vertex radiosity (" + opts.shade.vertex_interp + ")");
-  const ShadedField shaded = shade_vertices(m.loaded.mesh, m.B, opts.shade);
+  stages.next("per-vertex radiosity (" + resolve_vertex_interp(opts.shade, m.loaded, m.indirect) + ")");
+  const ShadedField shaded = shade_vertices(m.loaded, m.B, m.indirect, opts.shade, opts.run.threads);
 
   stages.next("rendering " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
   RenderStats rs;
@@ -179,7 +180,7 @@ int finish_run(const RunOptions& opts, const RunPaths& paths, const MethodOutcom
 
   stages.next("writing " + opts.output_dir + "/" + paths.name + ".*");
   const Timer timer;
-  const std::string settings = m.settings + shade_settings(opts, camera);
+  const std::string settings = m.settings + shade_settings(opts, shaded.interpolation, camera);
   std::vector<std::string> files =
       write_outputs(paths.files, m.loaded.mesh, shaded, image, ev, settings);
   files.push_back(paths.report);
@@ -268,6 +269,7 @@ int run_matrix(const RunOptions& opts) {
     r.ff_options = F.options;
     r.ff_entries = F.F.nonZeros();
     r.B = r.solution.B;
+    r.indirect = indirect_irradiance(loaded.mesh, F.F, r.B);
     r.solved = true;
     warn_about_lighting(loaded.mesh, F.F);
   } else {
@@ -278,6 +280,7 @@ int run_matrix(const RunOptions& opts) {
   }
 
   MethodOutcome m{"matrix", loaded, r.B};
+  m.indirect = &r.indirect;
   std::ostringstream settings;
   settings << "patches=" << loaded.mesh.size() << " max_edge=" << loaded.max_edge << ' '
            << ff_settings_text(r.ff_options, opts.ff.ff_file) << " solver=" << opts.solver.solver
@@ -346,6 +349,7 @@ int run_matrix(const RunOptions& opts) {
 
 // --method hierarchical: load (no meshing), hierarchical solve (stages 1-2 of 5).
 int run_hierarchical(const RunOptions& opts) {
+  check_vertex_interp(opts.shade, false, "--method hierarchical");
   Stages stages(5);
   const Timer timer;
   stages.next(loading_what(opts, "loading "));

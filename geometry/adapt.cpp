@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "core/error.hpp"
+#include "geometry/direct_light.hpp"
 
 namespace lambert {
 namespace {
@@ -73,6 +74,38 @@ std::vector<double> patch_errors(const PatchMesh& mesh, const Eigen::MatrixX3d& 
   }
   std::vector<double> e(mesh.size());
   for (std::int32_t i = 0; i < mesh.size(); ++i) e[i] = 0.5 * mesh.patches[i].area * jump[i];
+  return e;
+}
+
+std::vector<double> exact_direct_patch_errors(const Scene& scene, const PatchMesh& mesh,
+                                              const Eigen::MatrixX3d& indirect, int threads) {
+  LAMBERT_CHECK(indirect.rows() == mesh.size(), "exact_direct_patch_errors: I does not match the mesh");
+  // Per patch: its corners, then its edge midpoints, at its own normal.
+  std::vector<Eigen::Vector3d> points, normals;
+  std::vector<std::int64_t> first(mesh.size() + 1, 0);
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    const Patch& p = mesh.patches[i];
+    first[i] = static_cast<std::int64_t>(points.size());
+    for (int k = 0; k < p.vertex_count; ++k) points.push_back(mesh.vertices[p.vertices[k]]);
+    for (int k = 0; k < p.vertex_count; ++k)
+      points.push_back(0.5 * (mesh.vertices[p.vertices[k]] + mesh.vertices[p.vertices[(k + 1) % p.vertex_count]]));
+    normals.resize(points.size(), p.normal);
+  }
+  const Eigen::MatrixX3d H = exact_direct_irradiance(scene, points, normals, threads);
+  Eigen::MatrixX3d reflected = indirect;
+  for (std::int32_t i = 0; i < mesh.size(); ++i) reflected.row(i).array() *= mesh.patches[i].rho.transpose().array();
+  std::vector<double> e = patch_errors(mesh, reflected);
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    const Patch& p = mesh.patches[i];
+    const std::int64_t c = first[i], m = c + p.vertex_count;
+    double worst = 0.0;
+    for (int k = 0; k < p.vertex_count; ++k) {
+      const double mid = H.row(m + k).mean();
+      const double lin = 0.5 * (H.row(c + k).mean() + H.row(c + (k + 1) % p.vertex_count).mean());
+      worst = std::max(worst, std::abs(mid - lin));
+    }
+    e[i] += p.area * p.rho.mean() * worst;
+  }
   return e;
 }
 

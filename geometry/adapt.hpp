@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "geometry/mesh.hpp"
+#include "geometry/scene.hpp"
 
 namespace lambert {
 
@@ -28,6 +29,19 @@ RefinedMesh triangulate_quads(const PatchMesh& mesh);
 /// much across the patch): e_i = A_i max_j |b_i - b_j| / 2 (W, scene units). Isolated
 /// patches get 0. O(N).
 std::vector<double> patch_errors(const PatchMesh& mesh, const Eigen::MatrixX3d& B);
+
+/// Per-patch error estimate of a field with exact direct light at the vertices
+/// (exact_direct_vertex_field): its direct part is the linear interpolant of H_d between the
+/// corners, so the patch's error is estimated from H_d at its edge midpoints,
+///   e_i = A_i ρ̄_i max_edges |H_d(m) - (H_d(a) + H_d(b)) / 2|   (RGB means; W, scene units),
+/// the interpolation error where it is largest for a quadratic (exact for one), plus the
+/// jump estimate of patch_errors applied to the reflected indirect light ρ_i I_i
+/// (`indirect`, N x 3, as in exact_direct_vertex_field). Where the edges follow the shadow
+/// lines (discontinuity meshing) this marks the curved parts of the penumbrae, not the
+/// kinks the mesh already resolves. Cost: 2 exact evaluations (direct_light.hpp) per patch
+/// corner; parallel over `threads`, deterministic.
+std::vector<double> exact_direct_patch_errors(const Scene& scene, const PatchMesh& mesh,
+                                              const Eigen::MatrixX3d& indirect, int threads = 0);
 
 /// Bisects the `marked` triangles (and whatever conformity requires) once each. Every patch
 /// must be a triangle (triangulate_quads). Children keep their parent's reflectance,

@@ -8,7 +8,9 @@
 #include <utility>
 #include <vector>
 
+#include "geometry/mesh.hpp"
 #include "geometry/scene.hpp"
+#include "geometry/vertex_field.hpp"
 
 namespace lambert {
 
@@ -58,6 +60,27 @@ PartialShadowGeometry partial_shadow_geometry();
 /// light corner coordinate projected through every blocker edge coordinate,
 /// s + (b - s) H / (H - h_b), that falls inside the floor.
 std::pair<std::vector<double>, std::vector<double>> partial_shadow_lines();
+
+/// The exact floor radiosity of partial_shadow_scene at a floor point x (z = 0):
+/// 0.5 x shadowed_point_factor(x, +z, light, {blocker}).
+double partial_shadow_floor_radiosity(const Eigen::Vector3d& x);
+/// The exact occluded surface factor F_{floor->light} of partial_shadow_scene: the floor
+/// cut along every line of partial_shadow_lines into rectangles inside which the visible
+/// part of the light changes smoothly, each integrated by a tensor Gauss-Legendre rule of
+/// `order` points per direction (the integrand is analytic in each cell, so the rule
+/// converges exponentially: orders 12 and 20 agree to rounding, about 1e-16).
+double partial_shadow_floor_light_factor(int order = 16);
+
+/// Errors of a floor radiosity on partial_shadow_scene against the exact field.
+struct PartialShadowErrors {
+  double l1 = 0.0;    ///< area-mean |B_i - B(x)| of the patch constants (midpoint rule, 16 per triangle)
+  double line = 0.0;  ///< largest |f(x) - B(x)| of the interpolated vertex field f on y = 1.75
+};
+/// `B` (N x 3, its channel mean is used) and its vertex field on a mesh of
+/// partial_shadow_scene: both errors. The line crosses the umbra and both penumbrae in x,
+/// 0.05 from the umbra's edge y = 1.7 (400 points on x in [0.2, 3.8]).
+PartialShadowErrors partial_shadow_errors(const PatchMesh& mesh, const Eigen::MatrixX3d& B,
+                                          const VertexField& field);
 
 /// An analytic case: its scene and the exact factor from surface "a" to surface "b".
 struct AnalyticCase {

@@ -300,29 +300,40 @@ std::vector<Triangle> mesh_part(const Scene& scene, const Part& part, double max
       }
     }
   }
-  Mesher mesher(cdt, Criteria(kShapeBound, max_edge));
-  mesher.set_seeds(seeds.begin(), seeds.end(), /*mark=*/false);
-  mesher.init(/*domain_specified=*/false);
   // A vertex budget: the size bound alone needs about 2 A / (h² sin 60°) vertices; beyond
   // 16 times that (and 64 per input vertex), the refinement is chasing features at the
   // rounding scale (constraints crossing at tiny angles, self-intersecting faces), and stops
   // with a warning: the mesh is still valid and conforming, some triangles are thin.
-  double area = 0;
-  for (auto fh : cdt.finite_face_handles())
-    if (fh->is_in_domain()) area += std::abs(CGAL::to_double(cdt.triangle(fh).area()));
-  const double budget = 64.0 * static_cast<double>(cdt.number_of_vertices()) + 1000.0 +
-                        (max_edge > 0 ? 16.0 * 2.0 * area / (max_edge * max_edge * 0.866) : 0.0);
-  while (!mesher.is_refinement_done()) {
-    if (static_cast<double>(cdt.number_of_vertices()) > budget) {
-      log_warn("discontinuity meshing: stopped refining a plane of surface '" +
-               scene.surfaces[scene.faces[part.faces[0]].surface].name + "' at " +
-               std::to_string(cdt.number_of_vertices()) +
-               " vertices (constraints meet at angles or distances too small to resolve); some "
-               "triangles there are thinner than the " + std::to_string(kMinAngleDegrees).substr(0, 4) +
-               " degree bound");
-      break;
+  double budget = -1.0;  // set once the first pass has marked the domain
+  // Two passes: the size bound alone first (no angle bound: it only splits triangles larger
+  // than the bound, so it ends near the size plan's vertex count), then the angle bound.
+  // Where the second pass runs out of budget (constraints at tiny angles), every triangle
+  // still meets the size bound; a single pass could spend the budget on one cluster of
+  // small angles and leave the rest of the plane coarse.
+  Mesher mesher(cdt, Criteria(0.0, max_edge));
+  mesher.set_seeds(seeds.begin(), seeds.end(), /*mark=*/false);
+  mesher.init(/*domain_specified=*/false);
+  for (const double shape : {0.0, kShapeBound}) {
+    if (shape > 0.0) mesher.set_criteria(Criteria(shape, max_edge));
+    if (budget < 0) {
+      double area = 0;
+      for (auto fh : cdt.finite_face_handles())
+        if (fh->is_in_domain()) area += std::abs(CGAL::to_double(cdt.triangle(fh).area()));
+      budget = 64.0 * static_cast<double>(cdt.number_of_vertices()) + 1000.0 +
+               (max_edge > 0 ? 16.0 * 2.0 * area / (max_edge * max_edge * 0.866) : 0.0);
     }
-    mesher.step_by_step_refine_mesh();
+    while (!mesher.is_refinement_done()) {
+      if (static_cast<double>(cdt.number_of_vertices()) > budget) {
+        log_warn("discontinuity meshing: stopped refining a plane of surface '" +
+                 scene.surfaces[scene.faces[part.faces[0]].surface].name + "' at " +
+                 std::to_string(cdt.number_of_vertices()) +
+                 " vertices (constraints meet at angles or distances too small to resolve); "
+                 "some triangles there are thinner than the " +
+                 std::to_string(kMinAngleDegrees).substr(0, 4) + " degree bound");
+        break;
+      }
+      mesher.step_by_step_refine_mesh();
+    }
   }
 
   std::vector<Triangle> out;

@@ -24,6 +24,10 @@ constexpr double kVanishing = 1e-6;
 constexpr double kGrazeStop = 1e-3;
 // Lines are kept this far (relative to the receiver's size) past its bounding box.
 constexpr double kOverrun = 0.05;
+// A line is kept when at least this much of it (relative to the face's size) lies inside
+// the face polygon: far above the mesher's snap (1e-6), so that a line touching the face
+// only at a corner, or dipping in by rounding, is dropped.
+constexpr double kMinInside = 1e-3;
 // Pieces per wedge line at most (a line crossing the whole scene with the default piece).
 constexpr int kMaxPieces = 256;
 
@@ -89,6 +93,57 @@ bool clip_interval(double fa, double fb, double& t0, double& t1) {
   if (fa < 0) t0 = std::max(t0, t);
   else t1 = std::min(t1, t);
   return t0 < t1;
+}
+
+// The parts of the segment a-b (on the plane of `poly`, unit normal n) inside the polygon,
+// each end that the boundary cut extended by `overrun` (length) past it: the crossings with
+// the edges cut a-b into intervals, kept where their midpoints are inside (crossing number
+// in the plane). Any simple polygon, O(corners).
+std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> clip_to_polygon(
+    const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Polygon3& poly,
+    const Eigen::Vector3d& n, double overrun) {
+  const Eigen::Vector3d u = (std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY()).cross(n).normalized();
+  const Eigen::Vector3d v = n.cross(u);
+  auto to2 = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d((p - poly[0]).dot(u), (p - poly[0]).dot(v)); };
+  const Eigen::Vector2d A = to2(a), D = to2(b) - A;
+  std::vector<Eigen::Vector2d> P;
+  for (const auto& p : poly) P.push_back(to2(p));
+  std::vector<double> ts = {0.0, 1.0};
+  auto cross2 = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) { return x.x() * y.y() - x.y() * y.x(); };
+  for (size_t k = 0; k < P.size(); ++k) {
+    const Eigen::Vector2d E = P[(k + 1) % P.size()] - P[k];
+    const double den = cross2(D, E);
+    if (den == 0.0) continue;  // parallel: no transversal crossing
+    const double t = cross2(P[k] - A, E) / den, w = cross2(P[k] - A, D) / den;
+    if (t > 0.0 && t < 1.0 && w >= 0.0 && w <= 1.0) ts.push_back(t);
+  }
+  std::sort(ts.begin(), ts.end());
+  auto inside = [&](const Eigen::Vector2d& q) {
+    bool in = false;
+    for (size_t k = 0, j = P.size() - 1; k < P.size(); j = k++)
+      if ((P[k].y() > q.y()) != (P[j].y() > q.y()) &&
+          q.x() < P[j].x() + (P[k].x() - P[j].x()) * (q.y() - P[j].y()) / (P[k].y() - P[j].y()))
+        in = !in;
+    return in;
+  };
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> out;
+  const double dt = overrun / std::max((b - a).norm(), 1e-300);
+  auto emit = [&](double t0, double t1) {
+    if (t0 > 0.0) t0 = std::max(0.0, t0 - dt);
+    if (t1 < 1.0) t1 = std::min(1.0, t1 + dt);
+    out.push_back({a + t0 * (b - a), a + t1 * (b - a)});
+  };
+  double start = -1.0;
+  for (size_t k = 0; k + 1 < ts.size(); ++k) {
+    const bool in = ts[k + 1] > ts[k] && inside(A + 0.5 * (ts[k] + ts[k + 1]) * D);
+    if (in && start < 0) start = ts[k];
+    if (!in && start >= 0) {
+      emit(start, ts[k]);
+      start = -1.0;
+    }
+  }
+  if (start >= 0) emit(start, 1.0);
+  return out;
 }
 
 // A wedge line on the receiver, parametrised by u in [0, 1]: the receiver point q(u), the
@@ -191,12 +246,18 @@ std::vector<DiscontinuitySegment> discontinuity_segments(const Scene& scene,
       // Lines run a margin past the face's bounding box, so that they cross its boundary
       // transversally instead of ending at rounding distance from it (a feature Delaunay
       // refinement could not resolve); the mesher keeps only what lies inside the faces.
+      // A line with (almost) nothing inside the face polygon is dropped: it is no
+      // discontinuity of the face, and one running just outside an edge at a small angle
+      // (the wedges of a neighbour's edge on a slightly warped wall) made the refinement
+      // chase the sliver between them all along the edge.
       const double pad = kOverrun * (R.hi - R.lo).norm() + eps;
       const Eigen::Vector3d lo = R.lo - Eigen::Vector3d::Constant(pad);
       const Eigen::Vector3d hi = R.hi + Eigen::Vector3d::Constant(pad);
       auto add = [&](Eigen::Vector3d a, Eigen::Vector3d b, int order) {
         if (!clip_to_box(a, b, lo, hi) || (b - a).norm() <= eps) return;
-        segs.push_back({a, b, order, static_cast<std::int32_t>(r)});
+        double inside = 0.0;
+        for (const auto& [p, q] : clip_to_polygon(a, b, R.poly, R.normal, 0.0)) inside += (q - p).norm();
+        if (inside > kMinInside * (R.hi - R.lo).norm()) segs.push_back({a, b, order, static_cast<std::int32_t>(r)});
       };
 
       // D0: blocker faces touching or piercing the receiver's plane.

@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/sampling.hpp"
+#include "geometry/direct_light.hpp"
 
 namespace lambert {
 namespace {
@@ -299,20 +300,32 @@ std::vector<SurfacePower> surface_power(const PatchMesh& mesh, const Eigen::Matr
   return out;
 }
 
-VertexField interpolate_to_vertices(const PatchMesh& mesh, const Eigen::MatrixX3d& patch_values,
-                                    VertexInterpolation mode, std::vector<SurfacePower>* power) {
-  LAMBERT_CHECK(patch_values.rows() == mesh.size(), "patch field size does not match the mesh");
-  VertexField f = build_shading_vertices(mesh);
+namespace {
+
+// The area-weighted mean of a per-patch field (N x 3) at every shading vertex of f.
+Eigen::MatrixX3d area_weighted(const PatchMesh& mesh, const VertexField& f,
+                               const Eigen::MatrixX3d& patch_values) {
+  Eigen::MatrixX3d values = Eigen::MatrixX3d::Zero(f.size(), 3);
   Eigen::VectorXd weight = Eigen::VectorXd::Zero(f.size());
   for (std::int32_t i = 0; i < mesh.size(); ++i) {
     const Patch& p = mesh.patches[i];
     for (int k = 0; k < p.vertex_count; ++k) {
-      f.values.row(f.patch_corners[i][k]) += p.area * patch_values.row(i);
+      values.row(f.patch_corners[i][k]) += p.area * patch_values.row(i);
       weight[f.patch_corners[i][k]] += p.area;
     }
   }
   for (std::int32_t k = 0; k < f.size(); ++k)
-    if (weight[k] > 0) f.values.row(k) /= weight[k];
+    if (weight[k] > 0) values.row(k) /= weight[k];
+  return values;
+}
+
+}  // namespace
+
+VertexField interpolate_to_vertices(const PatchMesh& mesh, const Eigen::MatrixX3d& patch_values,
+                                    VertexInterpolation mode, std::vector<SurfacePower>* power) {
+  LAMBERT_CHECK(patch_values.rows() == mesh.size(), "patch field size does not match the mesh");
+  VertexField f = build_shading_vertices(mesh);
+  f.values = area_weighted(mesh, f, patch_values);
   anchor_hanging_vertices(find_hanging_vertices(mesh, f), f);
 
   std::vector<SurfacePower> pw = surface_power(mesh, patch_values, f);
@@ -332,6 +345,27 @@ VertexField interpolate_to_vertices(const PatchMesh& mesh, const Eigen::MatrixX3
     for (size_t s = 0; s < pw.size(); ++s) pw[s].field_power = after[s].field_power;
   }
   if (power) *power = std::move(pw);
+  return f;
+}
+
+VertexField exact_direct_vertex_field(const Scene& scene, const PatchMesh& mesh,
+                                      const Eigen::MatrixX3d& patch_values,
+                                      const Eigen::MatrixX3d& indirect, int threads,
+                                      std::vector<SurfacePower>* power) {
+  LAMBERT_CHECK(patch_values.rows() == mesh.size() && indirect.rows() == mesh.size(),
+                "patch field size does not match the mesh");
+  VertexField f = build_shading_vertices(mesh);
+  Eigen::MatrixX3d E(mesh.size(), 3), rho(mesh.size(), 3);
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    E.row(i) = mesh.patches[i].emission.transpose();
+    rho.row(i) = mesh.patches[i].rho.transpose();
+  }
+  const Eigen::MatrixX3d direct = exact_direct_irradiance(scene, f.positions, f.normals, threads);
+  f.values = area_weighted(mesh, f, E).array() +
+             area_weighted(mesh, f, rho).array() *
+                 (direct + area_weighted(mesh, f, indirect)).array();
+  anchor_hanging_vertices(find_hanging_vertices(mesh, f), f);
+  if (power) *power = surface_power(mesh, patch_values, f);
   return f;
 }
 

@@ -71,6 +71,7 @@
 #include <vector>
 
 #include "geometry/mesh.hpp"
+#include "geometry/scene.hpp"
 
 namespace lambert {
 
@@ -149,6 +150,24 @@ void anchor_hanging_vertices(const std::vector<HangingVertex>& hanging, VertexFi
 VertexField interpolate_to_vertices(const PatchMesh& mesh, const Eigen::MatrixX3d& patch_values,
                                     VertexInterpolation mode = VertexInterpolation::Conservative,
                                     std::vector<SurfacePower>* power = nullptr);
+
+/// Per-vertex radiosity with exact direct light (direct_light.hpp), for meshes whose
+/// edges follow the shadow boundaries (discontinuity meshing): splitting each patch's
+/// B_i = E_i + ρ_i (D_i + I_i) into emission, direct irradiance D_i = Σ_j F_ij E_j and
+/// indirect irradiance I_i = Σ_j F_ij (B_j - E_j) (`indirect`, N x 3, from the F B was solved
+/// with), the value at shading vertex k is
+///   v_k = Ē_k + ρ̄_k (H_d(x_k) + Ī_k),
+/// Ē, ρ̄, Ī the area-weighted means over its patches and H_d the exact direct irradiance at
+/// its position and normal. The direct part, where the radiosity has its kinks and jumps,
+/// is then exact at every vertex (no Monte Carlo noise, no mixing of the two sides of a
+/// penumbra boundary); only the smoother indirect part is averaged. No rescale: `power`
+/// (per surface) reports how far the field's integral is from Σ A_i B_i (the patches'
+/// discretisation and estimator error, not a reconstruction defect). Cost: one exact
+/// shadow evaluation per shading vertex and emitter face (direct_light.hpp).
+VertexField exact_direct_vertex_field(const Scene& scene, const PatchMesh& mesh,
+                                      const Eigen::MatrixX3d& patch_values,
+                                      const Eigen::MatrixX3d& indirect, int threads = 0,
+                                      std::vector<SurfacePower>* power = nullptr);
 
 /// Exact integral over patch i of the field interpolated from `values` (linear on
 /// triangles, bilinear on quads), per channel.

@@ -8,6 +8,7 @@
 
 #include "apps/cli.hpp"
 #include "common/run_cli.hpp"
+#include "geometry/analytic.hpp"
 #include "common/temp_dir.hpp"
 
 namespace lambert {
@@ -70,6 +71,32 @@ TEST(AccuracyCommand, TinyAnalyticCaseWritesTableCsvAndPlots) {
   }();
   EXPECT_NE(svg.find("<svg"), std::string::npos);
   EXPECT_NE(svg.find("hemicube"), std::string::npos);
+}
+
+// The occluded partial_shadow case: the exact floor-to-light factor past the blocker is the
+// reference for the surface factor (F_ab), and the hybrid reference's per-patch F lies near
+// it. Tolerance: the surface factor sums the pairs' visible fractions, each a binomial of k
+// = 256 rays (σ ≤ 1/(2√k) of its G); even fully correlated errors give σ ≤ F/(2√k) = F/32,
+// so 4σ = F/8. The unoccluded factor (0.0220) is 32 % above the exact 0.0167: a case that
+// ignored the blocker fails.
+TEST(AccuracyCommand, PartialShadowCaseHasAnExactOccludedSurfaceFactor) {
+  testing::TempDir dir;
+  const std::string prefix = dir.file("acc");
+  ::testing::internal::CaptureStdout();
+  ASSERT_EQ(run({"accuracy", "--case", "partial_shadow", "--max-edge", "1", "-q", "--estimators",
+                 "hybrid", "--hybrid-samples", "16", "--reference-samples", "256", "-o", prefix}),
+            kExitOk);
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  EXPECT_NE(out.find("partial-shadow kernel"), std::string::npos) << out;
+  const auto table = lines(prefix + "_table.csv");
+  ASSERT_EQ(table.size(), 3u);  // header, reference, hybrid k=16
+  const double exact = partial_shadow_floor_light_factor();
+  const double f_ref = std::stod(column(table[0], table[1], "F_ab"));
+  EXPECT_NEAR(f_ref, exact, exact / 8) << "reference F(floor->light)";
+  // F_exact_abs_err is the max over both directions; F(light->floor) = 16 F(floor->light)
+  // (the areas' ratio) with the same relative bound.
+  EXPECT_LE(std::stod(column(table[0], table[1], "F_exact_abs_err")), 16 * exact / 8);
+  EXPECT_GE(std::stod(column(table[0], table[1], "F_exact_abs_err")), std::abs(f_ref - exact));
 }
 
 TEST(AccuracyCommand, SceneWithoutClosedFormUsesAHybridReference) {

@@ -172,3 +172,47 @@ TEST(RenderCommand, BadOptionsAreUsageErrors) {
 }
 
 }  // namespace lambert
+
+namespace lambert {
+
+// --vertex-interp auto is exact-direct on a --discontinuity mesh solved here (report and
+// settings say so) and conservative otherwise; exact-direct is refused, before any work,
+// where B comes without its F (--radiosity, --method hierarchical).
+TEST(RunCommand, VertexInterpAutoIsExactDirectOnDiscontinuityMeshes) {
+  lambert::testing::TempDir dir;
+  write_tiny_scene(dir);
+  const std::string scene = dir.file("tiny.obj");
+  auto interpolation = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {"run", scene, "-o", dir.file("o/"), "--max-edge", "0.3",
+                                     "--samples", "2", "--size", "16x16", "--antialias", "1", "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    ::testing::internal::CaptureStdout();
+    const int code = run(args);
+    ::testing::internal::GetCapturedStdout();
+    EXPECT_EQ(code, kExitOk);
+    std::ifstream in(dir.file("o/report.json"));
+    return nlohmann::json::parse(in)["vertex_power"]["interpolation"].get<std::string>();
+  };
+  EXPECT_EQ(interpolation({"--discontinuity"}), "exact-direct");
+  EXPECT_EQ(interpolation({}), "conservative");
+  EXPECT_EQ(interpolation({"--vertex-interp", "exact-direct"}), "exact-direct");
+  EXPECT_EQ(interpolation({"--discontinuity", "--vertex-interp", "area"}), "area");
+
+  ::testing::internal::CaptureStdout();
+  ASSERT_EQ(run({"solve", scene, "--max-edge", "0.3", "--samples", "2", "-o", dir.file("B.csv"), "-q"}),
+            kExitOk);
+  ::testing::internal::GetCapturedStdout();
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(run({"render", scene, "--max-edge", "0.3", "--radiosity", dir.file("B.csv"),
+                 "--vertex-interp", "exact-direct", "-o", dir.file("r.exr"), "-q"}),
+            kExitUsage);
+  EXPECT_EQ(run({"run", scene, "--method", "hierarchical", "--vertex-interp", "exact-direct",
+                 "-o", dir.file("h/"), "-q"}),
+            kExitUsage);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("exact-direct"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("r.exr")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("h/report.json")));
+}
+
+}  // namespace lambert
