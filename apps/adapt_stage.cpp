@@ -72,6 +72,7 @@ std::vector<AdaptRound> adapt_scene(LoadedScene& scene, const FormFactorArgs& ff
     r.changed = changed_now;
     r.estimated_error = estimated_error(scene.mesh, e);
     r.seconds = timer.seconds();
+    r.solve_seconds = solution.seconds;
     r.rays = ff.stats.rays;
     out.push_back(r);
     log_info("adapt: round " + std::to_string(round) + ": " + std::to_string(r.patches) +

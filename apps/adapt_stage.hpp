@@ -36,6 +36,7 @@ struct AdaptRound {
   std::int64_t changed = 0;      ///< patches whose form factors were (re)computed
   double estimated_error = 0.0;  ///< Σ patch_errors / Σ A (W/m², mean over the area)
   double seconds = 0.0;          ///< form factors + solve of this round
+  double solve_seconds = 0.0;    ///< the solve alone
   std::int64_t rays = 0;
 };
 

@@ -359,7 +359,7 @@ std::vector<Triangle> mesh_part(const Scene& scene, const Part& part, double max
 // inserted into the triangles of the other side by fan splits.
 void conform_creases(const Scene& scene, const std::vector<Part>& parts, std::vector<Triangle>& tris) {
   if (parts.size() < 2) return;
-  std::map<std::array<Key3, 2>, std::pair<int, std::array<Eigen::Vector3d, 2>>> edge_part;
+  std::map<std::array<Key3, 2>, int> edge_part;  // an edge -> the first part holding it
   std::vector<std::array<Eigen::Vector3d, 2>> creases;
   std::map<std::array<Key3, 2>, char> is_crease;
   for (size_t pi = 0; pi < parts.size(); ++pi) {
@@ -369,8 +369,8 @@ void conform_creases(const Scene& scene, const std::vector<Part>& parts, std::ve
         Eigen::Vector3d a = poly[k], b = poly[(k + 1) % poly.size()];
         if (key(b) < key(a)) std::swap(a, b);
         const std::array<Key3, 2> e{key(a), key(b)};
-        const auto it = edge_part.emplace(e, std::make_pair(static_cast<int>(pi), std::array<Eigen::Vector3d, 2>{a, b}));
-        if (!it.second && it.first->second.first != static_cast<int>(pi) && !is_crease[e]) {
+        const auto it = edge_part.emplace(e, static_cast<int>(pi));
+        if (!it.second && it.first->second != static_cast<int>(pi) && !is_crease[e]) {
           is_crease[e] = 1;
           creases.push_back({a, b});
         }

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <numeric>
 
 #include "core/parallel.hpp"
 #include "geometry/bvh.hpp"

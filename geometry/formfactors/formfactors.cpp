@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <memory>
 
 #include "core/error.hpp"
@@ -315,23 +314,32 @@ FormFactors update_form_factors(const PatchMesh& mesh, const std::vector<std::in
       if (j >= 0) entries.emplace_back(i, j, it.value());
     }
   }
-  // Pairs with a new patch: sum and count the sides' G, keyed by the unordered pair.
-  std::map<std::pair<std::int32_t, std::int32_t>, std::pair<double, int>> pairs;
+  // Pairs with a new patch: each side's G, keyed by the unordered pair, sorted so that the
+  // (at most two) sides of a pair are adjacent, then averaged (16 bytes per side, O(m log m)).
+  struct Side {
+    std::int32_t i, j;  // i < j
+    double G;
+  };
+  std::vector<Side> sides;
   for (std::int32_t i = 0; i < n; ++i) {
     if (!estimated(i)) continue;
     for (SparseF::InnerIterator it(part.F, i); it; ++it) {
       const auto j = static_cast<std::int32_t>(it.col());
       if (origin[i] >= 0 && origin[j] >= 0) continue;
-      auto& g = pairs[{std::min(i, j), std::max(i, j)}];
-      g.first += area[i] * it.value();
-      g.second += 1;
+      sides.push_back({std::min(i, j), std::max(i, j), area[i] * it.value()});
     }
   }
-  for (const auto& [key, g] : pairs) {
-    const auto [i, j] = key;
+  std::stable_sort(sides.begin(), sides.end(), [](const Side& a, const Side& b) {
+    return a.i != b.i ? a.i < b.i : a.j < b.j;
+  });
+  for (size_t k = 0; k < sides.size();) {
+    const std::int32_t i = sides[k].i, j = sides[k].j;
+    double sum = 0.0;
+    int count = 0;
+    for (; k < sides.size() && sides[k].i == i && sides[k].j == j; ++k, ++count) sum += sides[k].G;
     // Sides estimated but without an entry estimated G = 0: they count in the mean.
-    const int sides = (estimated(i) ? 1 : 0) + (estimated(j) ? 1 : 0);
-    const double G = g.first / std::max(sides, g.second);
+    const int estimated_sides = (estimated(i) ? 1 : 0) + (estimated(j) ? 1 : 0);
+    const double G = sum / std::max(estimated_sides, count);
     if (!(G > 0.0)) continue;
     entries.emplace_back(i, j, G / area[i]);
     entries.emplace_back(j, i, G / area[j]);
