@@ -9,6 +9,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <Eigen/Geometry>
+#include <tuple>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -90,9 +91,11 @@ std::vector<Part> planar_parts(const Scene& scene, std::int32_t surface, double 
       Part p;
       p.o = poly[0];
       p.w = n;
+      // u along the face's first non-degenerate edge: on axis-aligned faces the frame is
+      // axis-aligned and axis-aligned lines keep exact coordinates (a frame along the
+      // diagonal rounds them to chains bent by 1e-16, on which CGAL's refinement failed).
       Eigen::Vector3d e = Eigen::Vector3d::Zero();
-      for (const auto& c : poly)
-        if ((c - poly[0]).squaredNorm() > e.squaredNorm()) e = c - poly[0];
+      for (size_t k = 1; k < poly.size() && !(e.squaredNorm() > 0); ++k) e = poly[k] - poly[0];
       p.u = (e - e.dot(n) * n).normalized();
       p.v = n.cross(p.u);
       parts.push_back(p);
@@ -101,6 +104,61 @@ std::vector<Part> planar_parts(const Scene& scene, std::int32_t surface, double 
     part->faces.push_back(static_cast<std::int32_t>(f));
   }
   return parts;
+}
+
+// Splits segments at their crossings so that the triangulation receives segments meeting
+// only at shared endpoints: each proper crossing (interiors of both) is computed in double
+// and merged by `snap_point` with every point within the snap distance, so crossings of
+// nearly concurrent lines become one vertex instead of a cluster at the rounding scale (on
+// which CGAL's refinement built degenerate triangles and crashed); every point goes through
+// `snap_point`, so no two vertices are closer than the snap distance. O(S²) for S segments
+// (a few hundred per plane).
+template <class Snap>
+std::vector<std::array<Point2, 2>> split_at_crossings(const std::vector<std::array<Point2, 2>>& in,
+                                                      Snap&& snap_point) {
+  const size_t n = in.size();
+  std::vector<Eigen::Vector2d> a(n), b(n);
+  std::vector<Eigen::Vector2d> lo(n), hi(n);
+  for (size_t i = 0; i < n; ++i) {
+    a[i] = {in[i][0].x(), in[i][0].y()};
+    b[i] = {in[i][1].x(), in[i][1].y()};
+    lo[i] = a[i].cwiseMin(b[i]);
+    hi[i] = a[i].cwiseMax(b[i]);
+  }
+  auto cross2 = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) { return x.x() * y.y() - x.y() * y.x(); };
+  std::vector<std::vector<std::pair<double, Eigen::Vector2d>>> cuts(n);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = i + 1; j < n; ++j) {
+      if ((lo[i].array() > hi[j].array()).any() || (lo[j].array() > hi[i].array()).any()) continue;
+      const Eigen::Vector2d d = b[i] - a[i], e = b[j] - a[j];
+      const double den = cross2(d, e);
+      if (den == 0.0) continue;
+      const double t = cross2(a[j] - a[i], e) / den, u = cross2(a[j] - a[i], d) / den;
+      if (!(t > 0.0 && t < 1.0 && u > 0.0 && u < 1.0)) continue;
+      const Eigen::Vector2d p = snap_point(Point2(a[i].x() + t * d.x(), a[i].y() + t * d.y()));
+      if (p != a[i] && p != b[i]) cuts[i].push_back({t, p});
+      if (p != a[j] && p != b[j]) cuts[j].push_back({u, p});
+    }
+  std::vector<std::array<Point2, 2>> out;
+  for (size_t i = 0; i < n; ++i) {
+    std::sort(cuts[i].begin(), cuts[i].end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    Eigen::Vector2d from = a[i];
+    cuts[i].push_back({1.0, b[i]});
+    for (const auto& c : cuts[i]) {
+      if (c.second == from) continue;
+      out.push_back({Point2(from.x(), from.y()), Point2(c.second.x(), c.second.y())});
+      from = c.second;
+    }
+  }
+  // Merged crossings may make two pieces coincide: keep one of each.
+  for (auto& s : out)
+    if (std::make_pair(s[1].x(), s[1].y()) < std::make_pair(s[0].x(), s[0].y())) std::swap(s[0], s[1]);
+  std::sort(out.begin(), out.end(), [](const auto& x, const auto& y) {
+    return std::make_tuple(x[0].x(), x[0].y(), x[1].x(), x[1].y()) <
+           std::make_tuple(y[0].x(), y[0].y(), y[1].x(), y[1].y());
+  });
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
 }
 
 // Constraint segments in a part's plane, cleaned so that no two features are closer than
@@ -231,7 +289,7 @@ std::vector<std::array<Point2, 2>> clean_segments(const std::vector<std::array<P
     }
     split.push_back({Point2(from.x(), from.y()), s[1]});
   }
-  return split;
+  return split_at_crossings(split, snapped);
 }
 
 // Triangles of one planar part, meshed by a refined constrained Delaunay triangulation.
