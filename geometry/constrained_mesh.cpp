@@ -1,19 +1,28 @@
 // Constrained Delaunay meshing of each planar part of every surface (CGAL Mesh_2), with the
 // discontinuity lines as constraints (see discontinuity.hpp).
 
+// CGAL's assertions stay on in this file, also in Release builds: with inexact
+// constructions the mesher can meet configurations it cannot handle (a split point that
+// rounds off its edge next to a sliver), and without its checks it then writes through
+// broken invariants (SIGSEGV, SIGFPE in GMP). With them it throws, and mesh_part falls back.
+#ifdef NDEBUG
+#undef NDEBUG
+#endif
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Delaunay_mesh_face_base_2.h>
 #include <CGAL/Delaunay_mesh_size_criteria_2.h>
 #include <CGAL/Delaunay_mesh_vertex_base_2.h>
 #include <CGAL/Delaunay_mesher_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/exceptions.h>
 
 #include <Eigen/Geometry>
-#include <tuple>
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
+#include <string>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -293,8 +302,8 @@ std::vector<std::array<Point2, 2>> clean_segments(const std::vector<std::array<P
 }
 
 // Triangles of one planar part, meshed by a refined constrained Delaunay triangulation.
-std::vector<Triangle> mesh_part(const Scene& scene, const Part& part, double max_edge,
-                                const std::vector<const DiscontinuitySegment*>& lines) {
+std::vector<Triangle> triangulate_part(const Scene& scene, const Part& part, double max_edge,
+                                       const std::vector<const DiscontinuitySegment*>& lines) {
   CDT cdt;
   std::map<std::pair<double, double>, Eigen::Vector3d> corners;  // exact 3-D input corners
   // Each face as triangles in 2-D, for the point-in-face tests.
@@ -410,6 +419,31 @@ std::vector<Triangle> mesh_part(const Scene& scene, const Part& part, double max
     out.push_back(t);
   }
   return out;
+}
+
+// Triangles of one planar part: with its lines, or, where CGAL's refinement fails on them
+// (an assertion inside the mesher: lines at the rounding scale of each other that the
+// cleaning did not merge), without them, with a warning naming the surface. Face edges
+// alone are simple polygons, which the mesher handles; if even that fails the scene is
+// refused with a SceneError.
+std::vector<Triangle> mesh_part(const Scene& scene, const Part& part, double max_edge,
+                                const std::vector<const DiscontinuitySegment*>& lines) {
+  const std::string& name = scene.surfaces[scene.faces[part.faces[0]].surface].name;
+  try {
+    return triangulate_part(scene, part, max_edge, lines);
+  } catch (const CGAL::Failure_exception& e) {
+    if (lines.empty())
+      throw SceneError(scene.source + ": surface '" + name +
+                       "': constrained Delaunay meshing failed (CGAL: " + e.expression() + ")");
+    log_warn("discontinuity meshing: CGAL could not refine the lines on a plane of surface '" +
+             name + "' (" + e.expression() + "); that plane is meshed without them");
+  }
+  try {
+    return triangulate_part(scene, part, max_edge, {});
+  } catch (const CGAL::Failure_exception& e) {
+    throw SceneError(scene.source + ": surface '" + name +
+                     "': constrained Delaunay meshing failed (CGAL: " + e.expression() + ")");
+  }
 }
 
 // Makes the triangles of a folded surface conforming across its creases: every vertex on a
