@@ -150,10 +150,14 @@ void print_summary(const RunOptions& opts, const MethodOutcome& m, const Tail& t
               format_si(static_cast<double>(m.rays + t.render.rays)).c_str());
   for (const std::string& line : m.summary) std::printf("%s\n", line.c_str());
   const auto [after, before] = worst_power_error(t.shaded.power);
-  std::printf(
-      "vertices   power error per surface (max) %.2e with %s interpolation "
-      "(area-weighted alone: %.2e)\n",
-      after, t.shaded.interpolation.c_str(), before);
+  if (t.shaded.interpolation == "exact-direct")
+    std::printf("vertices   exact direct light at the vertices; field vs patch power per surface "
+                "(max) %.2e (not rescaled)\n", after);
+  else
+    std::printf(
+        "vertices   power error per surface (max) %.2e with %s interpolation "
+        "(area-weighted alone: %.2e)\n",
+        after, t.shaded.interpolation.c_str(), before);
   std::printf("image      %dx%d, %d samples/pixel, exposure %+.2f EV\n", t.camera.width,
               t.camera.height, opts.shade.antialias * opts.shade.antialias, t.ev);
   std::string times;
