@@ -53,6 +53,8 @@ constexpr double kSameNormal = 1e-12;
 constexpr double kSamePlane = 1e-9;
 // A vertex this close (relative to the edge's length) to a crease edge lies on it.
 constexpr double kOnEdge = 1e-9;
+// A plane keeps D1/D2 lines of total length up to this many times its area / edge bound.
+constexpr double kLineBudget = 2.0;
 // Constraint features closer than this (relative to the part's extent) are merged.
 constexpr double kSnap = 1e-6;
 
@@ -421,6 +423,35 @@ std::vector<Triangle> triangulate_part(const Scene& scene, const Part& part, dou
   return out;
 }
 
+// The lines a part keeps: every D0 line, then D1/D2 lines longest first while their total
+// length stays within kLineBudget x (the part's area / the edge bound), the length of
+// lines one edge bound apart covering the part. Each line costs
+// about its length / edge bound vertices, so this keeps the mesh within a small multiple
+// of the size plan's patches; tessellated
+// curved blockers (a silhouette of hundreds of short edges, each casting lines onto every
+// wall) otherwise made 70x the requested patches. 0 edge bound: no budget.
+std::vector<const DiscontinuitySegment*> lines_within_budget(
+    const Scene& scene, const Part& part, double max_edge,
+    const std::vector<const DiscontinuitySegment*>& lines) {
+  if (!(max_edge > 0)) return lines;
+  double area = 0;
+  for (auto f : part.faces) area += polygon_area(face_polygon(scene, f));
+  double budget = kLineBudget * area / max_edge;
+  std::vector<const DiscontinuitySegment*> sorted = lines;
+  std::stable_sort(sorted.begin(), sorted.end(), [](const auto* a, const auto* b) {
+    if (a->order != b->order) return a->order < b->order;
+    return (a->b - a->a).squaredNorm() > (b->b - b->a).squaredNorm();
+  });
+  std::vector<const DiscontinuitySegment*> kept;
+  for (const auto* l : sorted) {
+    const double cost = (l->b - l->a).norm();
+    if (l->order > 0 && cost > budget) continue;
+    if (l->order > 0) budget -= cost;
+    kept.push_back(l);
+  }
+  return kept;
+}
+
 // Triangles of one planar part: with its lines, or, where CGAL's refinement fails on them
 // (an assertion inside the mesher: lines at the rounding scale of each other that the
 // cleaning did not merge), without them, with a warning naming the surface. Face edges
@@ -553,16 +584,25 @@ PatchMesh mesh_scene_constrained(const Scene& scene, double max_edge,
   mesh.scale = scene.faces.empty() ? 1.0 : std::max((hi - lo).norm(), 1e-300);
   std::vector<std::vector<const DiscontinuitySegment*>> by_face(scene.faces.size());
   for (const auto& s : constraints) by_face.at(s.face).push_back(&s);
+  size_t lines_found = 0, lines_kept = 0, surfaces_cut = 0;
+  std::string first_cut;
   for (size_t s = 0; s < scene.surfaces.size(); ++s) {
     const auto surface = static_cast<std::int32_t>(s);
     const std::vector<Part> parts = planar_parts(scene, surface, mesh.scale);
     std::vector<Triangle> tris;
+    size_t found = 0, kept = 0;
     for (const auto& part : parts) {
       std::vector<const DiscontinuitySegment*> lines;
       for (auto f : part.faces) lines.insert(lines.end(), by_face[f].begin(), by_face[f].end());
+      found += lines.size();
+      lines = lines_within_budget(scene, part, max_edge, lines);
+      kept += lines.size();
       const auto part_tris = mesh_part(scene, part, max_edge, lines);
       tris.insert(tris.end(), part_tris.begin(), part_tris.end());
     }
+    lines_found += found;
+    lines_kept += kept;
+    if (kept < found && surfaces_cut++ == 0) first_cut = scene.surfaces[s].name;
     conform_creases(scene, parts, tris);
     // Weld by exact position within the surface and emit.
     std::map<Key3, std::int32_t> ids;
@@ -590,6 +630,12 @@ PatchMesh mesh_scene_constrained(const Scene& scene, double max_edge,
                          " patches: choose a larger --max-edge");
     }
   }
+  if (lines_kept < lines_found)
+    log_warn("discontinuity meshing: kept " + std::to_string(lines_kept) + " of " +
+             std::to_string(lines_found) + " lines, the longest on each plane within a budget of " +
+             std::to_string(kLineBudget).substr(0, 3) + " x its area / the edge bound (" +
+             std::to_string(surfaces_cut) + " surfaces, first '" + first_cut +
+             "'); a smaller --max-edge or more --patches keeps more");
   return mesh;
 }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 
 #include "core/parallel.hpp"
 #include "geometry/bvh.hpp"
@@ -235,6 +236,49 @@ std::vector<DiscontinuitySegment> discontinuity_segments(const Scene& scene,
     }
   }
 
+  // Silhouette culling, per source: a blocker edge between two faces that both face every
+  // corner of the source the same way (both towards it or both away: the signs of their
+  // planes agree at all its corners, strictly) is on no silhouette seen from any point of
+  // the convex source, so its VE wedge bounds no shadow (its visibility test would reject
+  // it, at the cost of the rays); a vertex all of whose edges are such is no EV vertex.
+  // Boundary and non-manifold edges are kept. On tessellated curved blockers this keeps
+  // the silhouettes' few edges out of all of them.
+  std::map<std::pair<std::int32_t, std::int32_t>, std::vector<std::int32_t>> edge_faces;
+  for (size_t f = 0; f < faces.size(); ++f) {
+    const FaceGeom& g = faces[f];
+    for (size_t k = 0; k < g.poly.size(); ++k) {
+      const std::int32_t a = g.ids[k], b = g.ids[(k + 1) % g.poly.size()];
+      if (a != b) edge_faces[{std::min(a, b), std::max(a, b)}].push_back(static_cast<std::int32_t>(f));
+    }
+  }
+  auto silhouettes = [&](const FaceGeom& S, std::set<std::pair<std::int32_t, std::int32_t>>& keep_edges,
+                         std::set<std::int32_t>& keep_vertices) {
+    auto side = [&](std::int32_t f) {  // +1 / -1 when every source corner is strictly on one side
+      int sign = 0;
+      for (const auto& c : S.poly) {
+        const double h = faces[f].height(c);
+        const int sg = h > eps ? 1 : h < -eps ? -1 : 0;
+        if (sg == 0 || (sign != 0 && sg != sign)) return 0;
+        sign = sg;
+      }
+      return sign;
+    };
+    for (const auto& [key, fs] : edge_faces) {
+      bool keep = fs.size() != 2;
+      if (!keep) {
+        const int a = side(fs[0]), b = side(fs[1]);
+        keep = a == 0 || b == 0 || a != b;
+      }
+      if (!keep) continue;
+      keep_edges.insert(key);
+      keep_vertices.insert(key.first);
+      keep_vertices.insert(key.second);
+    }
+  };
+  std::vector<std::set<std::pair<std::int32_t, std::int32_t>>> source_edges(faces.size());
+  std::vector<std::set<std::int32_t>> source_vertices(faces.size());
+  for (std::int32_t sf : sources) silhouettes(faces[sf], source_edges[sf], source_vertices[sf]);
+
   std::vector<std::vector<DiscontinuitySegment>> per_face(faces.size());
   parallel_for(static_cast<std::int64_t>(faces.size()), 1, options.threads,
                [&](std::int64_t begin, std::int64_t end) {
@@ -346,6 +390,7 @@ std::vector<DiscontinuitySegment> discontinuity_segments(const Scene& scene,
           const double hs = R.height(sv);
           if (hs <= eps) continue;
           for (const auto& [key, e] : edges) {
+            if (!source_edges[sf].count(key)) continue;
             double t0 = 0, t1 = 1;
             const double ha = R.height(e.first), hb = R.height(e.second);
             if (!clip_interval(ha - eps, hb - eps, t0, t1)) continue;
@@ -364,6 +409,7 @@ std::vector<DiscontinuitySegment> discontinuity_segments(const Scene& scene,
           const Eigen::Vector3d& a = S.poly[k];
           const Eigen::Vector3d& b = S.poly[(k + 1) % S.poly.size()];
           for (const auto& [id, p] : vertices) {
+            if (!source_vertices[sf].count(id)) continue;
             const double hp = R.height(p);
             if (hp <= eps || S.height(p) <= eps) continue;
             double t0 = 0, t1 = 1;
