@@ -95,13 +95,11 @@ bool clip_interval(double fa, double fb, double& t0, double& t1) {
   return t0 < t1;
 }
 
-// The parts of the segment a-b (on the plane of `poly`, unit normal n) inside the polygon,
-// each end that the boundary cut extended by `overrun` (length) past it: the crossings with
-// the edges cut a-b into intervals, kept where their midpoints are inside (crossing number
-// in the plane). Any simple polygon, O(corners).
-std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> clip_to_polygon(
-    const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Polygon3& poly,
-    const Eigen::Vector3d& n, double overrun) {
+// The length of the part of the segment a-b (on the plane of `poly`, unit normal n) inside
+// the polygon: the crossings with its edges cut a-b into intervals, counted where their
+// midpoints are inside (crossing number in the plane). Any simple polygon, O(corners).
+double length_inside(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Polygon3& poly,
+                     const Eigen::Vector3d& n) {
   const Eigen::Vector3d u = (std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY()).cross(n).normalized();
   const Eigen::Vector3d v = n.cross(u);
   auto to2 = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d((p - poly[0]).dot(u), (p - poly[0]).dot(v)); };
@@ -126,24 +124,10 @@ std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> clip_to_polygon(
         in = !in;
     return in;
   };
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> out;
-  const double dt = overrun / std::max((b - a).norm(), 1e-300);
-  auto emit = [&](double t0, double t1) {
-    if (t0 > 0.0) t0 = std::max(0.0, t0 - dt);
-    if (t1 < 1.0) t1 = std::min(1.0, t1 + dt);
-    out.push_back({a + t0 * (b - a), a + t1 * (b - a)});
-  };
-  double start = -1.0;
-  for (size_t k = 0; k + 1 < ts.size(); ++k) {
-    const bool in = ts[k + 1] > ts[k] && inside(A + 0.5 * (ts[k] + ts[k + 1]) * D);
-    if (in && start < 0) start = ts[k];
-    if (!in && start >= 0) {
-      emit(start, ts[k]);
-      start = -1.0;
-    }
-  }
-  if (start >= 0) emit(start, 1.0);
-  return out;
+  double t_inside = 0.0;
+  for (size_t k = 0; k + 1 < ts.size(); ++k)
+    if (ts[k + 1] > ts[k] && inside(A + 0.5 * (ts[k] + ts[k + 1]) * D)) t_inside += ts[k + 1] - ts[k];
+  return t_inside * (b - a).norm();
 }
 
 // A wedge line on the receiver, parametrised by u in [0, 1]: the receiver point q(u), the
@@ -298,9 +282,8 @@ std::vector<DiscontinuitySegment> discontinuity_segments(const Scene& scene,
       const Eigen::Vector3d hi = R.hi + Eigen::Vector3d::Constant(pad);
       auto add = [&](Eigen::Vector3d a, Eigen::Vector3d b, int order) {
         if (!clip_to_box(a, b, lo, hi) || (b - a).norm() <= eps) return;
-        double inside = 0.0;
-        for (const auto& [p, q] : clip_to_polygon(a, b, R.poly, R.normal, 0.0)) inside += (q - p).norm();
-        if (inside > kMinInside * (R.hi - R.lo).norm()) segs.push_back({a, b, order, static_cast<std::int32_t>(r)});
+        if (length_inside(a, b, R.poly, R.normal) > kMinInside * (R.hi - R.lo).norm())
+          segs.push_back({a, b, order, static_cast<std::int32_t>(r)});
       };
 
       // D0: blocker faces touching or piercing the receiver's plane.
