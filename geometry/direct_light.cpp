@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/error.hpp"
 #include "core/parallel.hpp"
 #include "geometry/formfactors/constants.hpp"
 #include "geometry/polygon.hpp"
@@ -65,7 +66,7 @@ Eigen::MatrixX3d exact_direct_irradiance(const Scene& scene,
                                          const std::vector<Eigen::Vector3d>& normals,
                                          int threads) {
   Eigen::MatrixX3d H = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(points.size()), 3);
-  if (points.size() != normals.size()) return H;
+  LAMBERT_CHECK(points.size() == normals.size(), "exact_direct_irradiance: one normal per point");
   const std::vector<FaceGeometry> faces = face_geometry(scene);
   std::vector<size_t> emitters;
   for (size_t k = 0; k < scene.faces.size(); ++k)

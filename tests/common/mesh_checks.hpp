@@ -25,6 +25,17 @@ inline double scene_face_area(const Scene& s, std::int32_t surface) {
   return a;
 }
 
+/// Every surface's patches cover the area of its faces: |Σ A_i - A_faces| <= rel A + abs.
+inline void expect_surface_areas(const Scene& scene, const PatchMesh& m, double rel, double abs) {
+  for (size_t s = 0; s < scene.surfaces.size(); ++s) {
+    double area = 0;
+    for (const auto& p : m.patches)
+      if (p.surface == static_cast<std::int32_t>(s)) area += p.area;
+    EXPECT_NEAR(area, scene_face_area(scene, static_cast<std::int32_t>(s)), rel * area + abs)
+        << scene.surfaces[s].name;
+  }
+}
+
 // Every patch edge interior to a surface is shared by exactly two patches and no vertex of
 // a surface lies strictly inside another patch edge of it (no T-vertices): checked by
 // exact vertex ids (welded) and a distance test relative to the edge length. A non-manifold

@@ -20,7 +20,33 @@ namespace lambert {
 namespace {
 
 using test::expect_conforming;
-using test::scene_face_area;
+
+// F by hybrid with `samples` per pair and B solved to 1e-12 on `mesh`.
+struct Solved {
+  FormFactors F;
+  Eigen::MatrixX3d B;
+};
+Solved solve_hybrid(const PatchMesh& mesh, int samples) {
+  FormFactorOptions fo;
+  fo.estimator = "hybrid";
+  fo.samples = samples;
+  fo.progress = false;
+  Solved out;
+  out.F = compute_form_factors(mesh, fo);
+  SolveOptions so;
+  so.tol = 1e-12;
+  out.B = solve_radiosity(make_problem(mesh, out.F.F), so).B;
+  return out;
+}
+
+// A fixed-seed uniform in [0, 1) (64-bit LCG, the top 53 bits).
+struct Lcg {
+  std::uint64_t state;
+  double operator()() {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) * 0x1.0p-53;
+  }
+};
 
 TEST(DiscontinuityMesh, CornellBlocksGetContactLinesAlongTheirFootprints) {
   const Scene scene = load_obj(builtin_cornell_box_path());
@@ -73,12 +99,7 @@ TEST(DiscontinuityMesh, CornellBlocksGetContactLinesAlongTheirFootprints) {
       EXPECT_FALSE(lo < -1e-6 && hi > 1e-6) << "a floor triangle crosses a block's footprint";
     }
   }
-  for (size_t s = 0; s < scene.surfaces.size(); ++s) {
-    double area = 0;
-    for (const auto& p : m.patches)
-      if (p.surface == static_cast<std::int32_t>(s)) area += p.area;
-    EXPECT_NEAR(area, scene_face_area(scene, static_cast<int>(s)), 1e-12 * area + 1e-9);
-  }
+  test::expect_surface_areas(scene, m, 1e-12, 1e-9);
 }
 
 // Regression: on the Cornell box every triangle meets the edge bound, on every surface. The
@@ -135,21 +156,14 @@ Scene furnace_with_block() {
 // (into the block, where it is lost: an O(h) leak along every contact line, which makes
 // uniform meshing's per-surface averages low). At equal patch count the discontinuity
 // mesh's worst per-surface error against the exact averages is at least 3x below uniform
-// meshing's: measured 1.6e-4 against 2.8e-3 (17x) with 16 samples per pair; what remains
+// meshing's: measured 1.7e-4 against 3.7e-3 (22x, ~850 patches) with 16 samples per pair; what remains
 // on the discontinuity mesh is the estimator's noise (hybrid, fixed seed). Also a
 // regression test: this scene (every face a source, many near-concurrent lines) crashed
 // CGAL's refinement before crossings were merged (split_at_crossings).
 TEST(DiscontinuityRadiosity, FurnaceWithABlockPerSurfaceAveragesBeatUniform) {
   const Scene scene = furnace_with_block();
   auto worst = [&](const PatchMesh& m) {
-    FormFactorOptions fo;
-    fo.estimator = "hybrid";
-    fo.samples = 16;
-    fo.progress = false;
-    const FormFactors F = compute_form_factors(m, fo);
-    SolveOptions so;
-    so.tol = 1e-12;
-    const auto avg = surface_averages(m, solve_radiosity(make_problem(m, F.F), so).B);
+    const auto avg = surface_averages(m, solve_hybrid(m, 16).B);
     double err = 0;
     for (const auto& s : avg) {
       const double exact = s.name == "-z" ? 2.0 * (1 - 0.32 * 0.32) + 0.32 * 0.32 : 2.0;
@@ -176,11 +190,7 @@ TEST(DiscontinuityRadiosity, FurnaceWithABlockPerSurfaceAveragesBeatUniform) {
 // surface's area, and never crashes (such scenes crashed CGAL's refinement; a plane whose
 // lines it cannot refine is now meshed without them, with a warning).
 TEST(DiscontinuityMesh, RandomBoxScenesGiveValidMeshes) {
-  std::uint64_t state = 2026;
-  auto uniform = [&state] {
-    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
-    return static_cast<double>(state >> 11) * 0x1.0p-53;
-  };
+  Lcg uniform{2026};
   for (int trial = 0; trial < 8; ++trial) {
     Scene scene;
     const bool furnace = trial % 3 == 2;
@@ -217,14 +227,9 @@ TEST(DiscontinuityMesh, RandomBoxScenesGiveValidMeshes) {
     SCOPED_TRACE("trial " + std::to_string(trial));
     expect_conforming(m, /*manifold=*/false);
     for (const auto& p : m.patches) ASSERT_TRUE(p.area > 0.0 && std::isfinite(p.area));
-    for (size_t s = 0; s < scene.surfaces.size(); ++s) {
-      double area = 0;
-      for (const auto& p : m.patches)
-        if (p.surface == static_cast<std::int32_t>(s)) area += p.area;
-      // 1e-8: vertices within kOnEdge (1e-9 of an edge's length) of a crease are moved onto
-      // it, each changing the area by at most 1e-9 of its triangles' (a few per crease).
-      EXPECT_NEAR(area, scene_face_area(scene, static_cast<int>(s)), 1e-8 * area) << scene.surfaces[s].name;
-    }
+    // 1e-8: vertices within kOnEdge (1e-9 of an edge's length) of a crease are moved onto
+    // it, each changing the area by at most 1e-9 of its triangles' (a few per crease).
+    test::expect_surface_areas(scene, m, 1e-8, 0.0);
   }
 }
 
@@ -262,48 +267,11 @@ TEST(DiscontinuityMesh, TessellatedBlockersStayWithinTheRequestedSize) {
   expect_conforming(m, /*manifold=*/false);
 }
 
-// Solves the partial-shadow scene on `mesh` (hybrid: exact unoccluded factors times a
-// visible fraction from 256 kernel-distributed rays per pair).
-Eigen::MatrixX3d solve_partial_shadow(const PatchMesh& mesh) {
-  FormFactorOptions fo;
-  fo.estimator = "hybrid";
-  fo.samples = 256;
-  fo.progress = false;
-  const FormFactors F = compute_form_factors(mesh, fo);
-  SolveOptions so;
-  so.tol = 1e-12;
-  return solve_radiosity(make_problem(mesh, F.F), so).B;
-}
-
-// The exact floor radiosity of the partial-shadow scene at x (analytic.hpp).
-double exact_floor(const Eigen::Vector3d& x) {
-  const PartialShadowGeometry g = partial_shadow_geometry();
-  return 0.5 * shadowed_point_factor(x, Eigen::Vector3d::UnitZ(), g.light, {g.blocker});
-}
-
-// The L1 error of the patch-constant floor radiosity against the exact field, over the
-// floor's area: Σ_i ∫_i |B_i - B(x)| dA / A_floor, by the midpoint rule on 16 similar
-// sub-triangles per patch (its own error is O(h²/16 B''), below the O(h B') measured).
+// The L1 error of the patch-constant floor radiosity against the exact field
+// (partial_shadow_errors: midpoint rule on 16 similar sub-triangles per patch, its own
+// error O(h²/16 B''), below the O(h B') measured).
 double floor_error(const PatchMesh& mesh, const Eigen::MatrixX3d& B) {
-  double sum = 0, area = 0;
-  for (std::int32_t i = 0; i < mesh.size(); ++i) {
-    const Patch& p = mesh.patches[i];
-    if (p.surface != 0) continue;
-    const Eigen::Vector3d a = mesh.vertices[p.vertices[0]], b = mesh.vertices[p.vertices[1]],
-                          c = mesh.vertices[p.vertices[2]];
-    const double bi = B.row(i).mean();
-    double err = 0;
-    const int n = 4;
-    for (int u = 0; u < n; ++u)
-      for (int v = 0; u + v < n; ++v) {
-        const Eigen::Vector3d o = a + (b - a) * u / n + (c - a) * v / n;
-        err += std::abs(bi - exact_floor(o + ((b - a) + (c - a)) / (3.0 * n)));
-        if (u + v < n - 1) err += std::abs(bi - exact_floor(o + (2.0 * (b - a) + 2.0 * (c - a)) / (3.0 * n)));
-      }
-    sum += p.area * err / (n * n);
-    area += p.area;
-  }
-  return sum / area;
+  return partial_shadow_errors(mesh, B, interpolate_to_vertices(mesh, B)).l1;
 }
 
 // The floor radiosity along y = 1.75 (across both penumbrae and the umbra, 0.05 beside the
@@ -328,17 +296,10 @@ TEST(DiscontinuityRadiosity, PenumbraLineErrorFiveTimesBelowUniform) {
   const PatchMesh uni = mesh_scene(scene, uo);
   ASSERT_GE(uni.size(), disc.size() * 95 / 100) << "uniform must not have fewer patches";
   auto field = [&](const PatchMesh& m, bool exact) {
-    FormFactorOptions fo;
-    fo.estimator = "hybrid";
-    fo.samples = 64;
-    fo.progress = false;
-    const FormFactors F = compute_form_factors(m, fo);
-    SolveOptions so;
-    so.tol = 1e-12;
-    const Eigen::MatrixX3d B = solve_radiosity(make_problem(m, F.F), so).B;
-    const VertexField f = exact ? exact_direct_vertex_field(scene, m, B, indirect_irradiance(m, F.F, B))
-                                : interpolate_to_vertices(m, B);
-    return partial_shadow_errors(m, B, f);
+    const Solved r = solve_hybrid(m, 64);
+    const VertexField f = exact ? exact_direct_vertex_field(scene, m, r.B, indirect_irradiance(m, r.F.F, r.B))
+                                : interpolate_to_vertices(m, r.B);
+    return partial_shadow_errors(m, r.B, f);
   };
   const PartialShadowErrors d = field(disc, true), u_exact = field(uni, true),
                             u_cons = field(uni, false);
@@ -418,11 +379,7 @@ TEST(PartialShadowReference, FloorToLightFactorConverges) {
   const PartialShadowGeometry g = partial_shadow_geometry();
   const int n = 20000;
   double sum = 0, sum2 = 0;
-  std::uint64_t state = 12345;
-  auto uniform = [&state] {
-    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
-    return static_cast<double>(state >> 11) * 0x1.0p-53;
-  };
+  Lcg uniform{12345};
   for (int k = 0; k < n; ++k) {
     const Eigen::Vector3d x(4 * uniform(), 4 * uniform(), 0);
     const double v = shadowed_point_factor(x, Eigen::Vector3d::UnitZ(), g.light, {g.blocker});
@@ -473,7 +430,7 @@ TEST(AdaptiveRadiosity, ImprovesMonotonicallyAndBeatsUniformAtEqualPatches) {
   MeshOptions uni;
   uni.target_patches = final_patches / 2;  // quads, then split in two like adaptive's start
   const PatchMesh um = triangulate_quads(mesh_scene(scene, uni)).mesh;
-  const double e_uni = floor_error(um, solve_partial_shadow(um));
+  const double e_uni = floor_error(um, solve_hybrid(um, 256).B);
   std::printf("adaptive floor error by round: %.3g %.3g %.3g (%lld patches); uniform %.3g (%d)\n",
               errors[0], errors[1], errors[2], static_cast<long long>(final_patches), e_uni, um.size());
   EXPECT_LT(errors[1], errors[0]);
