@@ -578,7 +578,7 @@ void conform_creases(const Scene& scene, const std::vector<Part>& parts, std::ve
 PatchMesh mesh_scene_constrained(const Scene& scene, double max_edge,
                                  const std::vector<DiscontinuitySegment>& constraints) {
   PatchMesh mesh;
-  for (const auto& s : scene.surfaces) mesh.surface_names.push_back(s.name);
+  copy_surfaces(scene, mesh);
   const auto [lo, hi] = scene.bounds();
   mesh.max_edge = max_edge;
   mesh.scale = scene.faces.empty() ? 1.0 : std::max((hi - lo).norm(), 1e-300);

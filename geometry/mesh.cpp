@@ -338,7 +338,7 @@ PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options) {
   }
 
   PatchMesh mesh;
-  for (const auto& s : scene.surfaces) mesh.surface_names.push_back(s.name);
+  copy_surfaces(scene, mesh);
   const auto [lo, hi] = scene.bounds();
   mesh.max_edge = max_edge;
   mesh.scale = scene.faces.empty() ? 1.0 : std::max((hi - lo).norm(), 1e-300);
@@ -348,6 +348,17 @@ PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options) {
   }
   LAMBERT_CHECK(mesh.patches.size() < static_cast<size_t>(INT32_MAX), "too many patches");
   return mesh;
+}
+
+void copy_surfaces(const Scene& scene, PatchMesh& mesh) {
+  bool specular = false;
+  for (const auto& s : scene.surfaces) {
+    mesh.surface_names.push_back(s.name);
+    specular = specular || scene.materials[s.material].specular.any();
+  }
+  if (!specular) return;
+  for (const auto& s : scene.surfaces)
+    mesh.surface_specular.push_back(scene.materials[s.material].specular);
 }
 
 std::uint64_t mesh_hash(const PatchMesh& mesh) {
@@ -361,6 +372,12 @@ std::uint64_t mesh_hash(const PatchMesh& mesh) {
     for (int k = 0; k < p.vertex_count; ++k)
       for (int d = 0; d < 3; ++d) add(mesh.vertices[p.vertices[k]][d]);
     add(static_cast<double>(p.surface));
+  }
+  // Specular surfaces change where rays go, so they are part of what F was computed for
+  // (purely diffuse meshes hash as before).
+  for (const Specular& sp : mesh.surface_specular) {
+    for (int c = 0; c < 3; ++c) add(sp.reflectance[c]), add(sp.transmission[c]);
+    add(sp.dielectric ? sp.ior : -1.0);
   }
   return h;
 }

@@ -31,10 +31,21 @@ struct PatchMesh {
   std::vector<std::int32_t> vertex_surface;  ///< surface of each vertex
   std::vector<Patch> patches;
   std::vector<std::string> surface_names;  ///< copied from the scene, indexed by surface id
+  /// Specular part of each surface's material (indexed by surface id); empty when no
+  /// surface is specular (every mesh of a purely diffuse scene).
+  std::vector<Specular> surface_specular;
   double scale = 1.0;                      ///< bounding-box diagonal (for relative epsilons)
   double max_edge = 0.0;                   ///< edge bound used (0 = one element per face)
 
   std::int32_t size() const { return static_cast<std::int32_t>(patches.size()); }
+  /// True when some surface is specular (rays continue at it).
+  bool has_specular() const { return !surface_specular.empty(); }
+  /// The specular part of patch i's surface (nullptr when it is purely diffuse).
+  const Specular* specular_of(std::int32_t i) const {
+    if (surface_specular.empty()) return nullptr;
+    const Specular& s = surface_specular[patches[i].surface];
+    return s.any() ? &s : nullptr;
+  }
   /// Corner positions of patch i.
   std::vector<Eigen::Vector3d> corners(std::int32_t i) const;
 };
@@ -65,6 +76,9 @@ MeshPlan plan_mesh(const Scene& scene, const MeshOptions& options);
 /// Approximate peak memory (bytes) of a mesh of `patches` patches and its BVH.
 double mesh_peak_bytes(std::int64_t patches);
 
+/// Copies the scene's surface names (and specular parts, when any) into an empty mesh.
+void copy_surfaces(const Scene& scene, PatchMesh& mesh);
+
 /// Subdivides every surface of `scene`. Faces with more than 4 vertices and concave quads
 /// are triangulated first. Each element edge of length L shared within a surface gets
 /// n = ceil(L / max_edge) segments, raised until every triangle has equal counts on its
@@ -80,8 +94,9 @@ PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options);
 /// the caller.
 Patch make_patch(const PatchMesh& mesh, std::array<std::int32_t, 4> v, int n);
 
-/// A stable 64-bit hash of the meshed geometry (vertices, patches, surfaces), which is all
-/// F depends on; materials may change without invalidating a saved F.
+/// A stable 64-bit hash of the meshed geometry (vertices, patches, surfaces) and of the
+/// specular parts (extended form factors follow rays through them), which is all F depends
+/// on; diffuse reflectance and emission may change without invalidating a saved F.
 std::uint64_t mesh_hash(const PatchMesh& mesh);
 
 }  // namespace lambert

@@ -7,18 +7,46 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "geometry/camera.hpp"
 
 namespace lambert {
 
-/// A Lambertian material: diffuse reflectance rho (RGB, each in [0,1)) and emitted
-/// radiosity E (RGB, W/m^2, >= 0).
+/// The perfect-specular part of a material (MTL `illum` 3/5: a mirror of reflectance Ks;
+/// 4/6/7: a dielectric interface of index Ni that reflects by Fresnel and refracts, the
+/// refracted light filtered by Tf). Glossy lobes (Ns) are treated as perfect specular.
+/// Light arriving at a surface splits into rho (diffuse), the specular part and the rest,
+/// absorbed: a mirror needs rho + reflectance <= 1 per channel, a dielectric rho = 0.
+struct Specular {
+  Eigen::Vector3d reflectance = Eigen::Vector3d::Zero();  ///< mirror ρ_s per channel (Ks)
+  bool dielectric = false;  ///< a refracting Fresnel interface (then `reflectance` is unused)
+  double ior = 1.0;         ///< index of refraction behind the front side (Ni, dielectrics)
+  Eigen::Vector3d transmission = Eigen::Vector3d::Ones();  ///< Tf: filter of refracted light
+  double shininess = 0.0;   ///< Ns (reported only: every lobe is treated as a perfect one)
+  /// True when rays that reach the surface continue (mirror with ρ_s > 0, or dielectric).
+  bool any() const { return dielectric || reflectance.maxCoeff() > 0.0; }
+  /// The largest fraction of arriving light the specular part can carry on, per channel
+  /// (a dielectric's Fresnel reflectance reaches 1 at grazing incidence).
+  Eigen::Vector3d max_fraction() const {
+    return dielectric ? Eigen::Vector3d::Ones() : reflectance;
+  }
+};
+
+/// A material: diffuse reflectance rho (RGB, each in [0,1]), emitted radiosity E (RGB,
+/// W/m^2, >= 0) and an optional perfect-specular part.
 struct Material {
   std::string name;
   Eigen::Vector3d rho = Eigen::Vector3d::Zero();
   Eigen::Vector3d emission = Eigen::Vector3d::Zero();
+  Specular specular;
+
+  Material() = default;
+  /// A material from its parts (`{name, rho, emission}` as before the specular part).
+  Material(std::string name_, const Eigen::Vector3d& rho_,
+           const Eigen::Vector3d& emission_ = Eigen::Vector3d::Zero(), Specular specular_ = {})
+      : name(std::move(name_)), rho(rho_), emission(emission_), specular(std::move(specular_)) {}
   /// True when any channel of E is positive.
   bool emits() const { return emission.maxCoeff() > 0.0; }
 };

@@ -138,10 +138,52 @@ std::vector<MtlMaterial> read_libraries(const ObjData& obj, const std::string& n
   return defs;
 }
 
+// MTL illum models: 3, 5 and 8 reflect (a mirror of reflectance Ks), 4, 6, 7 and 9 refract
+// (a dielectric of index Ni, its refracted light filtered by Tf); the rest are diffuse (their
+// Ks is a highlight, not a mirror).
+bool mirror_illum(int illum) { return illum == 3 || illum == 5 || illum == 8; }
+bool dielectric_illum(int illum) { return illum == 4 || illum == 6 || illum == 7 || illum == 9; }
+
+// MTL statements the material's illum model does not use (for one warning). Ks with a
+// diffuse illum (0-2: a Phong highlight, in nearly every exported file) is ignored silently.
+struct Unused {
+  std::set<std::string> transparency;  // d < 1 without refraction
+};
+
+// The specular part of an MTL material: a mirror needs Kd + Ks <= 1 per channel, a
+// dielectric Kd = 0 (it reflects and transmits all it does not absorb).
+Specular convert_specular(const MtlMaterial& m, const Material& mat, Unused& unused) {
+  Specular sp;
+  sp.shininess = m.ns;
+  if (mirror_illum(m.illum)) {
+    sp.reflectance = m.ks;
+    const std::string at_ks = where(m.file, m.ks_line ? m.ks_line : m.line);
+    if (m.ks.minCoeff() < 0.0 || m.ks.maxCoeff() > 1.0)
+      throw SceneError(at_ks + ": material '" + m.name + "': specular reflectance Ks " +
+                       rgb(m.ks) + " must lie in [0, 1] in every channel");
+    if ((mat.rho + m.ks).maxCoeff() > 1.0)
+      throw SceneError(at_ks + ": material '" + m.name + "': Kd " + rgb(mat.rho) + " + Ks " +
+                       rgb(m.ks) + " exceeds 1 in some channel (the surface would reflect more "
+                       "than it receives)");
+  } else if (dielectric_illum(m.illum)) {
+    sp.dielectric = true;
+    sp.ior = m.ni;
+    sp.transmission = m.tf;
+    if (mat.rho.maxCoeff() > 0.0)
+      throw SceneError(where(m.file, m.kd_line ? m.kd_line : m.line) + ": material '" + m.name +
+                       "': a dielectric (illum " + std::to_string(m.illum) + ") needs Kd 0: it "
+                       "reflects (Fresnel) and refracts all the light it does not absorb, got Kd " +
+                       rgb(mat.rho));
+  }
+  if (m.dissolve < 1.0 && !sp.dielectric) unused.transparency.insert(m.name);
+  return sp;
+}
+
 // MTL material -> scene material: --max-reflectance clamps, then Kd must lie in [0, 1] and
-// Ke be >= 0. Returns whether some channel of Kd is 1 (lossless).
+// Ke be >= 0; the specular part from illum. Returns whether some channel of Kd is 1
+// (lossless).
 bool convert_material(const MtlMaterial& m, const LoadOptions& options, Material& mat,
-                      std::set<std::string>& clamped) {
+                      std::set<std::string>& clamped, Unused& unused) {
   mat.name = m.name;
   mat.rho = m.kd;
   mat.emission = m.ke;
@@ -157,6 +199,7 @@ bool convert_material(const MtlMaterial& m, const LoadOptions& options, Material
   if (mat.emission.minCoeff() < 0.0)
     throw SceneError(where(m.file, m.ke_line ? m.ke_line : m.line) + ": material '" + m.name +
                      "': emission Ke " + rgb(mat.emission) + " must be finite and >= 0");
+  mat.specular = convert_specular(m, mat, unused);
   const bool lossless = mat.rho.maxCoeff() == 1.0;
   if (lossless && options.strict)
     throw SceneError(at_kd + ": material '" + m.name + "': reflectance Kd " + rgb(mat.rho) +
@@ -179,15 +222,19 @@ Materials build_materials(const ObjData& obj, const std::vector<MtlMaterial>& de
   Materials out;
   std::map<std::string, std::int32_t> by_name;
   std::set<std::string> clamped, lossless;
+  Unused unused;
   for (const auto& m : defs) {
     Material mat;
-    if (convert_material(m, options, mat, clamped)) lossless.insert(m.name);
+    if (convert_material(m, options, mat, clamped, unused)) lossless.insert(m.name);
     by_name[m.name] = static_cast<std::int32_t>(scene.materials.size());
     scene.materials.push_back(mat);
   }
   if (!clamped.empty())
     diag.warn(name + ": Kd clamped to --max-reflectance " + num(options.max_reflectance) +
               " in material(s) " + list_names(clamped));
+  if (!unused.transparency.empty())
+    diag.warn(name + ": d/Tr < 1 of material(s) " + list_names(unused.transparency) +
+              " ignored: transparency without refraction is not modelled (illum 7 refracts)");
   auto add_default = [&](const std::string& mat_name) {
     scene.materials.push_back({mat_name, options.default_reflectance, Eigen::Vector3d::Zero()});
     return static_cast<std::int32_t>(scene.materials.size() - 1);
@@ -433,6 +480,31 @@ void report_lossless(const Materials& mats, const std::set<std::string>& colored
             ", which is refused once form factors are known; --max-reflectance 0.99 clamps");
 }
 
+// With specular surfaces, a scene where some channel is reflected or transmitted in full
+// everywhere (Kd + Ks = 1 on mirrors, Tf = 1 on dielectrics, Kd = 1 elsewhere) never absorbs
+// that channel: refused (light would bounce forever; a purely diffuse such scene keeps the
+// warning above and the check once F is known).
+void refuse_lossless_specular(const Scene& scene, const std::string& name) {
+  const bool specular = std::any_of(scene.materials.begin(), scene.materials.end(),
+                                    [](const Material& m) { return m.specular.any(); });
+  if (!specular || scene.faces.empty()) return;
+  static const char* const kChannel[] = {"red", "green", "blue"};
+  for (int c = 0; c < 3; ++c) {
+    bool every = true;
+    for (const auto& f : scene.faces) {
+      const Material& m = scene.material_of(f.surface);
+      const double kept = m.specular.dielectric
+                              ? m.specular.transmission[c]
+                              : (f.rho ? *f.rho : m.rho)[c] + m.specular.reflectance[c];
+      every = every && kept >= 1.0;
+    }
+    if (every)
+      throw SceneError(name + ": no surface absorbs " + kChannel[c] + " light (every material "
+                       "reflects or transmits all of it: Kd + Ks = 1, or Tf = 1 on dielectrics): "
+                       "light would never be absorbed and the radiosity has no solution");
+  }
+}
+
 // What was skipped, in one warning.
 void report_skipped(const ObjData& obj, const std::string& name, Diagnostics& diag,
                     LoadReport& report) {
@@ -562,6 +634,7 @@ Scene load_obj_stream(std::istream& in, const std::string& name, const MtlOpener
   report_default_materials(obj, mats, users, name, options, diag, scene);
   const auto colored_lossless = report_face_colors(obj.colors, options, name, diag, scene);
   report_lossless(mats, colored_lossless, name, diag, scene);
+  refuse_lossless_specular(scene, name);
   report_skipped(obj, name, diag, report);
   if (report.degenerate_faces_dropped > 0)
     diag.warn(name + ": " + std::to_string(report.degenerate_faces_dropped) + " zero-area face(s) dropped");

@@ -328,6 +328,7 @@ void export_leaves(const Hierarchy& h, const State& s, const std::vector<double>
   const PatchMesh& faces = h.faces();
   PatchMesh& mesh = out.mesh;
   mesh.surface_names = faces.surface_names;
+  mesh.surface_specular = faces.surface_specular;
   mesh.scale = faces.scale;
   struct Key {
     std::int32_t surface;
