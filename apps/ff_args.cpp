@@ -46,6 +46,17 @@ void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load) {
   compute_only.push_back(
       cmd->add_flag("--symmetrize", args.symmetrize, "Alias of --reciprocity average")
           ->excludes(reciprocity));
+  cmd->add_option("--specular-depth", args.specular_depth,
+                  "Specular bounces a ray follows through mirrors and glass (extended form "
+                  "factors, ray-traced shading); 0 = specular surfaces only receive and block")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
+  compute_only.push_back(
+      cmd->add_option("--specular-rays", args.specular_rays,
+                      "Rays per patch that trace the specular paths of the extended form "
+                      "factors (scenes with mirrors or glass)")
+          ->check(CLI::Range(1, 1 << 24))
+          ->capture_default_str());
   if (!with_load) return;
   CLI::Option* ff = cmd->add_option(
       "--ff", args.ff_file,
@@ -77,6 +88,8 @@ FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run
   o.hemicube_resolution = args.hemicube_resolution;
   o.reciprocity = args.symmetrize ? "average" : args.reciprocity;
   o.progress = !run.quiet;
+  o.specular_depth = args.specular_depth;
+  o.specular_rays = args.specular_rays;
   if (args.estimator != "auto") {
     const std::vector<std::string> unused = unused_count_options(args, args.estimator);
     if (!unused.empty())

@@ -24,6 +24,10 @@ struct FormFactorArgs {
   bool samples_given = false;  ///< --samples was on the command line
   bool rays_given = false;     ///< --rays was on the command line
   std::string ff_file;  ///< load F from this file instead of computing it
+  /// --specular-depth: specular bounces followed by the extended form factors and by the
+  /// ray-traced view pass (with --ff it steers the view pass only; F keeps its own).
+  int specular_depth = 8;
+  int specular_rays = 1024;  ///< --specular-rays: rays per patch of the extended part
 };
 
 /// Adds the form-factor options to a subcommand. `with_load` adds --ff FILE, which excludes

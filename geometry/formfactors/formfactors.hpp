@@ -37,6 +37,11 @@ struct FormFactorOptions {
   /// construction; the hemicube keeps its historical default, --symmetrize to average).
   std::string reciprocity = "auto";
   bool progress = true;              ///< draw a progress bar (when stderr is a terminal)
+  /// Extended form factors (specular.hpp), used when the mesh has specular surfaces: the
+  /// most specular bounces a path follows (0: specular surfaces only receive and block),
+  /// and the cosine rays per patch that trace the paths with at least one bounce.
+  int specular_depth = 8;
+  int specular_rays = 1024;
   /// Incremental updates (adaptive meshing): when non-empty (one flag per patch), only the
   /// pairs with a flagged patch are estimated (pair estimators: both entries of each such
   /// pair; gather and hemicube: the flagged rows); everything else is left empty, and
