@@ -33,7 +33,7 @@ double estimated_error(const PatchMesh& mesh, const std::vector<double>& e) {
 }
 
 RadiositySolution solve_on(const LoadedScene& scene, const FormFactors& ff, SolveOptions so) {
-  const RadiosityProblem problem = make_problem(scene.mesh, ff.F);
+  const RadiosityProblem problem = make_problem(scene.mesh, ff);
   return solve_radiosity(problem, so);
 }
 

@@ -161,7 +161,7 @@ int compare_matrix(const CompareOptions& opts) {
   plan_form_factors(plan, opts.ff, opts.run);
   const LoadedScene loaded = load_scene(opts.scene, plan);
   const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);
-  const RadiosityProblem problem = make_problem(loaded.mesh, ff.F);
+  const RadiosityProblem problem = make_problem(loaded.mesh, ff);
   warn_about_lighting(loaded.mesh, ff.F);
   check_closed_lossless(loaded.mesh, ff);
   std::vector<std::string> names = opts.solvers.empty() ? solver_names() : opts.solvers;
@@ -302,7 +302,7 @@ int compare_hierarchical(const CompareOptions& opts) {
   const LoadedScene loaded = load_scene(opts.scene, plan);
   const Timer ff_timer;
   const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);
-  const RadiosityProblem problem = make_problem(loaded.mesh, ff.F);
+  const RadiosityProblem problem = make_problem(loaded.mesh, ff);
   warn_about_lighting(loaded.mesh, ff.F);
   check_closed_lossless(loaded.mesh, ff);
   // The reference's own stopping rule (the default solver tolerance): --tol and --max-iter

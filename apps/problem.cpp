@@ -37,6 +37,12 @@ RadiosityProblem make_problem(const PatchMesh& mesh, const SparseRowMatrix& F) {
   return p;
 }
 
+RadiosityProblem make_problem(const PatchMesh& mesh, const FormFactors& ff) {
+  RadiosityProblem p = make_problem(mesh, ff.F);
+  if (ff.specular_continued.size() == mesh.size()) p.continued = ff.specular_continued;
+  return p;
+}
+
 std::vector<SurfaceRadiosity> surface_averages(const PatchMesh& mesh, const Eigen::MatrixX3d& B) {
   std::vector<SurfaceRadiosity> out(mesh.surface_names.size());
   for (size_t s = 0; s < out.size(); ++s) out[s].name = mesh.surface_names[s];

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/formfactors/formfactors.hpp"
 #include "geometry/mesh.hpp"
 #include "solvers/radiosity.hpp"
 
@@ -14,6 +15,9 @@ namespace lambert {
 /// RadiosityProblem for `mesh` with a CsrOperator over F (which must outlive it). Throws SceneError if
 /// F's size does not match the mesh.
 RadiosityProblem make_problem(const PatchMesh& mesh, const SparseRowMatrix& F);
+/// The same over a FormFactors (its specular_continued goes with it: the energy balance of
+/// extended form factors).
+RadiosityProblem make_problem(const PatchMesh& mesh, const FormFactors& ff);
 
 /// The indirect irradiance of every patch, I_i = Σ_j F_ij (B_j - E_j) (N x 3, W/m²): the
 /// light arriving after at least one reflection, for exact_direct_vertex_field

@@ -102,7 +102,7 @@ void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOpti
   r.ff_options = F.options;
   r.ff_entries = F.F.nonZeros();
   const Timer solve_timer;
-  const RadiosityProblem problem = make_problem(scene.mesh, F.F);
+  const RadiosityProblem problem = make_problem(scene.mesh, F);
   warn_about_lighting(scene.mesh, F.F);
   check_closed_lossless(scene.mesh, F);
   SolveOptions so = solver;

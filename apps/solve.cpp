@@ -73,7 +73,7 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
   } else {
     ff = obtain_form_factors(loaded, opts.ff, opts.run);
     ff_seconds = ff_timer.seconds();
-    const RadiosityProblem problem = make_problem(loaded.mesh, ff.F);
+    const RadiosityProblem problem = make_problem(loaded.mesh, ff);
     warn_about_lighting(loaded.mesh, ff.F);
     check_closed_lossless(loaded.mesh, ff);
     sol = solve_radiosity(problem, so);

@@ -14,8 +14,8 @@
 
 namespace lambert {
 
-/// The perfect-specular part of a material (MTL `illum` 3/5: a mirror of reflectance Ks;
-/// 4/6/7: a dielectric interface of index Ni that reflects by Fresnel and refracts, the
+/// The perfect-specular part of a material (MTL `illum` 3, 5, 8: a mirror of reflectance Ks;
+/// 4, 6, 7, 9: a dielectric interface of index Ni that reflects by Fresnel and refracts, the
 /// refracted light filtered by Tf). Glossy lobes (Ns) are treated as perfect specular.
 /// Light arriving at a surface splits into rho (diffuse), the specular part and the rest,
 /// absorbed: a mirror needs rho + reflectance <= 1 per channel, a dielectric rho = 0.

@@ -143,6 +143,10 @@ double relative_residual(const RadiosityProblem& problem, const Eigen::MatrixX3d
 // A_i F_ij = A_j F_ji. Both parts are computed from their definitions (not as differences),
 // so each carries only the rounding of its own sums. Cost: one product with F and one pass
 // for its row sums, O(nnz); no entry is looked up by (row, column).
+// Extended form factors count an arrival at a specular patch and again wherever the light
+// it carries on arrives: with c_i the carried-on part of row i (problem.continued), light
+// that escapes is A_i B_i (1 − rowsum_i + c_i) and the absorbed part of H loses Σ A B c, so
+// the two parts of the imbalance above are unchanged.
 EnergyBalance energy_balance(const RadiosityProblem& problem, const Eigen::MatrixX3d& B,
                              int channel) {
   const TransportOperator& F = *problem.F;
@@ -153,10 +157,12 @@ EnergyBalance energy_balance(const RadiosityProblem& problem, const Eigen::Matri
   const Eigen::VectorXd& a = problem.area;
   const Eigen::VectorXd rho = problem.rho.col(channel);
   const Eigen::VectorXd e_col = problem.emission.col(channel);
+  const Eigen::VectorXd c =
+      problem.continued.size() ? problem.continued : Eigen::VectorXd::Zero(b.size());
   EnergyBalance e;
   e.emitted = a.dot(e_col);
-  e.absorbed = a.dot((1.0 - rho.array()).matrix().cwiseProduct(h));
-  e.escaped = a.dot(b.cwiseProduct((1.0 - row_sum.array()).matrix()));
+  e.absorbed = a.dot((1.0 - rho.array()).matrix().cwiseProduct(h)) - a.dot(b.cwiseProduct(c));
+  e.escaped = a.dot(b.cwiseProduct((1.0 - row_sum.array() + c.array()).matrix()));
   const double imbalance = std::abs(e.emitted - e.absorbed - e.escaped);
   e.relative_imbalance = e.emitted > 0.0 ? imbalance / e.emitted : imbalance;
   e.residual_part = a.dot(e_col + rho.cwiseProduct(h) - b);

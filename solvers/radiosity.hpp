@@ -29,6 +29,10 @@ struct RadiosityProblem {
   Eigen::MatrixX3d rho;                ///< N x 3 reflectance, each in [0, 1]
   Eigen::MatrixX3d emission;           ///< N x 3 emitted radiosity E (W/m^2)
   Eigen::VectorXd area;                ///< N patch areas
+  /// Extended form factors (through mirrors and glass): per row, the part of its row sum
+  /// that arrived and was carried on specularly (counted again further on); empty = none.
+  /// The energy balance needs it: row sum − continued is what ends somewhere.
+  Eigen::VectorXd continued;
 };
 
 /// Solver settings; one stopping rule for all: ||E - K B||_2 / ||E||_2 <= tol.

@@ -14,6 +14,7 @@
 #include "geometry/formfactors/hemicube.hpp"
 #include "geometry/formfactors/pairwise.hpp"
 #include "geometry/formfactors/reciprocity.hpp"
+#include "geometry/formfactors/specular.hpp"
 
 namespace lambert {
 
@@ -257,6 +258,12 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
   if (e.traces_rays && o.with_stderr && (count == "rays" ? o.rays : o.samples) < 4)
     throw UsageError("--stderr needs --" + count + " of at least 4 (standard errors come from "
                      "independent replicates of the " + count + ")");
+  const bool specular = mesh.has_specular() && o.specular_depth > 0;
+  if (specular && !e.traces_rays)
+    throw UsageError("--estimator " + o.estimator + " does not follow rays through mirrors and "
+                     "glass: use mc, hybrid or gather for this scene, or --specular-depth 0 "
+                     "(specular surfaces then only receive and block)");
+  if (specular) ff::check_grey_specular(mesh);
   std::unique_ptr<Bvh> own;
   if (!bvh && e.traces_rays) {
     own = std::make_unique<Bvh>(mesh, o.threads);
@@ -283,6 +290,9 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
     out.stats.reciprocity_seconds = timer.seconds();
     out.stats.seconds += out.stats.reciprocity_seconds;
   }
+  // The specular paths after the direct part's averaging, whose row-sum cap assumes rows
+  // of at most 1 (extended rows may exceed it): S is reciprocal by its own averaging.
+  if (specular) ff::add_specular_transport(mesh, o, *bvh, out);
   apply_threshold(out, o.threshold);
   return out;
 }
@@ -290,6 +300,8 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
 FormFactors update_form_factors(const PatchMesh& mesh, const std::vector<std::int32_t>& origin,
                                 const SparseF& old_F, const FormFactorOptions& options,
                                 const Bvh* bvh) {
+  // Specular paths connect patches far apart through mirrors: recomputed whole.
+  if (mesh.has_specular() && options.specular_depth > 0) return compute_form_factors(mesh, options, bvh);
   const std::int32_t n = mesh.size();
   LAMBERT_CHECK(static_cast<std::int32_t>(origin.size()) == n, "origin map does not match the mesh");
   FormFactorOptions o = options;

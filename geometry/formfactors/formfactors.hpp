@@ -76,6 +76,8 @@ struct FormFactorStats {
   double reciprocity_max_row_sum = 0.0;
   int reciprocity_balance_iterations = 0;
   double reciprocity_seconds = 0.0;  ///< wall time of the averaging (included in seconds)
+  /// Ray segments of the extended form factors' specular paths (included in rays).
+  std::int64_t specular_rays = 0;
 };
 
 /// The estimated matrix, optionally with per-entry standard errors (same sparsity).
@@ -84,6 +86,9 @@ struct FormFactorStats {
 struct FormFactors {
   SparseF F;
   SparseF stderr_F;  ///< empty (0 x 0) unless with_stderr
+  /// Extended form factors (specular.hpp): per row, the weight carried on specularly past
+  /// the arrivals counted in F; empty for a purely diffuse mesh (then it is all zero).
+  Eigen::VectorXd specular_continued;
   FormFactorStats stats;
   FormFactorOptions options;  ///< the settings that produced F
 
@@ -94,6 +99,7 @@ struct FormFactors {
   FormFactors& operator=(FormFactors&& other) noexcept {
     F.swap(other.F);
     stderr_F.swap(other.stderr_F);
+    specular_continued.swap(other.specular_continued);
     stats = other.stats;
     options = std::move(other.options);
     return *this;

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -44,6 +45,24 @@ inline Eigen::Vector3d sample_patch(const PatchGeom& g, double u, double v, doub
   const Eigen::Vector3d dv = (1 - u) * (g.p[3] - g.p[0]) + u * (g.p[2] - g.p[1]);
   jacobian = du.cross(dv).norm();
   return (1 - u) * (1 - v) * g.p[0] + u * (1 - v) * g.p[1] + u * v * g.p[2] + (1 - u) * v * g.p[3];
+}
+
+/// An orthonormal frame (t, b, n) for unit n (Duff et al. 2017, branchless).
+inline void orthonormal_frame(const Eigen::Vector3d& n, Eigen::Vector3d& t, Eigen::Vector3d& b) {
+  const double sign = std::copysign(1.0, n.z());
+  const double a = -1.0 / (sign + n.z());
+  const double c = n.x() * n.y() * a;
+  t = Eigen::Vector3d(1.0 + sign * n.x() * n.x() * a, sign * c, -sign * n.x());
+  b = Eigen::Vector3d(c, sign + n.y() * n.y() * a, -n.y());
+}
+
+/// Malley's method: (u, v) in [0,1)^2 -> the uniform point (√u cos 2πv, √u sin 2πv) of the
+/// unit disk lifted to the hemisphere about n (frame t, b, n): density cosθ / π.
+inline Eigen::Vector3d cosine_direction(const Eigen::Vector3d& t, const Eigen::Vector3d& b,
+                                        const Eigen::Vector3d& n, double u, double v) {
+  const double r = std::sqrt(u), phi = 2.0 * M_PI * v;
+  const double z = std::sqrt(std::max(0.0, 1.0 - u));
+  return r * std::cos(phi) * t + r * std::sin(phi) * b + z * n;
 }
 
 /// Like sample_patch but smooth in (u, v), for quadrature: triangles use the collapsed
