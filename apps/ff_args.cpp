@@ -152,6 +152,10 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
       ff.options.estimator.clear();
       log_warn(args.ff_file + ": records no form-factor settings; reports show them as unknown");
     }
+    if (ff.options.extended && ff.specular_continued.size() != ff.F.rows())
+      log_warn(args.ff_file + ": extended form factors without their specular bookkeeping "
+               "(a Matrix Market file): the energy balance counts light carried on by mirrors "
+               "and glass once more, as negative escaped power (save F as .bin to keep it)");
     log_info("form factors: loaded " + args.ff_file + " (" + std::to_string(ff.F.nonZeros()) +
              " entries, " + ff_settings_text(ff.options, "") + ")");
     return ff;
@@ -163,7 +167,11 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
   log_info("form factors: " + std::to_string(scene.mesh.size()) + " patches, " +
            format_si(static_cast<double>(ff.F.nonZeros())) + " entries, " +
            format_si(static_cast<double>(ff.stats.rays)) + " rays in " +
-           format_duration(ff.stats.seconds) + reciprocity_summary(ff));
+           format_duration(ff.stats.seconds) + reciprocity_summary(ff) +
+           (ff.options.extended ? ", " + format_si(static_cast<double>(ff.stats.specular_rays)) +
+                                      " of them on specular paths (depth " +
+                                      std::to_string(ff.options.specular_depth) + ")"
+                                : ""));
   if (ff.stats.pairs_unverified > 0)
     log_warn(std::to_string(ff.stats.pairs_unverified) +
              " patch pairs could not have their visibility sampled as designed (no ray could be "
@@ -197,6 +205,9 @@ Json ff_settings_json(const FormFactorOptions& o, const std::string& loaded_from
           {"hemicube_resolution", known(o.hemicube_resolution)},
           {"reciprocity", known(o.reciprocity)},
           {"symmetrize", known(o.reciprocity == "average")},
+          {"extended", known(o.extended)},  // specular paths included (specular.hpp)
+          {"specular_depth", o.extended ? Json(o.specular_depth) : Json()},
+          {"specular_rays", o.extended ? Json(o.specular_rays) : Json()},
           {"loaded_from", loaded_from}};
 }
 

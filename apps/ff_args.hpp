@@ -69,7 +69,8 @@ void check_closed_lossless(const PatchMesh& mesh, const FormFactors& ff, bool so
 
 /// The settings that made F, for reports: {estimator (the resolved one),
 /// estimator_requested ("auto" or null), samples, rays_per_patch (--rays), seed, threshold,
-/// hemicube_resolution, reciprocity, symmetrize (reciprocity == average), loaded_from} (""
+/// hemicube_resolution, reciprocity, symmetrize (reciprocity == average), extended (F holds
+/// specular paths), specular_depth and specular_rays (null unless extended), loaded_from} (""
 /// when computed here), every setting null when unknown (see obtain_form_factors).
 Json ff_settings_json(const FormFactorOptions& options, const std::string& loaded_from);
 

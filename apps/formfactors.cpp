@@ -155,6 +155,9 @@ int run_formfactors(const FormFactorsOptions& opts) {
   const LoadedScene scene = load_scene(opts.scene, plan);
   if (!opts.point.empty()) {
     const FormFactorOptions o = make_ff_options(opts.ff, opts.run);
+    if (scene.mesh.has_specular())
+      log_warn("--point: sensor-point factors are direct only (specular surfaces receive and "
+               "block; paths through mirrors and glass are not followed)");
     const PointFactors pf = point_form_factors(scene.mesh, parse_vec(opts.point), parse_vec(opts.normal), o);
     if (opts.output.empty()) {
       std::cout << json_text(point_json(pf));

@@ -166,6 +166,14 @@ RowSumRule row_sum_rule(const FormFactors& ff, const std::string& settings) {
   return rule;
 }
 
+// True when the settings describe extended form factors (specular paths included): a patch
+// may then see itself through a mirror (diagonal entries) and rows count light again after
+// each specular bounce.
+bool extended_settings(const std::string& settings) {
+  FormFactorOptions o;
+  return parse_ff_settings(settings, o) && o.extended;
+}
+
 std::string patch_pair(std::int64_t i, std::int64_t j) {
   return "entry (" + std::to_string(i) + ", " + std::to_string(j) + ")";
 }
@@ -177,11 +185,12 @@ std::string value_text(double v) {
 }
 
 // What is physically wrong with the value of F_ij (or its standard error), or "".
-std::string bad_value(double v, std::int64_t i, std::int64_t j, bool is_stderr) {
+std::string bad_value(double v, std::int64_t i, std::int64_t j, bool is_stderr,
+                      bool extended) {
   const char* what = is_stderr ? "standard error" : "value";
   if (!std::isfinite(v)) return std::string(what) + " " + value_text(v) + " is not finite";
   if (v < 0) return std::string(what) + " " + value_text(v) + " is negative";
-  if (!is_stderr && i == j && v != 0)
+  if (!is_stderr && i == j && v != 0 && !extended)
     return "nonzero diagonal " + value_text(v) + " (a planar patch sees none of itself)";
   return "";
 }
@@ -195,8 +204,12 @@ void check_row_sums(const FormFactors& ff, const std::string& settings, const st
                     double value_rounding = 0.0,
                     const std::vector<double>* row_rounding = nullptr) {
   const RowSumRule rule = row_sum_rule(ff, settings);
+  // Extended rows exceed 1 by what they carried on (specular_continued); without it (a
+  // Matrix Market file) they state no bound.
+  const bool extended = extended_settings(settings);
+  if (extended && ff.specular_continued.size() != ff.F.rows()) return;
   for (std::int32_t i = 0; rule.check && i < ff.F.outerSize(); ++i) {
-    double sum = 0, err = 0;
+    double sum = extended ? -ff.specular_continued[i] : 0.0, err = 0;
     const auto begin = ff.F.outerIndexPtr()[i], end = ff.F.outerIndexPtr()[i + 1];
     for (auto k = begin; k < end; ++k) {
       sum += ff.F.valuePtr()[k];
@@ -214,7 +227,7 @@ void check_row_sums(const FormFactors& ff, const std::string& settings, const st
 // Binary structure and values: row starts from 0 to nnz and monotone, columns in range,
 // strictly increasing within a row, values (and standard errors) finite, non-negative,
 // zero on the diagonal. Linear in nnz.
-void check_binary_entries(const FormFactors& ff, const std::string& path) {
+void check_binary_entries(const FormFactors& ff, const std::string& path, bool extended) {
   const std::int64_t n = ff.F.rows(), nnz = ff.F.nonZeros();
   const auto* outer = ff.F.outerIndexPtr();
   const auto* col = ff.F.innerIndexPtr();
@@ -236,8 +249,9 @@ void check_binary_entries(const FormFactors& ff, const std::string& path) {
       if (k > outer[i] && col[k] <= col[k - 1])
         throw corrupt(patch_pair(i, col[k]) + (col[k] == col[k - 1] ? " repeated" : " unsorted") +
                       " (columns must increase within a row)");
-      std::string why = bad_value(ff.F.valuePtr()[k], i, col[k], false);
-      if (why.empty() && with_err) why = bad_value(ff.stderr_F.valuePtr()[k], i, col[k], true);
+      std::string why = bad_value(ff.F.valuePtr()[k], i, col[k], false, extended);
+      if (why.empty() && with_err)
+        why = bad_value(ff.stderr_F.valuePtr()[k], i, col[k], true, extended);
       if (!why.empty()) throw SceneError(path + ": " + patch_pair(i, col[k]) + ": " + why);
     }
   }
@@ -254,7 +268,9 @@ std::int64_t stream_size(std::istream& in, const std::string& path) {
 }
 
 constexpr std::int64_t kBinaryHeaderBytes = 8 + 4 + 4 + 8 + 8 + 8 + 4;
-constexpr std::uint32_t kWithErrors = 1u, kFloatValues = 2u;  // header flags
+// Header flags; kContinued: f64[n] specular_continued follow the values and errors
+// (extended form factors, specular.hpp).
+constexpr std::uint32_t kWithErrors = 1u, kFloatValues = 2u, kContinued = 4u;
 constexpr double kFloatRounding = 0x1p-24;  // relative rounding of a double stored as f32
 
 // The byte count a binary F file with this header has: header, settings, row starts,
@@ -264,7 +280,7 @@ std::int64_t binary_size(std::uint32_t version, std::int64_t n, std::int64_t nnz
   const std::int64_t row_start_bytes = version == 1 ? 4 : 8;
   const std::int64_t value_bytes = flags & kFloatValues ? 4 : 8;
   return kBinaryHeaderBytes + len + row_start_bytes * (n + 1) + (4 + value_bytes) * nnz +
-         (flags & kWithErrors ? value_bytes * nnz : 0) + 8;
+         (flags & kWithErrors ? value_bytes * nnz : 0) + (flags & kContinued ? 8 * n : 0) + 8;
 }
 
 FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t expected_hash,
@@ -287,7 +303,8 @@ FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t
   const auto len = r.get<std::uint32_t>();
   // Bounds before any allocation: a corrupt header must not trigger a huge allocation or
   // signed overflow (n <= INT32_MAX makes n * n fit in 64 bits).
-  const std::uint32_t known = version == 1 ? kWithErrors : kWithErrors | kFloatValues;
+  const std::uint32_t known =
+      version == 1 ? kWithErrors : kWithErrors | kFloatValues | kContinued;
   if (flags & ~known)
     throw IoError(path + ": corrupt header: unknown flags " + std::to_string(flags));
   if (n < 0 || n > INT32_MAX || nnz < 0 || nnz > n * n || (version == 1 && nnz > INT32_MAX) ||
@@ -323,10 +340,18 @@ FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t
     else
       r.get(ff.stderr_F.valuePtr(), sizeof(double) * nnz);
   }
+  if (flags & kContinued) {
+    ff.specular_continued.resize(n);
+    r.get(ff.specular_continued.data(), sizeof(double) * n);
+  }
   const std::uint64_t computed = r.checksum();
   const auto stored = r.get<std::uint64_t>();
   if (stored != computed) throw IoError(path + ": form-factor file is corrupt (checksum mismatch)");
-  check_binary_entries(ff, path);
+  for (Eigen::Index i = 0; i < ff.specular_continued.size(); ++i)
+    if (!(ff.specular_continued[i] >= 0.0) || !std::isfinite(ff.specular_continued[i]))
+      throw SceneError(path + ": specular bookkeeping of patch " + std::to_string(i) + " is " +
+                       value_text(ff.specular_continued[i]) + " (must be finite and >= 0)");
+  check_binary_entries(ff, path, extended_settings(settings));
   check_row_sums(ff, settings, path, f32 ? kFloatRounding : 0.0);
   if (info) *info = {hash, settings};
   return ff;
@@ -404,7 +429,7 @@ FormFactorFileInfo read_mm_header(LineReader& lines, std::string_view& line, boo
 // One entry line "i j value": exactly three fields, indices in [1, n], value finite, >= 0
 // and 0 on the diagonal.
 MmEntry parse_mm_entry(const LineReader& lines, std::string_view line, std::int64_t n,
-                       std::vector<std::string_view>& tok) {
+                       bool extended, std::vector<std::string_view>& tok) {
   split_fields(line, tok);
   if (tok.size() != 3)
     throw SceneError(lines.where() + ": expected 'row column value', found " +
@@ -419,7 +444,7 @@ MmEntry parse_mm_entry(const LineReader& lines, std::string_view line, std::int6
   if (i < 1 || i > n || j < 1 || j > n)
     throw SceneError(lines.where() + ": entry (" + std::to_string(i) + ", " + std::to_string(j) +
                      ") out of range [1, " + std::to_string(n) + "]");
-  why = bad_value(v, i, j, false);
+  why = bad_value(v, i, j, false, extended);
   if (!why.empty()) throw SceneError(lines.where() + ": " + why);
   return {static_cast<std::int32_t>(i - 1), static_cast<std::int32_t>(j - 1), v, lines.line_number(),
           half_unit_in_last_digit(tok[2])};
@@ -460,6 +485,7 @@ FormFactors read_matrix_market(std::istream& in, const std::string& path,
   std::string_view line;
   bool have_hash = false;
   const FormFactorFileInfo meta = read_mm_header(lines, line, have_hash);
+  const bool extended = extended_settings(meta.settings);
   if (!have_hash && expected_n >= 0)
     throw SceneError(path + ": no lambert mesh hash in the header: cannot check it belongs to "
                             "this scene");
@@ -482,7 +508,7 @@ FormFactors read_matrix_market(std::istream& in, const std::string& path,
     if (static_cast<std::int64_t>(entries.size()) == nnz)
       throw SceneError(lines.where() + ": extra line after the " + std::to_string(nnz) +
                        " entries the size line announced");
-    entries.push_back(parse_mm_entry(lines, line, rows, tok));
+    entries.push_back(parse_mm_entry(lines, line, rows, extended, tok));
   }
   if (static_cast<std::int64_t>(entries.size()) != nnz)
     throw IoError(path + ": truncated: " + std::to_string(entries.size()) + " of " +
@@ -524,7 +550,10 @@ std::string format_ff_settings(const FormFactorOptions& o) {
   return "estimator=" + o.estimator + " samples=" + std::to_string(o.samples) +
          " rays=" + std::to_string(o.rays) + " seed=" + std::to_string(o.seed) +
          " threshold=" + threshold + " hemicube_res=" + std::to_string(o.hemicube_resolution) +
-         " reciprocity=" + (average ? "average" : "none") + " symmetrize=" + (average ? "1" : "0");
+         " reciprocity=" + (average ? "average" : "none") + " symmetrize=" + (average ? "1" : "0") +
+         (o.extended ? " specular_depth=" + std::to_string(o.specular_depth) +
+                           " specular_rays=" + std::to_string(o.specular_rays)
+                     : "");
 }
 
 bool parse_ff_settings(const std::string& text, FormFactorOptions& options) {
@@ -555,6 +584,13 @@ bool parse_ff_settings(const std::string& text, FormFactorOptions& options) {
     } else if (key == "rays") {
       if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
       o.rays = static_cast<int>(k);
+    } else if (key == "specular_depth") {
+      if (!parse_int(value, k) || k < 1 || k > 64) return false;
+      o.specular_depth = static_cast<int>(k);
+      o.extended = true;
+    } else if (key == "specular_rays") {
+      if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
+      o.specular_rays = static_cast<int>(k);
     } else if (key == "symmetrize") {
       if (value != "0" && value != "1") return false;
       if (!reciprocity) o.reciprocity = value == "1" ? "average" : "none";
@@ -609,9 +645,11 @@ void write_ff_binary(const std::string& path, const FormFactors& ff, const FormF
         Writer w(out);
         const std::int64_t n = ff.F.rows(), nnz = ff.F.nonZeros();
         const bool err = ff.stderr_F.nonZeros() == nnz && nnz > 0;
+        const bool continued = ff.specular_continued.size() == n && n > 0;
         w.put(kMagic, 8);
         w.put(kVersion);
-        w.put(static_cast<std::uint32_t>((err ? kWithErrors : 0u) | (f32 ? kFloatValues : 0u)));
+        w.put(static_cast<std::uint32_t>((err ? kWithErrors : 0u) | (f32 ? kFloatValues : 0u) |
+                                         (continued ? kContinued : 0u)));
         w.put(n);
         w.put(nnz);
         w.put(info.mesh_hash);
@@ -626,6 +664,7 @@ void write_ff_binary(const std::string& path, const FormFactors& ff, const FormF
           w.put(ff.F.valuePtr(), sizeof(double) * nnz);
           if (err) w.put(ff.stderr_F.valuePtr(), sizeof(double) * nnz);
         }
+        if (continued) w.put(ff.specular_continued.data(), sizeof(double) * n);
         const std::uint64_t sum = w.checksum();
         out.write(reinterpret_cast<const char*>(&sum), sizeof sum);
       },

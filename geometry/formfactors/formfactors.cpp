@@ -292,7 +292,10 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
   }
   // The specular paths after the direct part's averaging, whose row-sum cap assumes rows
   // of at most 1 (extended rows may exceed it): S is reciprocal by its own averaging.
-  if (specular) ff::add_specular_transport(mesh, o, *bvh, out);
+  if (specular) {
+    ff::add_specular_transport(mesh, o, *bvh, out);
+    out.options.extended = true;
+  }
   apply_threshold(out, o.threshold);
   return out;
 }

@@ -42,6 +42,9 @@ struct FormFactorOptions {
   /// and the cosine rays per patch that trace the paths with at least one bounce.
   int specular_depth = 8;
   int specular_rays = 1024;
+  /// Set on the result: F holds the specular paths (the mesh had specular surfaces and
+  /// specular_depth > 0).
+  bool extended = false;
   /// Incremental updates (adaptive meshing): when non-empty (one flag per patch), only the
   /// pairs with a flagged patch are estimated (pair estimators: both entries of each such
   /// pair; gather and hemicube: the flagged rows); everything else is left empty, and

@@ -447,6 +447,11 @@ std::vector<std::int32_t> blind_emitters(const Hierarchy& h, double plane_eps) {
 
 HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOptions& o) {
   check_options(o);
+  for (const Surface& s : scene.surfaces)
+    if (scene.materials[s.material].specular.any())
+      throw UsageError("--method hierarchical handles diffuse surfaces only, and surface '" +
+                       s.name + "' is specular (a mirror or glass): use --method matrix, whose "
+                       "extended form factors follow rays through it");
   const int threads = resolve_threads(o.threads);
   HierarchicalResult result;
   HierarchicalStats& st = result.stats;
