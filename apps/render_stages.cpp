@@ -134,8 +134,14 @@ RadiosityResult compute_radiosity(const LoadedScene& scene, const FormFactorArgs
 
 std::string resolve_vertex_interp(const ShadeArgs& args, const LoadedScene& scene,
                                   const Eigen::MatrixX3d* indirect) {
+  // Exact direct light sees emitters only directly: light they send through mirrors and
+  // glass is in B but would be missing at the vertices.
+  if (args.vertex_interp == "exact-direct" && scene.mesh.has_specular())
+    throw UsageError("--vertex-interp exact-direct computes direct light without mirrors and "
+                     "glass, and this scene has specular surfaces: use conservative");
   if (args.vertex_interp != "auto") return args.vertex_interp;
-  return scene.discontinuity && indirect ? "exact-direct" : "conservative";
+  return scene.discontinuity && indirect && !scene.mesh.has_specular() ? "exact-direct"
+                                                                        : "conservative";
 }
 
 ShadedField shade_vertices(const LoadedScene& scene, const Eigen::MatrixX3d& B,

@@ -77,7 +77,8 @@ struct ShadedField {
   double seconds = 0.0;
 };
 /// --vertex-interp with auto resolved: exact-direct on a --discontinuity mesh when
-/// `indirect` is given, else conservative.
+/// `indirect` is given and no surface is specular, else conservative. Throws UsageError for
+/// an explicit exact-direct on a scene with specular surfaces.
 std::string resolve_vertex_interp(const ShadeArgs& args, const LoadedScene& scene,
                                   const Eigen::MatrixX3d* indirect);
 /// Interpolates B to the shading vertices with --vertex-interp. `indirect` (I = F (B - E),
