@@ -44,15 +44,6 @@ struct Hit {
   double w;
 };
 
-// An orthonormal frame (t, b, n) for unit n (Duff et al. 2017, branchless).
-void frame(const Eigen::Vector3d& n, Eigen::Vector3d& t, Eigen::Vector3d& b) {
-  const double sign = std::copysign(1.0, n.z());
-  const double a = -1.0 / (sign + n.z());
-  const double c = n.x() * n.y() * a;
-  t = Eigen::Vector3d(1.0 + sign * n.x() * n.x() * a, sign * c, -sign * n.x());
-  b = Eigen::Vector3d(c, sign + n.y() * n.y() * a, -n.y());
-}
-
 // Traces row i's K rays into `hits` (cleared first).
 // `normals`: the patches' normals packed (the front test reads one per hit, at random:
 // 24 bytes apart instead of a whole PatchGeom).
@@ -61,7 +52,7 @@ void trace_row(const std::vector<PatchGeom>& geom, const std::vector<Eigen::Vect
                std::vector<Hit>& hits) {
   const PatchGeom& g = geom[i];
   Eigen::Vector3d t, b;
-  frame(g.normal, t, b);
+  orthonormal_frame(g.normal, t, b);
   hits.clear();
   const int R = replicate_count(K);
   for (int rep = 0; rep < R; ++rep) {
@@ -71,9 +62,8 @@ void trace_row(const std::vector<PatchGeom>& geom, const std::vector<Eigen::Vect
     for (int s = 0; s < k; ++s) {
       double jac;
       const Eigen::Vector3d x = sample_patch(g, seq.get(s, 0), seq.get(s, 1), jac);
-      const double r = std::sqrt(seq.get(s, 2)), phi = 2.0 * M_PI * seq.get(s, 3);
-      const double z = std::sqrt(std::max(0.0, 1.0 - seq.get(s, 2)));
-      const Eigen::Vector3d dir = r * std::cos(phi) * t + r * std::sin(phi) * b + z * g.normal;
+      const Eigen::Vector3d dir =
+          cosine_direction(g.normal, t, b, seq.get(s, 2), seq.get(s, 3));
       const Eigen::Vector3d origin = x + offset * g.normal;
       const RayHit hit = bvh.intersect(origin.cast<float>(), dir.cast<float>());
       if (hit.patch < 0 || hit.patch == i) continue;

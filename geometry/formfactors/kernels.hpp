@@ -3,12 +3,31 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 
 #include "geometry/mesh.hpp"
 
 namespace lambert::ff {
+
+/// An orthonormal frame (t, b, n) for unit n (Duff et al. 2017, branchless).
+inline void orthonormal_frame(const Eigen::Vector3d& n, Eigen::Vector3d& t, Eigen::Vector3d& b) {
+  const double sign = std::copysign(1.0, n.z());
+  const double a = -1.0 / (sign + n.z());
+  const double c = n.x() * n.y() * a;
+  t = Eigen::Vector3d(1.0 + sign * n.x() * n.x() * a, sign * c, -sign * n.x());
+  b = Eigen::Vector3d(c, sign + n.y() * n.y() * a, -n.y());
+}
+
+/// The cosine-distributed direction (density cos θ / π about n, frame (t, b, n)) of (u, v)
+/// in [0,1)²: radius √u, angle 2π v on the unit disk, lifted to the hemisphere.
+inline Eigen::Vector3d cosine_direction(const Eigen::Vector3d& n, const Eigen::Vector3d& t,
+                                        const Eigen::Vector3d& b, double u, double v) {
+  const double r = std::sqrt(u), phi = 2.0 * M_PI * v;
+  const double z = std::sqrt(std::max(0.0, 1.0 - u));
+  return r * std::cos(phi) * t + r * std::sin(phi) * b + z * n;
+}
 
 /// A patch's corners and frame, copied out of the mesh for cache-friendly pair loops.
 struct PatchGeom {
