@@ -163,14 +163,17 @@ TEST(ViewPass, GlassSlabTransmitsTheSumOfInternalReflections) {
   }
 }
 
-TEST(ViewPass, MirrorShowsTheMirroredCameraViewTimesRhoS) {
+TEST(ViewPass, MirrorShowsItsOwnRadiancePlusTheMirroredCameraViewTimesRhoS) {
   // A wall at z = 3 facing the mirror (z = 0) with a smooth B; the camera at z = 1 looks at
   // the mirror, the mirrored camera (z = -1) at the wall with the mirror taken away.
-  const Eigen::Vector3d rho_s(0.9, 0.6, 0.3);
+  // The mirror is also diffuse (ρ 0.3 + ρ_s ≤ 1) with a uniform B_m of its own.
+  const Eigen::Vector3d rho_s(0.6, 0.5, 0.3), B_m(0.7, 0.8, 0.9);
   Scene with, without;
   for (Scene* s : {&with, &without})
     add_rect(*s, "wall", diffuse("wall", 0.5), -10, 10, -10, 10, 3.0, false);
-  add_rect(with, "mirror", mirror(rho_s), -3, 3, -3, 3, 0.0, true);
+  Material shiny = mirror(rho_s);
+  shiny.rho = Eigen::Vector3d::Constant(0.3);
+  add_rect(with, "mirror", shiny, -3, 3, -3, 3, 0.0, true);
   const PatchMesh mesh = mesh_scene(with, {1.0, 0});
   const PatchMesh bare = mesh_scene(without, {1.0, 0});
   Eigen::MatrixX3d B = Eigen::MatrixX3d::Zero(mesh.size(), 3);
@@ -179,6 +182,7 @@ TEST(ViewPass, MirrorShowsTheMirroredCameraViewTimesRhoS) {
     const Eigen::Vector3d& c = bare.patches[i].centroid;
     B.row(i) << 2 + 0.1 * c.x(), 2 + 0.05 * c.y(), 2 + 0.1 * c.x() - 0.05 * c.y();
   }
+  for (std::int32_t i = bare.size(); i < mesh.size(); ++i) B.row(i) = B_m.transpose();
   const Eigen::MatrixX3d B_bare = B.topRows(bare.size());
   const VertexField field = interpolate_to_vertices(mesh, B, VertexInterpolation::AreaWeighted);
   const VertexField field_bare = interpolate_to_vertices(bare, B_bare, VertexInterpolation::AreaWeighted);
@@ -201,7 +205,8 @@ TEST(ViewPass, MirrorShowsTheMirroredCameraViewTimesRhoS) {
         // The reflected ray starts 1e-6 × scene size (≈ 3e-5) off the mirror, and its float
         // hit is rounded by ~1e-7 × 3: the wall point moves by < 1e-4; B's slope is ≤ 0.15
         // per unit on B ≥ 1, so L moves by < 2e-5 relative; 1e-4 leaves a margin.
-        EXPECT_NEAR(a[c], rho_s[c] * b[c], 1e-4 * b[c]) << x << "," << y;
+        // L = B_m/π + ρ_s L_reflected (B_m uniform: its Gouraud value is exact).
+        EXPECT_NEAR(a[c], B_m[c] / M_PI + rho_s[c] * b[c], 1e-4 * b[c]) << x << "," << y;
       }
     }
   }
@@ -239,6 +244,34 @@ TEST(FinalGather, DirectLightWithNothingBlockingIsTheExactFactorTimesE) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(b[c], 0.5 * E[c] * F, 1e-12 * E[c]);
   }
   EXPECT_EQ(rays, 2 * 16);
+}
+
+TEST(FinalGather, GatherRaysReadTheFullRadiosityAfterAMirror) {
+  // An emitting floor (E = 1, ρ = 0.5, given B = 2) under a mirror ceiling (ρ_s = 0.8) at
+  // height 1: every gather ray goes up, is reflected and reads the floor's full B (E
+  // included: light via a mirror is not in H_d). H_d = 0 (the floor's plane holds x), so
+  // B_fg = E + ρ ρ_s B = 1 + 0.5 · 0.8 · 2 = 1.8; reading B − E would give 1.4.
+  Scene s;
+  add_rect(s, "floor", diffuse("floor", 0.5, {1, 1, 1}), -2000, 2000, -2000, 2000, 0.0, true);
+  add_rect(s, "mirror", mirror({0.8, 0.8, 0.8}), -1000, 1000, -1000, 1000, 1.0, false);
+  const PatchMesh mesh = mesh_scene(s, {});
+  const Bvh bvh(mesh);
+  Eigen::MatrixX3d B = Eigen::MatrixX3d::Zero(mesh.size(), 3);
+  B.row(0).setConstant(2.0);
+  const DirectLight light(s);
+  ViewPassSettings vs;
+  vs.final_gather = 32;
+  const ViewTracer tracer(mesh, bvh, B, VertexField{}, vs, &light);
+  std::int64_t rays = 0;
+  const Eigen::Vector3d b = tracer.gathered_radiosity({0.3, 0.2, 0.0}, 0, 3, rays);
+  // Rays escape past the mirror's edge (tan θ > 1000) with cosine-weighted probability
+  // 1 / (1 + 10⁶) = 1e-6, each losing 0.4 · 2 / 32; 1e-6 bounds it with room.
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(b[c], 1.8, 1e-6);
+  EXPECT_EQ(rays, 2 * 32);  // up to the mirror, down to the floor
+  // With no specular bounce allowed the mirror ends every gather ray.
+  vs.specular_depth = 0;
+  const ViewTracer flat_tracer(mesh, bvh, B, VertexField{}, vs, &light);
+  EXPECT_NEAR(flat_tracer.gathered_radiosity({0.3, 0.2, 0.0}, 0, 3, rays)[0], 1.0, 1e-12);
 }
 
 TEST(FinalGather, FurnaceIsExactForAnyRayCount) {
