@@ -34,8 +34,9 @@ std::string render_settings(const RenderOptions& o, const std::string& method_pa
   std::ostringstream ss;
   ss << method_part;
   ss << " interp=" << interp << ' ' << shading_settings(o.shade, o.ff.specular_depth)
-     << (o.shade.wireframe ? " wireframe=1" : "") << " antialias=" << o.shade.antialias << " render_seed=" << o.run.seed << " size=" << cam.width
-     << "x" << cam.height << " eye=" << cam.eye.x() << "," << cam.eye.y() << "," << cam.eye.z()
+     << (o.shade.wireframe ? " wireframe=1" : "") << " antialias=" << o.shade.antialias
+     << " render_seed=" << o.run.seed << " size=" << cam.width << "x" << cam.height
+     << " eye=" << cam.eye.x() << "," << cam.eye.y() << "," << cam.eye.z()
      << " look_at=" << cam.look_at.x() << "," << cam.look_at.y() << "," << cam.look_at.z()
      << " vfov=" << cam.vfov_degrees;
   return ss.str();

@@ -113,9 +113,12 @@ Shading resolve_shading(const ShadeArgs& args) {
 
 const char* shading_name(Shading shading) {
   switch (shading) {
-    case Shading::Flat: return "flat";
-    case Shading::Raytrace: return "raytrace";
-    case Shading::Gouraud: break;
+    case Shading::Flat:
+      return "flat";
+    case Shading::Raytrace:
+      return "raytrace";
+    case Shading::Gouraud:
+      break;
   }
   return "gouraud";
 }

@@ -32,9 +32,9 @@ Camera make_camera(const Scene& scene, const CameraArgs& args);
 
 /// --shading, --flat, --final-gather, --wireframe, --antialias, --exposure, --vertex-interp.
 struct ShadeArgs {
-  std::string shading;  ///< gouraud, flat or raytrace; empty = from --flat / --final-gather
-  bool flat = false;    ///< --flat: alias of --shading flat
-  int final_gather = 0;  ///< --final-gather N: gather rays per diffuse hit (implies raytrace)
+  std::string shading;     ///< gouraud, flat or raytrace; empty = from --flat / --final-gather
+  bool flat = false;       ///< --flat: alias of --shading flat
+  int final_gather = 0;    ///< --final-gather N: gather rays per diffuse hit (implies raytrace)
   bool wireframe = false;  ///< --wireframe: patch edges drawn over the shading
   int antialias = 2;
   std::string exposure = "auto";  ///< "auto" or EV stops

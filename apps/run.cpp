@@ -70,8 +70,8 @@ std::vector<double> as_vector(const Eigen::Vector3d& v) { return {v[0], v[1], v[
 std::string shade_settings(const RunOptions& o, const std::string& interp, const Camera& cam) {
   std::ostringstream ss;
   ss << " interp=" << interp << ' ' << shading_settings(o.shade, o.ff.specular_depth)
-     << (o.shade.wireframe ? " wireframe=1" : "") << " antialias=" << o.shade.antialias << " render_seed=" << o.run.seed << " size=" << cam.width
-     << "x" << cam.height;
+     << (o.shade.wireframe ? " wireframe=1" : "") << " antialias=" << o.shade.antialias
+     << " render_seed=" << o.run.seed << " size=" << cam.width << "x" << cam.height;
   return ss.str();
 }
 

@@ -100,12 +100,18 @@ int main(int argc, char** argv) {
   std::string gathers = "16,64,256", png_dir;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i], v = argv[i + 1];
-    if (a == "--size") size = std::atoi(v.c_str());
-    else if (a == "--patches") patches = std::atol(v.c_str());
-    else if (a == "--ref-patches") ref_patches = std::atol(v.c_str());
-    else if (a == "--gather") gathers = v;
-    else if (a == "--threads") threads = std::atoi(v.c_str());
-    else if (a == "--png-dir") png_dir = v;
+    if (a == "--size")
+      size = std::atoi(v.c_str());
+    else if (a == "--patches")
+      patches = std::atol(v.c_str());
+    else if (a == "--ref-patches")
+      ref_patches = std::atol(v.c_str());
+    else if (a == "--gather")
+      gathers = v;
+    else if (a == "--threads")
+      threads = std::atoi(v.c_str());
+    else if (a == "--png-dir")
+      png_dir = v;
     else {
       std::fprintf(stderr, "unknown option %s\n", a.c_str());
       return 2;
@@ -131,8 +137,8 @@ int main(int argc, char** argv) {
   };
 
   Timer t;
-  const VertexField ref_field = exact_direct_vertex_field(scene, fine.mesh, fine.B, fine.indirect,
-                                                          threads);
+  const VertexField ref_field =
+      exact_direct_vertex_field(scene, fine.mesh, fine.B, fine.indirect, threads);
   const Bvh ref_bvh(fine.mesh, threads);
   const Image ref = render(fine.mesh, ref_bvh, cam, fine.B, ref_field, base);
   const double ev = auto_exposure(ref);

@@ -32,9 +32,10 @@ ViewTracer::ViewTracer(const PatchMesh& mesh, const Bvh& bvh, const Eigen::Matri
   LAMBERT_CHECK(settings.specular_depth >= 0 && settings.final_gather >= 0,
                 "view pass: negative depth or gather count");
   LAMBERT_CHECK(settings.final_gather == 0 || direct, "final gather without direct light");
-  LAMBERT_CHECK(settings.final_gather > 0 || (vertices.patch_corners.size() == mesh.patches.size() &&
-                                              vertices.values.rows() == vertices.size()),
-                "view pass: vertex field does not match the mesh");
+  LAMBERT_CHECK(
+      settings.final_gather > 0 || (vertices.patch_corners.size() == mesh.patches.size() &&
+                                    vertices.values.rows() == vertices.size()),
+      "view pass: vertex field does not match the mesh");
 }
 
 Eigen::Vector3d ViewTracer::radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
@@ -93,8 +94,8 @@ Eigen::Vector3d ViewTracer::gathered_radiosity(const Eigen::Vector3d& x, std::in
   // Onto the patch's plane: a ray hit is rounded off it by ~1e-7 of the scene's size, and
   // the exact direct light skips the faces whose plane holds the point within 1e-12 only.
   const Eigen::Vector3d xp = x - p.normal * p.normal.dot(x - p.centroid);
-  const Eigen::Vector3d H = direct_->irradiance(xp, p.normal) +
-                            indirect_irradiance(xp, i, stream, rays);
+  const Eigen::Vector3d H =
+      direct_->irradiance(xp, p.normal) + indirect_irradiance(xp, i, stream, rays);
   return B + p.rho.cwiseProduct(H);
 }
 
@@ -109,8 +110,7 @@ Eigen::Vector3d ViewTracer::indirect_irradiance(const Eigen::Vector3d& x, std::i
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (int s = 0; s < N; ++s) {
     // Cosine-distributed (pdf cos θ / π): H_i = ∫ L cos θ dω ≈ (π / N) Σ L_k = (1/N) Σ B_k.
-    const Eigen::Vector3d dir =
-        ff::cosine_direction(n, t, b, lattice.get(s, 0), lattice.get(s, 1));
+    const Eigen::Vector3d dir = ff::cosine_direction(n, t, b, lattice.get(s, 0), lattice.get(s, 1));
     sum += gather_ray(origin, dir, hash_keys(stream, kGatherKey, s), rays);
   }
   return sum / N;

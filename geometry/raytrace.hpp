@@ -67,8 +67,8 @@ class ViewTracer {
                         std::uint64_t stream, std::int64_t& rays) const;
 
   /// Final-gather radiosity E + ρ (H_d + H_i) at x on the front of patch i (W/m²).
-  Eigen::Vector3d gathered_radiosity(const Eigen::Vector3d& x, std::int32_t i,
-                                     std::uint64_t stream, std::int64_t& rays) const;
+  Eigen::Vector3d gathered_radiosity(const Eigen::Vector3d& x, std::int32_t i, std::uint64_t stream,
+                                     std::int64_t& rays) const;
 
   /// The N-ray estimate H_i of the indirect irradiance at x on the front of patch i (W/m²).
   Eigen::Vector3d indirect_irradiance(const Eigen::Vector3d& x, std::int32_t i,

@@ -71,8 +71,9 @@ Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
   LAMBERT_CHECK(patch_B.rows() == mesh.size(), "render: radiosity size does not match the mesh");
   const bool flat = options.shading == Shading::Flat;
   const bool gathers = options.shading == Shading::Raytrace && options.view.final_gather > 0;
-  LAMBERT_CHECK(flat || gathers || (vertices.patch_corners.size() == mesh.patches.size() &&
-                                    vertices.values.rows() == vertices.size()),
+  LAMBERT_CHECK(flat || gathers ||
+                    (vertices.patch_corners.size() == mesh.patches.size() &&
+                     vertices.values.rows() == vertices.size()),
                 "render: vertex field does not match the mesh");
   std::unique_ptr<ViewTracer> tracer;
   if (options.shading == Shading::Raytrace)
@@ -110,9 +111,9 @@ Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
             const double py = static_cast<double>(y) + (sy + jy) / K;
             const std::uint64_t stream =
                 hash_keys(options.seed ^ 0x76696577ull, pixel, sy * K + sx);  // "view"
-            const Sample s = trace(mesh, bvh, camera.eye, camera.ray_direction(px, py), patch_B,
-                                   vertices, options.shading, wire_angle, tracer.get(), stream,
-                                   row_rays[y]);
+            const Sample s =
+                trace(mesh, bvh, camera.eye, camera.ray_direction(px, py), patch_B, vertices,
+                      options.shading, wire_angle, tracer.get(), stream, row_rays[y]);
             sum += s.value;
             hits += s.hit ? 1 : 0;
           }

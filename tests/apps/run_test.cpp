@@ -52,7 +52,6 @@ std::string solve_tiny_scene(const lambert::testing::TempDir& dir) {
   return scene;
 }
 
-
 }  // namespace
 
 TEST(RunCommand, TinySceneProducesEveryFile) {
@@ -175,8 +174,9 @@ TEST(RenderCommand, RaytraceAndFinalGatherWriteOutputsAndRecordTheirSettings) {
   lambert::testing::TempDir dir;
   const std::string scene = solve_tiny_scene(dir);
   ::testing::internal::CaptureStdout();
-  const std::vector<std::string> common = {"render", scene, "--patches", "60", "--radiosity",
-                                           dir.file("B.csv"), "--size", "24x18", "-q"};
+  const std::vector<std::string> common = {"render", scene,         "--patches",
+                                           "60",     "--radiosity", dir.file("B.csv"),
+                                           "--size", "24x18",       "-q"};
   const auto render_with = [&](const std::string& name, std::vector<std::string> extra) {
     std::vector<std::string> args = common;
     args.insert(args.end(), {"-o", dir.file(name + ".exr")});
@@ -193,14 +193,16 @@ TEST(RenderCommand, RaytraceAndFinalGatherWriteOutputsAndRecordTheirSettings) {
   EXPECT_NE(info.settings.find("shading=gouraud"), std::string::npos) << info.settings;
   const Image traced = read_image_exr(dir.file("traced.exr"), &info);
   EXPECT_NE(info.settings.find("shading=raytrace specular_depth=3 final_gather=0"),
-            std::string::npos) << info.settings;
+            std::string::npos)
+      << info.settings;
   // A diffuse scene: the view pass reads the same field (float rounding, 2^-23 relative).
   ASSERT_EQ(traced.rgb.size(), gouraud.rgb.size());
   for (size_t k = 0; k < traced.rgb.size(); ++k)
     EXPECT_NEAR(traced.rgb[k], gouraud.rgb[k], 1.2e-7 * std::abs(gouraud.rgb[k]));
   const Image gathered = read_image_exr(dir.file("gathered.exr"), &info);
   EXPECT_NE(info.settings.find("shading=raytrace specular_depth=8 final_gather=4"),
-            std::string::npos) << info.settings;
+            std::string::npos)
+      << info.settings;
   EXPECT_EQ(gathered.alpha, gouraud.alpha);
   read_image_exr(dir.file("flat.exr"), &info);
   EXPECT_NE(info.settings.find("shading=flat"), std::string::npos) << info.settings;
@@ -213,9 +215,8 @@ TEST(RunCommand, ReportRecordsTheViewPass) {
   write_tiny_scene(dir);
   const std::string out = dir.file("results");
   ::testing::internal::CaptureStdout();
-  const int code = run({"run", dir.file("tiny.obj"), "-o", out, "--patches", "60", "--samples",
-                        "4", "--size", "16x12", "--final-gather", "2", "--specular-depth", "5",
-                        "-q"});
+  const int code = run({"run", dir.file("tiny.obj"), "-o", out, "--patches", "60", "--samples", "4",
+                        "--size", "16x12", "--final-gather", "2", "--specular-depth", "5", "-q"});
   ::testing::internal::GetCapturedStdout();
   ASSERT_EQ(code, kExitOk);
   const nlohmann::json report = nlohmann::json::parse(slurp(out + "/report.json"));

@@ -33,8 +33,8 @@ Material mirror(const Eigen::Vector3d& rho_s) {
 }
 
 // An axis-aligned rectangle in the plane z = `z`, facing +z (`up`) or -z.
-void add_rect(Scene& s, const std::string& name, const Material& m, double x0, double x1,
-              double y0, double y1, double z, bool up) {
+void add_rect(Scene& s, const std::string& name, const Material& m, double x0, double x1, double y0,
+              double y1, double z, bool up) {
   std::vector<Eigen::Vector3d> c = {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}};
   if (!up) std::swap(c[1], c[3]);
   add_polygon(s, name, m, c);
@@ -185,11 +185,12 @@ TEST(ViewPass, MirrorShowsItsOwnRadiancePlusTheMirroredCameraViewTimesRhoS) {
   for (std::int32_t i = bare.size(); i < mesh.size(); ++i) B.row(i) = B_m.transpose();
   const Eigen::MatrixX3d B_bare = B.topRows(bare.size());
   const VertexField field = interpolate_to_vertices(mesh, B, VertexInterpolation::AreaWeighted);
-  const VertexField field_bare = interpolate_to_vertices(bare, B_bare, VertexInterpolation::AreaWeighted);
+  const VertexField field_bare =
+      interpolate_to_vertices(bare, B_bare, VertexInterpolation::AreaWeighted);
   const Bvh bvh(mesh), bvh_bare(bare);
   const int W = 32, H = 24;
-  const Image seen = render(mesh, bvh, camera({0.3, -0.2, 1}, {0.5, 0.1, 0}, 40, W, H), B, field,
-                            raytraced(8));
+  const Image seen =
+      render(mesh, bvh, camera({0.3, -0.2, 1}, {0.5, 0.1, 0}, 40, W, H), B, field, raytraced(8));
   RenderSettings gouraud;
   gouraud.antialias = 1;
   gouraud.progress = false;
@@ -231,7 +232,8 @@ TEST(FinalGather, DirectLightWithNothingBlockingIsTheExactFactorTimesE) {
   const auto corner = [](double a, double b) {
     const double A2 = 1 + a * a, B2 = 1 + b * b;
     return (a / std::sqrt(A2) * std::atan(b / std::sqrt(A2)) +
-            b / std::sqrt(B2) * std::atan(a / std::sqrt(B2))) / (2 * M_PI);
+            b / std::sqrt(B2) * std::atan(a / std::sqrt(B2))) /
+           (2 * M_PI);
   };
   std::int64_t rays = 0;
   // Under the corner (0, 0); and under (0.5, 0.25), splitting the light into four rectangles.
