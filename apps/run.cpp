@@ -159,8 +159,9 @@ void print_summary(const RunOptions& opts, const MethodOutcome& m, const Tail& t
         "vertices   power error per surface (max) %.2e with %s interpolation "
         "(area-weighted alone: %.2e)\n",
         after, t.shaded.interpolation.c_str(), before);
-  std::printf("image      %dx%d, %d samples/pixel, exposure %+.2f EV\n", t.camera.width,
-              t.camera.height, opts.shade.antialias * opts.shade.antialias, t.ev);
+  std::printf("image      %dx%d, %d samples/pixel, %s, exposure %+.2f EV\n", t.camera.width,
+              t.camera.height, opts.shade.antialias * opts.shade.antialias,
+              shading_settings(opts.shade, opts.ff.specular_depth).c_str(), t.ev);
   std::string times;
   for (size_t k = 0; k < m.seconds.size(); ++k)
     times += m.time_labels[k] + " " + format_duration(m.seconds[k].second) + ", ";
