@@ -33,9 +33,10 @@ std::string render_settings(const RenderOptions& o, const std::string& method_pa
                             const std::string& interp, const Camera& cam) {
   std::ostringstream ss;
   ss << method_part;
-  ss << " interp=" << interp << " shading=" << (o.shade.flat ? "flat" : "gouraud")
-     << (o.shade.wireframe ? " wireframe=1" : "") << " antialias=" << o.shade.antialias << " render_seed=" << o.run.seed << " size=" << cam.width
-     << "x" << cam.height << " eye=" << cam.eye.x() << "," << cam.eye.y() << "," << cam.eye.z()
+  ss << " interp=" << interp << ' ' << shading_settings(o.shade, o.ff.specular_depth)
+     << (o.shade.wireframe ? " wireframe=1" : "") << " antialias=" << o.shade.antialias
+     << " render_seed=" << o.run.seed << " size=" << cam.width << "x" << cam.height
+     << " eye=" << cam.eye.x() << "," << cam.eye.y() << "," << cam.eye.z()
      << " look_at=" << cam.look_at.x() << "," << cam.look_at.y() << "," << cam.look_at.z()
      << " vfov=" << cam.vfov_degrees;
   return ss.str();
@@ -52,7 +53,8 @@ void render_and_write(const RenderOptions& opts, const LoadedScene& loaded,
                       const Camera& camera, const std::string& method_settings) {
   const ShadedField shaded = shade_vertices(loaded, B, indirect, opts.shade, opts.run.threads);
   RenderStats stats;
-  const Image image = render_scene(loaded, B, shaded.field, camera, opts.shade, opts.run, &stats);
+  const Image image = render_scene(loaded, B, shaded.field, camera, opts.shade,
+                                   opts.ff.specular_depth, opts.run, &stats);
   const double ev = choose_exposure(opts.shade, image);
   OutputPaths paths;
   paths.image_exr = opts.output;
@@ -145,6 +147,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opts) {
 }
 
 int run_render(const RenderOptions& opts) {
+  resolve_shading(opts.shade);  // contradicting shading options: usage error before any work
   static const MethodTable<RenderOptions> kMethods = {{"matrix", render_matrix},
                                                       {"hierarchical", render_hierarchical}};
   return run_for_method(kMethods, opts);

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "apps/problem.hpp"
 #include "apps/solve_args.hpp"
@@ -64,7 +65,16 @@ Camera make_camera(const Scene& scene, const CameraArgs& args) {
 }
 
 void add_shade_options(CLI::App* cmd, ShadeArgs& args) {
-  cmd->add_flag("--flat", args.flat, "Per-patch (flat) shading instead of Gouraud");
+  cmd->add_option("--shading", args.shading,
+                  "gouraud (B/pi interpolated from the vertices), flat (per patch) or raytrace "
+                  "(camera rays followed through mirrors and glass up to --specular-depth "
+                  "bounces, Gouraud or --final-gather at diffuse hits); default gouraud")
+      ->check(CLI::IsMember({"gouraud", "flat", "raytrace"}));
+  cmd->add_flag("--flat", args.flat, "Per-patch (flat) shading: the same as --shading flat");
+  cmd->add_option("--final-gather", args.final_gather,
+                  "N: at diffuse hits, exact direct light plus N cosine rays reading the "
+                  "solution's indirect light (implies --shading raytrace)")
+      ->check(CLI::Range(1, 65536));
   cmd->add_flag("--wireframe", args.wireframe,
                 "Draw the patch edges (black, about one pixel wide) over the shading");
   cmd->add_option("--antialias", args.antialias, "K: K x K stratified samples per pixel")
@@ -88,6 +98,45 @@ void add_shade_options(CLI::App* cmd, ShadeArgs& args) {
                   "(exact-direct on a --discontinuity mesh, else conservative)")
       ->check(CLI::IsMember({"auto", "conservative", "area", "exact-direct"}))
       ->capture_default_str();
+}
+
+Shading resolve_shading(const ShadeArgs& args) {
+  if (args.flat && !args.shading.empty() && args.shading != "flat")
+    throw UsageError("--flat contradicts --shading " + args.shading);
+  if (args.final_gather > 0 && (args.flat || (!args.shading.empty() && args.shading != "raytrace")))
+    throw UsageError("--final-gather needs --shading raytrace (got " +
+                     (args.flat ? std::string("--flat") : "--shading " + args.shading) + ")");
+  if (args.shading == "raytrace" || args.final_gather > 0) return Shading::Raytrace;
+  if (args.shading == "flat" || args.flat) return Shading::Flat;
+  return Shading::Gouraud;
+}
+
+const char* shading_name(Shading shading) {
+  switch (shading) {
+    case Shading::Flat:
+      return "flat";
+    case Shading::Raytrace:
+      return "raytrace";
+    case Shading::Gouraud:
+      break;
+  }
+  return "gouraud";
+}
+
+std::string shading_settings(const ShadeArgs& args, int specular_depth) {
+  const Shading shading = resolve_shading(args);
+  std::string s = std::string("shading=") + shading_name(shading);
+  if (shading == Shading::Raytrace)
+    s += " specular_depth=" + std::to_string(specular_depth) +
+         " final_gather=" + std::to_string(args.final_gather);
+  return s;
+}
+
+Json shading_json(const ShadeArgs& args, int specular_depth) {
+  const Shading shading = resolve_shading(args);
+  return {{"shading", shading_name(shading)},
+          {"final_gather", args.final_gather},
+          {"specular_depth", shading == Shading::Raytrace ? Json(specular_depth) : Json()}};
 }
 
 void check_vertex_interp(const ShadeArgs& args, bool has_form_factors, const std::string& why) {
@@ -161,23 +210,27 @@ ShadedField shade_vertices(const LoadedScene& scene, const Eigen::MatrixX3d& B,
 }
 
 Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const VertexField& field,
-                   const Camera& camera, const ShadeArgs& args, const RunArgs& run,
-                   RenderStats* stats) {
+                   const Camera& camera, const ShadeArgs& args, int specular_depth,
+                   const RunArgs& run, RenderStats* stats) {
   const Timer timer;
   const PatchMesh& mesh = scene.mesh;
   const Bvh& bvh = scene_bvh(scene, run.threads);
   RenderSettings settings;
-  settings.flat = args.flat;
+  settings.shading = resolve_shading(args);
+  settings.view.specular_depth = specular_depth;
+  settings.view.final_gather = args.final_gather;
   settings.wireframe = args.wireframe;
   settings.antialias = args.antialias;
   settings.seed = run.seed;
   settings.threads = run.threads;
   settings.progress = !run.quiet;
-  Image img = render(mesh, bvh, camera, B, field, settings, stats);
+  std::unique_ptr<DirectLight> direct;
+  if (args.final_gather > 0) direct = std::make_unique<DirectLight>(scene.scene);
+  Image img = render(mesh, bvh, camera, B, field, settings, stats, direct.get());
   if (stats) stats->seconds = timer.seconds();  // including the BVH build when not yet built
   log_info("render: " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + ", " +
            std::to_string(args.antialias * args.antialias) + " samples/pixel, " +
-           (args.flat ? "flat" : "Gouraud") + " shading in " + format_duration(timer.seconds()));
+           shading_settings(args, specular_depth) + " in " + format_duration(timer.seconds()));
   return img;
 }
 

@@ -13,6 +13,7 @@
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/render.hpp"
 #include "geometry/vertex_field.hpp"
+#include "io/json.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
@@ -29,9 +30,11 @@ void add_camera_options(CLI::App* cmd, CameraArgs& args);
 /// Throws UsageError for a malformed --size or a degenerate view.
 Camera make_camera(const Scene& scene, const CameraArgs& args);
 
-/// --flat, --wireframe, --antialias, --exposure, --vertex-interp.
+/// --shading, --flat, --final-gather, --wireframe, --antialias, --exposure, --vertex-interp.
 struct ShadeArgs {
-  bool flat = false;
+  std::string shading;     ///< gouraud, flat or raytrace; empty = from --flat / --final-gather
+  bool flat = false;       ///< --flat: alias of --shading flat
+  int final_gather = 0;    ///< --final-gather N: gather rays per diffuse hit (implies raytrace)
   bool wireframe = false;  ///< --wireframe: patch edges drawn over the shading
   int antialias = 2;
   std::string exposure = "auto";  ///< "auto" or EV stops
@@ -41,6 +44,17 @@ struct ShadeArgs {
 };
 /// Adds the shading options to a subcommand.
 void add_shade_options(CLI::App* cmd, ShadeArgs& args);
+/// The shading the options ask for: --shading, else flat with --flat, raytrace with
+/// --final-gather, else Gouraud. Throws UsageError when they contradict each other.
+Shading resolve_shading(const ShadeArgs& args);
+/// "gouraud", "flat" or "raytrace".
+const char* shading_name(Shading shading);
+/// The shading part of a settings line: "shading=S" and, raytraced, " specular_depth=D" and
+/// " final_gather=N" (0 = off).
+std::string shading_settings(const ShadeArgs& args, int specular_depth);
+/// The same for a report: {shading, final_gather (0 = off), specular_depth (null unless
+/// raytraced)}.
+Json shading_json(const ShadeArgs& args, int specular_depth);
 /// Refuses --vertex-interp exact-direct before any work when B will not come with its F
 /// (`has_form_factors` false: --radiosity, --method hierarchical). Throws UsageError.
 void check_vertex_interp(const ShadeArgs& args, bool has_form_factors, const std::string& why);
@@ -87,10 +101,11 @@ std::string resolve_vertex_interp(const ShadeArgs& args, const LoadedScene& scen
 ShadedField shade_vertices(const LoadedScene& scene, const Eigen::MatrixX3d& B,
                            const Eigen::MatrixX3d* indirect, const ShadeArgs& args, int threads);
 
-/// Renders the scene through `camera` (with the run's shared BVH, scene_bvh).
+/// Renders the scene through `camera` (with the run's shared BVH, scene_bvh); raytraced
+/// paths follow at most `specular_depth` specular bounces (--specular-depth).
 Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const VertexField& field,
-                   const Camera& camera, const ShadeArgs& args, const RunArgs& run,
-                   RenderStats* stats);
+                   const Camera& camera, const ShadeArgs& args, int specular_depth,
+                   const RunArgs& run, RenderStats* stats);
 
 /// The exposure (EV) to use: --exposure, or automatic from the image.
 double choose_exposure(const ShadeArgs& args, const Image& image);

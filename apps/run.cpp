@@ -69,9 +69,9 @@ std::vector<double> as_vector(const Eigen::Vector3d& v) { return {v[0], v[1], v[
 
 std::string shade_settings(const RunOptions& o, const std::string& interp, const Camera& cam) {
   std::ostringstream ss;
-  ss << " interp=" << interp << " shading=" << (o.shade.flat ? "flat" : "gouraud")
-     << (o.shade.wireframe ? " wireframe=1" : "") << " antialias=" << o.shade.antialias << " render_seed=" << o.run.seed << " size=" << cam.width
-     << "x" << cam.height;
+  ss << " interp=" << interp << ' ' << shading_settings(o.shade, o.ff.specular_depth)
+     << (o.shade.wireframe ? " wireframe=1" : "") << " antialias=" << o.shade.antialias
+     << " render_seed=" << o.run.seed << " size=" << cam.width << "x" << cam.height;
   return ss.str();
 }
 
@@ -127,9 +127,10 @@ Json report_json(const RunOptions& opts, const MethodOutcome& m, const Tail& t) 
   j["render"] = {{"width", t.camera.width},
                  {"height", t.camera.height},
                  {"samples_per_pixel", opts.shade.antialias * opts.shade.antialias},
-                 {"shading", opts.shade.flat ? "flat" : "gouraud"},
                  {"rays", t.render.rays},
                  {"exposure_ev", t.ev}};
+  const Json shading = shading_json(opts.shade, opts.ff.specular_depth);
+  for (const auto& [key, value] : shading.items()) j["render"][key] = value;
   Json& seconds = j["seconds"] = Json::object();
   for (const auto& [key, s] : m.seconds) seconds[key] = s;
   seconds["vertices"] = t.shaded.seconds;
@@ -158,8 +159,9 @@ void print_summary(const RunOptions& opts, const MethodOutcome& m, const Tail& t
         "vertices   power error per surface (max) %.2e with %s interpolation "
         "(area-weighted alone: %.2e)\n",
         after, t.shaded.interpolation.c_str(), before);
-  std::printf("image      %dx%d, %d samples/pixel, exposure %+.2f EV\n", t.camera.width,
-              t.camera.height, opts.shade.antialias * opts.shade.antialias, t.ev);
+  std::printf("image      %dx%d, %d samples/pixel, %s, exposure %+.2f EV\n", t.camera.width,
+              t.camera.height, opts.shade.antialias * opts.shade.antialias,
+              shading_settings(opts.shade, opts.ff.specular_depth).c_str(), t.ev);
   std::string times;
   for (size_t k = 0; k < m.seconds.size(); ++k)
     times += m.time_labels[k] + " " + format_duration(m.seconds[k].second) + ", ";
@@ -179,7 +181,8 @@ int finish_run(const RunOptions& opts, const RunPaths& paths, const MethodOutcom
 
   stages.next("rendering " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
   RenderStats rs;
-  const Image image = render_scene(m.loaded, m.B, shaded.field, camera, opts.shade, opts.run, &rs);
+  const Image image = render_scene(m.loaded, m.B, shaded.field, camera, opts.shade,
+                                   opts.ff.specular_depth, opts.run, &rs);
   const double ev = choose_exposure(opts.shade, image);
 
   stages.next("writing " + opts.output_dir + "/" + paths.name + ".*");
@@ -439,6 +442,7 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& opts) {
 }
 
 int run_run(const RunOptions& opts) {
+  resolve_shading(opts.shade);  // contradicting shading options: usage error before any work
   static const MethodTable<RunOptions> kMethods = {{"matrix", run_matrix},
                                                    {"hierarchical", run_hierarchical}};
   return run_for_method(kMethods, opts);

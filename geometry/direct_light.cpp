@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
@@ -61,39 +62,62 @@ bool scene_has_emitters(const Scene& scene) {
   return false;
 }
 
+struct DirectLight::Faces {
+  std::vector<FaceGeometry> faces;
+  std::vector<size_t> emitters;  // emitting, non-degenerate faces
+};
+
+DirectLight::DirectLight(const Scene& scene) : scene_(scene) {
+  auto f = std::make_shared<Faces>();
+  f->faces = face_geometry(scene);
+  for (size_t k = 0; k < scene.faces.size(); ++k)
+    if (scene.material_of(scene.faces[k].surface).emits() && !f->faces[k].degenerate)
+      f->emitters.push_back(k);
+  faces_ = std::move(f);
+}
+
+bool DirectLight::empty() const { return faces_->emitters.empty(); }
+
+Eigen::Vector3d DirectLight::irradiance(const Eigen::Vector3d& x, const Eigen::Vector3d& normal,
+                                        std::vector<Polygon3>& blockers) const {
+  Eigen::Vector3d H = Eigen::Vector3d::Zero();
+  const std::vector<FaceGeometry>& faces = faces_->faces;
+  for (size_t e : faces_->emitters) {
+    const FaceGeometry& src = faces[e];
+    if (!(src.normal.dot(x) - src.offset > src.slack)) continue;  // behind or in its plane
+    const Eigen::Vector3d lo = src.lo.cwiseMin(x), hi = src.hi.cwiseMax(x);
+    blockers.clear();
+    for (size_t k = 0; k < faces.size(); ++k) {
+      const FaceGeometry& b = faces[k];
+      if (k == e || b.degenerate || !boxes_meet(lo, hi, b.lo, b.hi)) continue;
+      if (std::abs(b.normal.dot(x) - b.offset) <= b.slack) continue;  // x on its plane
+      blockers.push_back(b.corners);
+    }
+    const double F = shadowed_point_factor(x, normal, src.corners, blockers);
+    H += F * scene_.material_of(scene_.faces[e].surface).emission;
+  }
+  return H;
+}
+
+Eigen::Vector3d DirectLight::irradiance(const Eigen::Vector3d& x,
+                                        const Eigen::Vector3d& normal) const {
+  std::vector<Polygon3> blockers;
+  return irradiance(x, normal, blockers);
+}
+
 Eigen::MatrixX3d exact_direct_irradiance(const Scene& scene,
                                          const std::vector<Eigen::Vector3d>& points,
                                          const std::vector<Eigen::Vector3d>& normals,
                                          int threads) {
   Eigen::MatrixX3d H = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(points.size()), 3);
   LAMBERT_CHECK(points.size() == normals.size(), "exact_direct_irradiance: one normal per point");
-  const std::vector<FaceGeometry> faces = face_geometry(scene);
-  std::vector<size_t> emitters;
-  for (size_t k = 0; k < scene.faces.size(); ++k)
-    if (scene.material_of(scene.faces[k].surface).emits() && !faces[k].degenerate)
-      emitters.push_back(k);
-  if (emitters.empty()) return H;
-
+  const DirectLight light(scene);
+  if (light.empty()) return H;
   parallel_for(static_cast<std::int64_t>(points.size()), 16, threads,
                [&](std::int64_t begin, std::int64_t end) {
     std::vector<Polygon3> blockers;
-    for (std::int64_t i = begin; i < end; ++i) {
-      const Eigen::Vector3d& x = points[i];
-      for (size_t e : emitters) {
-        const FaceGeometry& src = faces[e];
-        if (!(src.normal.dot(x) - src.offset > src.slack)) continue;  // behind or in its plane
-        const Eigen::Vector3d lo = src.lo.cwiseMin(x), hi = src.hi.cwiseMax(x);
-        blockers.clear();
-        for (size_t k = 0; k < faces.size(); ++k) {
-          const FaceGeometry& b = faces[k];
-          if (k == e || b.degenerate || !boxes_meet(lo, hi, b.lo, b.hi)) continue;
-          if (std::abs(b.normal.dot(x) - b.offset) <= b.slack) continue;  // x on its plane
-          blockers.push_back(b.corners);
-        }
-        const double F = shadowed_point_factor(x, normals[i], src.corners, blockers);
-        H.row(i) += F * scene.material_of(scene.faces[e].surface).emission.transpose();
-      }
-    }
+    for (std::int64_t i = begin; i < end; ++i)
+      H.row(i) = light.irradiance(points[i], normals[i], blockers).transpose();
   });
   return H;
 }

@@ -24,11 +24,34 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "geometry/polygon.hpp"
 #include "geometry/scene.hpp"
 
 namespace lambert {
+
+/// The exact direct irradiance H_d of one point at a time (the kernel of
+/// exact_direct_irradiance), with the scene's faces prepared once. Keeps a reference to the
+/// scene, which must outlive it. Queries are const and thread-safe.
+class DirectLight {
+ public:
+  /// Prepares the faces (bounds, planes) and the list of emitting faces: O(faces).
+  explicit DirectLight(const Scene& scene);
+  /// True when nothing emits (H_d = 0 everywhere).
+  bool empty() const;
+  /// H_d (RGB, W/m²) at x (on its surface's plane) with unit front normal `normal`.
+  Eigen::Vector3d irradiance(const Eigen::Vector3d& x, const Eigen::Vector3d& normal) const;
+  /// The same with a caller-owned scratch list of blockers (no allocation once it is large).
+  Eigen::Vector3d irradiance(const Eigen::Vector3d& x, const Eigen::Vector3d& normal,
+                             std::vector<Polygon3>& blockers) const;
+
+ private:
+  struct Faces;
+  const Scene& scene_;
+  std::shared_ptr<const Faces> faces_;
+};
 
 /// Exact direct irradiance H_d (rows: per point; columns R, G, B) at `points` with unit
 /// front normals `normals`, from every emitting face of `scene`. 0 where nothing emits.

@@ -13,41 +13,51 @@
 namespace lambert {
 namespace {
 
-// Radiosity B (W/m^2) carried along a camera ray, or nullopt-like `hit = false`.
+// What a camera ray brings back: radiosity B (W/m^2, Gouraud and flat) or radiance L
+// (raytrace), and whether it hit anything.
 struct Sample {
-  Eigen::Vector3d B = Eigen::Vector3d::Zero();
+  Eigen::Vector3d value = Eigen::Vector3d::Zero();
   bool hit = false;
 };
 
+// True when the hit lies within half a pixel footprint of its patch's boundary.
+bool on_wire(const PatchMesh& mesh, const Patch& p, const Eigen::Vector3d& eye,
+             const Eigen::Vector3d& dir, double t, double wire_angle) {
+  const Eigen::Vector3d x = eye + t * dir;
+  const double cosine = std::max(0.25, -p.normal.dot(dir.normalized()));
+  const double width = 0.5 * wire_angle * t * dir.norm() / cosine;
+  for (int k = 0; k < p.vertex_count; ++k) {
+    const Eigen::Vector3d& a = mesh.vertices[p.vertices[k]];
+    const Eigen::Vector3d& b = mesh.vertices[p.vertices[(k + 1) % p.vertex_count]];
+    const double s = std::clamp((x - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+    if ((a + s * (b - a) - x).norm() < width) return true;
+  }
+  return false;
+}
+
 Sample trace(const PatchMesh& mesh, const Bvh& bvh, const Eigen::Vector3d& eye,
              const Eigen::Vector3d& dir, const Eigen::MatrixX3d& patch_B,
-             const VertexField& vertices, bool flat, double wire_angle) {
+             const VertexField& vertices, Shading shading, double wire_angle,
+             const ViewTracer* tracer, std::uint64_t stream, std::int64_t& rays) {
   Sample s;
+  ++rays;
   const RayHit h = bvh.intersect(eye.cast<float>(), dir.cast<float>());
   if (h.patch < 0) return s;
   s.hit = true;
   const Patch& p = mesh.patches[h.patch];
-  if (p.normal.dot(dir) >= 0) return s;  // back face: no radiosity leaves it
-  if (wire_angle > 0) {
-    // Distance from the hit to the patch's boundary against the pixel's footprint there.
-    const Eigen::Vector3d x = eye + h.t * dir;
-    const double cosine = std::max(0.25, -p.normal.dot(dir.normalized()));
-    const double width = 0.5 * wire_angle * h.t * dir.norm() / cosine;
-    for (int k = 0; k < p.vertex_count; ++k) {
-      const Eigen::Vector3d& a = mesh.vertices[p.vertices[k]];
-      const Eigen::Vector3d& b = mesh.vertices[p.vertices[(k + 1) % p.vertex_count]];
-      const double t = std::clamp((x - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
-      if ((a + t * (b - a) - x).norm() < width) return s;  // on an edge: black
-    }
-  }
-  if (flat) {
-    s.B = patch_B.row(h.patch).transpose();
+  const bool front = p.normal.dot(dir) < 0;
+  if (wire_angle > 0 && (front || tracer) && on_wire(mesh, p, eye, dir, h.t, wire_angle))
+    return s;  // on an edge: black
+  if (tracer) {
+    s.value = tracer->radiance(eye, dir, h, stream, rays);
     return s;
   }
-  const Eigen::Vector3d x = eye + h.t * dir;
-  const auto w = patch_weights(mesh, h.patch, x);
-  const auto& c = vertices.patch_corners[h.patch];
-  for (int k = 0; k < p.vertex_count; ++k) s.B += w[k] * vertices.values.row(c[k]).transpose();
+  if (!front) return s;  // back face: no radiosity leaves it
+  if (shading == Shading::Flat) {
+    s.value = patch_B.row(h.patch).transpose();
+    return s;
+  }
+  s.value = field_value(mesh, vertices, h.patch, eye + h.t * dir);
   return s;
 }
 
@@ -55,13 +65,19 @@ Sample trace(const PatchMesh& mesh, const Bvh& bvh, const Eigen::Vector3d& eye,
 
 Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
              const Eigen::MatrixX3d& patch_B, const VertexField& vertices,
-             const RenderSettings& options, RenderStats* stats) {
+             const RenderSettings& options, RenderStats* stats, const DirectLight* direct) {
   LAMBERT_CHECK(camera.width > 0 && camera.height > 0, "render: empty image");
   LAMBERT_CHECK(options.antialias >= 1, "render: antialias must be >= 1");
   LAMBERT_CHECK(patch_B.rows() == mesh.size(), "render: radiosity size does not match the mesh");
-  LAMBERT_CHECK(options.flat || (vertices.patch_corners.size() == mesh.patches.size() &&
-                                 vertices.values.rows() == vertices.size()),
+  const bool flat = options.shading == Shading::Flat;
+  const bool gathers = options.shading == Shading::Raytrace && options.view.final_gather > 0;
+  LAMBERT_CHECK(flat || gathers ||
+                    (vertices.patch_corners.size() == mesh.patches.size() &&
+                     vertices.values.rows() == vertices.size()),
                 "render: vertex field does not match the mesh");
+  std::unique_ptr<ViewTracer> tracer;
+  if (options.shading == Shading::Raytrace)
+    tracer = std::make_unique<ViewTracer>(mesh, bvh, patch_B, vertices, options.view, direct);
   const Timer timer;
   Image img;
   img.width = camera.width;
@@ -72,8 +88,10 @@ Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
   // The angle one pixel subtends (radians), 0 without a wireframe.
   const double wire_angle =
       options.wireframe ? 2.0 * std::tan(camera.vfov_degrees * M_PI / 360.0) / camera.height : 0.0;
-  const double inv_pi = 1.0 / M_PI;
   const double inv_samples = 1.0 / (K * K);
+  // Gouraud and flat samples carry B, raytraced ones L: pixel = mean of B/π, or of L.
+  const double to_radiance = tracer ? inv_samples : inv_samples * (1.0 / M_PI);
+  std::vector<std::int64_t> row_rays(static_cast<size_t>(img.height), 0);
   std::unique_ptr<Progress> progress;
   if (options.progress) progress = std::make_unique<Progress>("render", img.height, "rays");
 
@@ -91,23 +109,27 @@ Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
             const double jy = K == 1 ? 0.5 : rng.uniform();
             const double px = x + (sx + jx) / K;
             const double py = static_cast<double>(y) + (sy + jy) / K;
-            const Sample s = trace(mesh, bvh, camera.eye, camera.ray_direction(px, py), patch_B,
-                                   vertices, options.flat, wire_angle);
-            sum += s.B;
+            const std::uint64_t stream =
+                hash_keys(options.seed ^ 0x76696577ull, pixel, sy * K + sx);  // "view"
+            const Sample s =
+                trace(mesh, bvh, camera.eye, camera.ray_direction(px, py), patch_B, vertices,
+                      options.shading, wire_angle, tracer.get(), stream, row_rays[y]);
+            sum += s.value;
             hits += s.hit ? 1 : 0;
           }
         }
-        const Eigen::Vector3d L = sum * (inv_samples * inv_pi);
+        const Eigen::Vector3d L = sum * to_radiance;
         const size_t k = static_cast<size_t>(pixel);
         for (int c = 0; c < 3; ++c) img.rgb[3 * k + c] = static_cast<float>(L[c]);
         img.alpha[k] = static_cast<float>(hits * inv_samples);
       }
-      if (progress) progress->advance(1, static_cast<std::int64_t>(img.width) * K * K);
+      if (progress) progress->advance(1, row_rays[y]);
     }
   });
   if (progress) progress->finish();
   if (stats) {
-    stats->rays = static_cast<std::int64_t>(img.width) * img.height * K * K;
+    stats->rays = 0;
+    for (std::int64_t r : row_rays) stats->rays += r;
     stats->seconds = timer.seconds();
   }
   return img;

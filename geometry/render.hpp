@@ -10,6 +10,9 @@
 // hash of (seed, pixel, sample), so the image is a pure function of the inputs (deterministic
 // for any thread count). Pixel value = mean over samples; alpha = fraction of samples that hit.
 // Complexity O(width · height · K²) ray casts; rows are rendered in parallel.
+//
+// Raytrace shading hands each camera ray's hit to the view pass (raytrace.hpp): specular
+// bounces to --specular-depth, Gouraud radiance or a final gather at diffuse hits.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -17,7 +20,9 @@
 
 #include "geometry/bvh.hpp"
 #include "geometry/camera.hpp"
+#include "geometry/direct_light.hpp"
 #include "geometry/mesh.hpp"
+#include "geometry/raytrace.hpp"
 #include "geometry/vertex_field.hpp"
 
 namespace lambert {
@@ -36,9 +41,17 @@ struct Image {
   }
 };
 
+/// How a camera ray's hit is shaded.
+enum class Shading {
+  Gouraud,   ///< B/π interpolated from the vertex field
+  Flat,      ///< B/π of the patch
+  Raytrace,  ///< the view pass: specular bounces, Gouraud or final gather at diffuse hits
+};
+
 /// Render settings.
 struct RenderSettings {
-  bool flat = false;       ///< per-patch shading instead of Gouraud
+  Shading shading = Shading::Gouraud;
+  ViewPassSettings view;  ///< read with Shading::Raytrace
   /// Patch edges drawn black over the shading: a sample whose hit lies within 0.5 pixel
   /// footprints (the pixel's width at the hit's distance, divided by the cosine to the
   /// surface, at least 1/4) of its patch's boundary is black.
@@ -51,15 +64,17 @@ struct RenderSettings {
 
 /// What the render did.
 struct RenderStats {
-  std::int64_t rays = 0;
+  std::int64_t rays = 0;  ///< every ray cast (camera, specular, gather)
   double seconds = 0.0;
 };
 
 /// Renders the mesh as seen by `camera` (its width x height). `patch_B` is N x 3; `vertices`
-/// (with values) is used for Gouraud shading and ignored when options.flat.
+/// (with values) is used for Gouraud shading and ignored when flat. `direct` (the exact
+/// direct light of the mesh's scene) is needed with a final gather only.
 /// Thread-safe with respect to its inputs (all const).
 Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
              const Eigen::MatrixX3d& patch_B, const VertexField& vertices,
-             const RenderSettings& options, RenderStats* stats = nullptr);
+             const RenderSettings& options, RenderStats* stats = nullptr,
+             const DirectLight* direct = nullptr);
 
 }  // namespace lambert

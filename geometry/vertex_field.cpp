@@ -412,4 +412,14 @@ std::array<double, 4> patch_weights(const PatchMesh& mesh, std::int32_t i,
   return {(1 - u) * (1 - v), u * (1 - v), u * v, (1 - u) * v};
 }
 
+Eigen::Vector3d field_value(const PatchMesh& mesh, const VertexField& field, std::int32_t i,
+                            const Eigen::Vector3d& p) {
+  const auto w = patch_weights(mesh, i, p);
+  const auto& c = field.patch_corners[i];
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  for (int k = 0; k < mesh.patches[i].vertex_count; ++k)
+    v += w[k] * field.values.row(c[k]).transpose();
+  return v;
+}
+
 }  // namespace lambert

@@ -183,4 +183,8 @@ std::vector<SurfacePower> surface_power(const PatchMesh& mesh, const Eigen::Matr
 std::array<double, 4> patch_weights(const PatchMesh& mesh, std::int32_t i,
                                     const Eigen::Vector3d& p);
 
+/// The field's value (RGB) at point p of patch i: its corners' values with patch_weights.
+Eigen::Vector3d field_value(const PatchMesh& mesh, const VertexField& field, std::int32_t i,
+                            const Eigen::Vector3d& p);
+
 }  // namespace lambert

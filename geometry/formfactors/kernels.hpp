@@ -11,6 +11,24 @@
 
 namespace lambert::ff {
 
+/// An orthonormal frame (t, b, n) for unit n (Duff et al. 2017, branchless).
+inline void orthonormal_frame(const Eigen::Vector3d& n, Eigen::Vector3d& t, Eigen::Vector3d& b) {
+  const double sign = std::copysign(1.0, n.z());
+  const double a = -1.0 / (sign + n.z());
+  const double c = n.x() * n.y() * a;
+  t = Eigen::Vector3d(1.0 + sign * n.x() * n.x() * a, sign * c, -sign * n.x());
+  b = Eigen::Vector3d(c, sign + n.y() * n.y() * a, -n.y());
+}
+
+/// The cosine-distributed direction (density cos θ / π about n, frame (t, b, n)) of (u, v)
+/// in [0,1)²: radius √u, angle 2π v on the unit disk, lifted to the hemisphere.
+inline Eigen::Vector3d cosine_direction(const Eigen::Vector3d& n, const Eigen::Vector3d& t,
+                                        const Eigen::Vector3d& b, double u, double v) {
+  const double r = std::sqrt(u), phi = 2.0 * M_PI * v;
+  const double z = std::sqrt(std::max(0.0, 1.0 - u));
+  return r * std::cos(phi) * t + r * std::sin(phi) * b + z * n;
+}
+
 /// A patch's corners and frame, copied out of the mesh for cache-friendly pair loops.
 struct PatchGeom {
   std::array<Eigen::Vector3d, 4> p;
@@ -45,24 +63,6 @@ inline Eigen::Vector3d sample_patch(const PatchGeom& g, double u, double v, doub
   const Eigen::Vector3d dv = (1 - u) * (g.p[3] - g.p[0]) + u * (g.p[2] - g.p[1]);
   jacobian = du.cross(dv).norm();
   return (1 - u) * (1 - v) * g.p[0] + u * (1 - v) * g.p[1] + u * v * g.p[2] + (1 - u) * v * g.p[3];
-}
-
-/// An orthonormal frame (t, b, n) for unit n (Duff et al. 2017, branchless).
-inline void orthonormal_frame(const Eigen::Vector3d& n, Eigen::Vector3d& t, Eigen::Vector3d& b) {
-  const double sign = std::copysign(1.0, n.z());
-  const double a = -1.0 / (sign + n.z());
-  const double c = n.x() * n.y() * a;
-  t = Eigen::Vector3d(1.0 + sign * n.x() * n.x() * a, sign * c, -sign * n.x());
-  b = Eigen::Vector3d(c, sign + n.y() * n.y() * a, -n.y());
-}
-
-/// Malley's method: (u, v) in [0,1)^2 -> the uniform point (√u cos 2πv, √u sin 2πv) of the
-/// unit disk lifted to the hemisphere about n (frame t, b, n): density cosθ / π.
-inline Eigen::Vector3d cosine_direction(const Eigen::Vector3d& t, const Eigen::Vector3d& b,
-                                        const Eigen::Vector3d& n, double u, double v) {
-  const double r = std::sqrt(u), phi = 2.0 * M_PI * v;
-  const double z = std::sqrt(std::max(0.0, 1.0 - u));
-  return r * std::cos(phi) * t + r * std::sin(phi) * b + z * n;
 }
 
 /// Like sample_patch but smooth in (u, v), for quadrature: triangles use the collapsed

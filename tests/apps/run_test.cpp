@@ -40,6 +40,17 @@ void write_tiny_scene(const lambert::testing::TempDir& dir) {
             "g light\nusemtl light\nf 9 10 11 12\n");
 }
 
+// The tiny scene solved on 60 patches into dir/B.csv; returns the scene's path.
+std::string solve_tiny_scene(const lambert::testing::TempDir& dir) {
+  write_tiny_scene(dir);
+  const std::string scene = dir.file("tiny.obj");
+  ::testing::internal::CaptureStdout();
+  EXPECT_EQ(
+      run({"solve", scene, "--patches", "60", "--samples", "4", "-o", dir.file("B.csv"), "-q"}),
+      kExitOk);
+  ::testing::internal::GetCapturedStdout();
+  return scene;
+}
 
 }  // namespace
 
@@ -139,12 +150,8 @@ TEST(RunCommand, NamePrefixAndBuiltInCornellBox) {
 
 TEST(RenderCommand, RendersASolvedCsvAndRefusesOneForAnotherMesh) {
   lambert::testing::TempDir dir;
-  write_tiny_scene(dir);
-  const std::string scene = dir.file("tiny.obj");
+  const std::string scene = solve_tiny_scene(dir);
   ::testing::internal::CaptureStdout();
-  ASSERT_EQ(
-      run({"solve", scene, "--patches", "60", "--samples", "4", "-o", dir.file("B.csv"), "-q"}),
-      kExitOk);
   EXPECT_EQ(run({"render", scene, "--patches", "60", "--radiosity", dir.file("B.csv"), "-o",
                  dir.file("img.exr"), "--size", "24x24", "--vertex-exr", dir.file("v.exr"), "--ply",
                  dir.file("m.ply"), "-q"}),
@@ -161,6 +168,78 @@ TEST(RenderCommand, RendersASolvedCsvAndRefusesOneForAnotherMesh) {
   EXPECT_NE(err.find("B.csv"), std::string::npos) << err;
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
   EXPECT_FALSE(std::filesystem::exists(dir.file("bad.exr")));
+}
+
+TEST(RenderCommand, RaytraceAndFinalGatherWriteOutputsAndRecordTheirSettings) {
+  lambert::testing::TempDir dir;
+  const std::string scene = solve_tiny_scene(dir);
+  ::testing::internal::CaptureStdout();
+  const std::vector<std::string> common = {"render", scene,         "--patches",
+                                           "60",     "--radiosity", dir.file("B.csv"),
+                                           "--size", "24x18",       "-q"};
+  const auto render_with = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> args = common;
+    args.insert(args.end(), {"-o", dir.file(name + ".exr")});
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run(args);
+  };
+  EXPECT_EQ(render_with("gouraud", {}), kExitOk);
+  EXPECT_EQ(render_with("traced", {"--shading", "raytrace", "--specular-depth", "3"}), kExitOk);
+  EXPECT_EQ(render_with("gathered", {"--final-gather", "4"}), kExitOk);
+  EXPECT_EQ(render_with("flat", {"--flat"}), kExitOk);
+  ::testing::internal::GetCapturedStdout();
+  ExrInfo info;
+  const Image gouraud = read_image_exr(dir.file("gouraud.exr"), &info);
+  EXPECT_NE(info.settings.find("shading=gouraud"), std::string::npos) << info.settings;
+  const Image traced = read_image_exr(dir.file("traced.exr"), &info);
+  EXPECT_NE(info.settings.find("shading=raytrace specular_depth=3 final_gather=0"),
+            std::string::npos)
+      << info.settings;
+  // A diffuse scene: the view pass reads the same field (float rounding, 2^-23 relative).
+  ASSERT_EQ(traced.rgb.size(), gouraud.rgb.size());
+  for (size_t k = 0; k < traced.rgb.size(); ++k)
+    EXPECT_NEAR(traced.rgb[k], gouraud.rgb[k], 1.2e-7 * std::abs(gouraud.rgb[k]));
+  const Image gathered = read_image_exr(dir.file("gathered.exr"), &info);
+  EXPECT_NE(info.settings.find("shading=raytrace specular_depth=8 final_gather=4"),
+            std::string::npos)
+      << info.settings;
+  EXPECT_EQ(gathered.alpha, gouraud.alpha);
+  read_image_exr(dir.file("flat.exr"), &info);
+  EXPECT_NE(info.settings.find("shading=flat"), std::string::npos) << info.settings;
+  for (const char* f : {"traced.png", "gathered.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir.file(f))) << f;
+}
+
+TEST(RunCommand, ReportRecordsTheViewPass) {
+  lambert::testing::TempDir dir;
+  write_tiny_scene(dir);
+  const std::string out = dir.file("results");
+  ::testing::internal::CaptureStdout();
+  const int code = run({"run", dir.file("tiny.obj"), "-o", out, "--patches", "60", "--samples", "4",
+                        "--size", "16x12", "--final-gather", "2", "--specular-depth", "5", "-q"});
+  ::testing::internal::GetCapturedStdout();
+  ASSERT_EQ(code, kExitOk);
+  const nlohmann::json report = nlohmann::json::parse(slurp(out + "/report.json"));
+  const auto& r = report.at("render");
+  EXPECT_EQ(r.at("shading"), "raytrace");
+  EXPECT_EQ(r.at("final_gather").get<int>(), 2);
+  EXPECT_EQ(r.at("specular_depth").get<int>(), 5);
+  // At least the camera rays and two gather rays per diffuse camera hit.
+  EXPECT_GT(r.at("rays").get<std::int64_t>(), 16 * 12 * 4);
+  EXPECT_NE(report.at("settings").get<std::string>().find("final_gather=2"), std::string::npos);
+}
+
+TEST(RenderCommand, BadShadingOptionsAreUsageErrors) {
+  for (const char* cmd : {"render", "run"}) {
+    EXPECT_EQ(run({cmd, "--shading", "phong", "-q"}), kExitUsage);
+    EXPECT_EQ(run({cmd, "--final-gather", "0", "-q"}), kExitUsage);
+    EXPECT_EQ(run({cmd, "--final-gather", "-3", "-q"}), kExitUsage);
+    EXPECT_EQ(run({cmd, "--final-gather", "many", "-q"}), kExitUsage);
+    EXPECT_EQ(run({cmd, "--final-gather", "4", "--shading", "gouraud", "-q"}), kExitUsage);
+    EXPECT_EQ(run({cmd, "--final-gather", "4", "--flat", "-q"}), kExitUsage);
+    EXPECT_EQ(run({cmd, "--flat", "--shading", "raytrace", "-q"}), kExitUsage);
+    EXPECT_EQ(run({cmd, "--shading", "raytrace", "--specular-depth", "65", "-q"}), kExitUsage);
+  }
 }
 
 TEST(RenderCommand, BadOptionsAreUsageErrors) {

@@ -53,7 +53,7 @@ TEST(Render, UniformRadiosityGivesBOverPiInEveryPixelThatHits) {
   const VertexField field = interpolate_to_vertices(mesh, B);
   for (bool flat : {false, true}) {
     RenderSettings o;
-    o.flat = flat;
+    o.shading = flat ? Shading::Flat : Shading::Gouraud;
     o.antialias = 3;
     o.progress = false;
     RenderStats stats;
