@@ -36,8 +36,16 @@ int run_info(const InfoOptions& opts) {
   std::printf("\nmaterials (%zu):\n", scene.materials.size());
   std::printf("  %-16s %-26s %-26s\n", "name", "rho (R G B)", "E (R G B, W/m^2)");
   for (const auto& m : scene.materials) {
-    std::printf("  %-16s %8.4f %8.4f %8.4f  %8.4g %8.4g %8.4g\n", m.name.c_str(), m.rho[0],
+    std::printf("  %-16s %8.4f %8.4f %8.4f  %8.4g %8.4g %8.4g", m.name.c_str(), m.rho[0],
                 m.rho[1], m.rho[2], m.emission[0], m.emission[1], m.emission[2]);
+    const Specular& sp = m.specular;
+    if (sp.dielectric)
+      std::printf("  dielectric Ni %.4g Tf %.4g %.4g %.4g", sp.ior, sp.transmission[0],
+                  sp.transmission[1], sp.transmission[2]);
+    else if (sp.any())
+      std::printf("  mirror Ks %.4g %.4g %.4g", sp.reflectance[0], sp.reflectance[1],
+                  sp.reflectance[2]);
+    std::printf("\n");
   }
 
   std::vector<double> surface_area(scene.surfaces.size(), 0.0);
