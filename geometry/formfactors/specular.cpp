@@ -164,7 +164,8 @@ void check_grey_specular(const PatchMesh& mesh) {
 }
 
 SpecularTransport compute_specular_transport(const PatchMesh& mesh,
-                                             const FormFactorOptions& options, const Bvh& bvh) {
+                                             const FormFactorOptions& options, const Bvh& bvh,
+                                             bool average) {
   LAMBERT_CHECK(mesh.has_specular(), "specular transport on a diffuse mesh");
   if (options.specular_rays < 1) throw UsageError("--specular-rays must be at least 1");
   if (options.with_stderr && options.specular_rays < 4)
@@ -207,7 +208,7 @@ SpecularTransport compute_specular_transport(const PatchMesh& mesh,
     out.stderr_S.resize(n, n);
     out.stderr_S.setFromTriplets(errors.begin(), errors.end());
   }
-  average_sides(out.S, options.with_stderr ? &out.stderr_S : nullptr, area);
+  if (average) average_sides(out.S, options.with_stderr ? &out.stderr_S : nullptr, area);
   return out;
 }
 

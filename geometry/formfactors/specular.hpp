@@ -53,9 +53,12 @@ struct SpecularTransport {
 void check_grey_specular(const PatchMesh& mesh);
 
 /// The specular part of F for `mesh` (which has specular surfaces) with options.seed,
-/// specular_rays, specular_depth, threads, with_stderr and progress.
+/// specular_rays, specular_depth, threads, with_stderr and progress. `average` false keeps
+/// each row's own estimate S_ij (not reciprocal to rounding; for tests of the reversibility
+/// the averaging relies on).
 SpecularTransport compute_specular_transport(const PatchMesh& mesh,
-                                             const FormFactorOptions& options, const Bvh& bvh);
+                                             const FormFactorOptions& options, const Bvh& bvh,
+                                             bool average = true);
 
 /// Adds the specular part to a matrix estimate in place: F += S, standard errors combined
 /// as independent (sqrt of the sum of squares), `continued` and the rays recorded.

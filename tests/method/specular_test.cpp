@@ -12,6 +12,7 @@
 #include "apps/problem.hpp"
 #include "core/error.hpp"
 #include "geometry/analytic.hpp"
+#include "geometry/bvh.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
@@ -116,6 +117,41 @@ TEST(ExtendedFormFactors, AreReciprocalEntryByEntry) {
     }
   }
   EXPECT_GT(checked, 100);
+}
+
+// Reversibility, the physics the averaging relies on: through a glass slab (index 1.5,
+// Fresnel reflection at both faces, refraction, internal reflections) between two unequal
+// parallel plates, each side's own estimate A_a S_ab and A_b S_ba (rays from a only, from b
+// only) agree within 4 combined standard errors (independent streams), and carry most of
+// the unoccluded G: Fresnel loses ~8 % at the four crossings near normal incidence while the
+// slab brings b optically closer (apparent depth), so G_ab lies near the unoccluded value
+// (measured 1.03 x), not below half of it.
+TEST(ExtendedFormFactors, PathsThroughGlassAreReversibleFromEitherEnd) {
+  Scene s;
+  add_polygon(s, "a", diffuse(0.5), {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});
+  add_polygon(s, "b", diffuse(0.5), {{0.2, 0.1, 1}, {0.2, 0.5, 1}, {0.8, 0.5, 1}, {0.8, 0.1, 1}});
+  const Material g = glass(1.5, 1.0);
+  const double z0 = 0.4, z1 = 0.6, lo = -2, hi = 3;
+  add_polygon(s, "slab", g, {{lo, lo, z0}, {lo, hi, z0}, {hi, hi, z0}, {hi, lo, z0}});
+  add_polygon(s, "slab", g, {{lo, lo, z1}, {hi, lo, z1}, {hi, hi, z1}, {lo, hi, z1}});
+  add_polygon(s, "slab", g, {{lo, lo, z0}, {hi, lo, z0}, {hi, lo, z1}, {lo, lo, z1}});
+  add_polygon(s, "slab", g, {{lo, hi, z0}, {lo, hi, z1}, {hi, hi, z1}, {hi, hi, z0}});
+  add_polygon(s, "slab", g, {{lo, lo, z0}, {lo, lo, z1}, {lo, hi, z1}, {lo, hi, z0}});
+  add_polygon(s, "slab", g, {{hi, lo, z0}, {hi, hi, z0}, {hi, hi, z1}, {hi, lo, z1}});
+  const PatchMesh mesh = mesh_scene(s, {});  // one patch per face
+  const Bvh bvh(mesh);
+  FormFactorOptions o;
+  o.specular_rays = 65536;
+  o.with_stderr = true;
+  o.progress = false;
+  const ff::SpecularTransport sp = ff::compute_specular_transport(mesh, o, bvh, false);
+  const double g_ab = 1.0 * sp.S.coeff(0, 1), g_ba = 0.24 * sp.S.coeff(1, 0);
+  const double se = std::hypot(1.0 * sp.stderr_S.coeff(0, 1), 0.24 * sp.stderr_S.coeff(1, 0));
+  ASSERT_GT(se, 0.0);
+  EXPECT_NEAR(g_ab, g_ba, 4 * se) << "G from a " << g_ab << ", from b " << g_ba;
+  const double unoccluded = parallel_rectangles_G(0, 1, 0, 1, 0.2, 0.8, 0.1, 0.5, 1.0);
+  EXPECT_GT(g_ab, 0.5 * unoccluded);
+  EXPECT_LT(g_ab, 1.5 * unoccluded);
 }
 
 // The same seed gives the same F bitwise for 1 and 2 threads.
