@@ -68,6 +68,17 @@ void print_diagnostics(const LoadedScene& s, const FormFactors& ff, const FormFa
               format_duration(ff.stats.seconds).c_str(),
               format_si(ff.stats.seconds > 0 ? ff.stats.rays / ff.stats.seconds : 0).c_str());
   std::printf("row sums: min %.6f  mean %.6f  max %.6f\n", d.row_sum_min, d.row_sum_mean, d.row_sum_max);
+  if (ff.specular_continued.size() == d.n && d.n > 0) {
+    // Extended rows count light again after each specular bounce; what ends somewhere (row
+    // sum minus what was carried on) is the quantity bounded by 1.
+    double lo = 1e300, hi = -1e300, mean = 0.0;
+    for (std::int32_t i = 0; i < d.n; ++i) {
+      const double t = row_sum(ff.F, i) - ff.specular_continued[i];
+      lo = std::min(lo, t), hi = std::max(hi, t), mean += t / d.n;
+    }
+    std::printf("extended: row sums minus the part carried on by mirrors and glass: min %.6f  "
+                "mean %.6f  max %.6f\n", lo, mean, hi);
+  }
   std::printf("row-sum histogram (bins of %.2f from 0):", FormFactorDiagnostics::kHistogramMax / FormFactorDiagnostics::kHistogramBins);
   for (auto c : d.row_sum_histogram) std::printf(" %lld", static_cast<long long>(c));
   std::printf("\nlargest row sums:");
