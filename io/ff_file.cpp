@@ -209,14 +209,15 @@ void check_row_sums(const FormFactors& ff, const std::string& settings, const st
   const bool extended = extended_settings(settings);
   if (extended && ff.specular_continued.size() != ff.F.rows()) return;
   for (std::int32_t i = 0; rule.check && i < ff.F.outerSize(); ++i) {
-    double sum = extended ? -ff.specular_continued[i] : 0.0, err = 0;
+    double sum = 0, err = 0;
     const auto begin = ff.F.outerIndexPtr()[i], end = ff.F.outerIndexPtr()[i + 1];
     for (auto k = begin; k < end; ++k) {
       sum += ff.F.valuePtr()[k];
       if (rule.with_errors) err += ff.stderr_F.valuePtr()[k];
     }
     const double allowed = 1.0 + kRowSumRounding + kRowSumErrors * err + value_rounding * sum +
-                           (row_rounding ? (*row_rounding)[i] : 0.0);
+                           (row_rounding ? (*row_rounding)[i] : 0.0) +
+                           (extended ? ff.specular_continued[i] : 0.0);
     if (sum > allowed)
       throw SceneError(path + ": row of patch " + std::to_string(i) + " sums to " +
                        value_text(sum) + ", above 1 by more than its stated error (allowed " +
@@ -347,6 +348,9 @@ FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t
   const std::uint64_t computed = r.checksum();
   const auto stored = r.get<std::uint64_t>();
   if (stored != computed) throw IoError(path + ": form-factor file is corrupt (checksum mismatch)");
+  if ((flags & kContinued) && !extended_settings(settings))
+    throw IoError(path + ": corrupt header: specular bookkeeping (flag 4) without extended "
+                         "form-factor settings (specular_depth)");
   for (Eigen::Index i = 0; i < ff.specular_continued.size(); ++i)
     if (!(ff.specular_continued[i] >= 0.0) || !std::isfinite(ff.specular_continued[i]))
       throw SceneError(path + ": specular bookkeeping of patch " + std::to_string(i) + " is " +

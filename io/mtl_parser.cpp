@@ -73,6 +73,9 @@ std::vector<MtlMaterial> parse_mtl(std::istream& in, const std::string& name) {
     }
     if (std::find(std::begin(kKeys), std::end(kKeys), tok[0]) == std::end(kKeys)) continue;
     const std::string key(tok[0]);
+    // Kd and Ke before a newmtl have always been refused; the statements read since
+    // specular materials stay ignored there, as they were before.
+    if (out.empty() && key != "Kd" && key != "Ke") continue;
     if (out.empty()) throw SceneError(lines.where() + ": " + key + " before any newmtl");
     MtlMaterial& m = out.back();
     const Statement st{lines, tok, m};
@@ -91,8 +94,7 @@ std::vector<MtlMaterial> parse_mtl(std::istream& in, const std::string& name) {
       m.ns = st.scalar(), m.ns_line = at;
       if (m.ns < 0.0) st.fail("specular exponent Ns must be >= 0");
     } else if (key == "Ni") {
-      m.ni = st.scalar(), m.ni_line = at;
-      if (!(m.ni > 0.0)) st.fail("index of refraction Ni must be > 0");
+      m.ni = st.scalar(), m.ni_line = at;  // > 0 is checked for dielectrics (obj_loader)
     } else if (key == "d" || key == "Tr") {
       // `d -halo f` is the one option form of d; its halo is not modelled.
       const double v = tok.size() == 3 && tok[1] == "-halo" ? st.number(2) : st.scalar();

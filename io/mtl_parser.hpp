@@ -27,8 +27,10 @@ struct MtlMaterial {
 /// Parses MTL text: `newmtl NAME`; `Kd`, `Ke`, `Ks`, `Tf` as `r g b` or one grey value;
 /// `Ns`, `Ni`, `d`, `Tr` (= 1 - d) one number; `illum` an integer 0..10. Every other
 /// statement is ignored (the spectral `spectral` and `xyz` forms of the colours are
-/// refused). Numbers are read by parse_finite and must be finite; Ns >= 0, Ni > 0, d and Tr
-/// in [0, 1]. Throws SceneError "name:line: what is wrong" (IoError on a read error).
+/// refused). Numbers are read by parse_finite and must be finite; Ns >= 0, d and Tr in
+/// [0, 1] (Ni > 0 is required of dielectrics by the loader: exporters write `Ni 0` on
+/// diffuse materials). Statements other than Kd and Ke before any newmtl are ignored.
+/// Throws SceneError "name:line: what is wrong" (IoError on a read error).
 std::vector<MtlMaterial> parse_mtl(std::istream& in, const std::string& name);
 
 }  // namespace lambert

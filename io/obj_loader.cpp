@@ -169,6 +169,10 @@ Specular convert_specular(const MtlMaterial& m, const Material& mat, Unused& unu
     sp.dielectric = true;
     sp.ior = m.ni;
     sp.transmission = m.tf;
+    if (!(m.ni > 0.0))
+      throw SceneError(where(m.file, m.ni_line ? m.ni_line : m.line) + ": material '" + m.name +
+                       "': index of refraction Ni " + num(m.ni) + " of a dielectric (illum " +
+                       std::to_string(m.illum) + ") must be > 0");
     if (mat.rho.maxCoeff() > 0.0)
       throw SceneError(where(m.file, m.kd_line ? m.kd_line : m.line) + ": material '" + m.name +
                        "': a dielectric (illum " + std::to_string(m.illum) + ") needs Kd 0: it "
@@ -485,9 +489,10 @@ void report_lossless(const Materials& mats, const std::set<std::string>& colored
 // that channel: refused (light would bounce forever; a purely diffuse such scene keeps the
 // warning above and the check once F is known).
 void refuse_lossless_specular(const Scene& scene, const std::string& name) {
-  const bool specular = std::any_of(scene.materials.begin(), scene.materials.end(),
-                                    [](const Material& m) { return m.specular.any(); });
-  if (!specular || scene.faces.empty()) return;
+  const bool specular = std::any_of(scene.faces.begin(), scene.faces.end(), [&](const Face& f) {
+    return scene.material_of(f.surface).specular.any();
+  });
+  if (!specular) return;
   static const char* const kChannel[] = {"red", "green", "blue"};
   for (int c = 0; c < 3; ++c) {
     bool every = true;
@@ -502,6 +507,22 @@ void refuse_lossless_specular(const Scene& scene, const std::string& name) {
       throw SceneError(name + ": no surface absorbs " + kChannel[c] + " light (every material "
                        "reflects or transmits all of it: Kd + Ks = 1, or Tf = 1 on dielectrics): "
                        "light would never be absorbed and the radiosity has no solution");
+  }
+}
+
+// Face colours (--vertex-colors-as-reflectance) replace Kd, so they obey the rules Kd does
+// on specular materials: 0 on a dielectric, colour + Ks <= 1 on a mirror.
+void check_specular_face_colors(const Scene& scene, const std::string& name) {
+  for (const auto& f : scene.faces) {
+    if (!f.rho) continue;
+    const Material& m = scene.material_of(f.surface);
+    if (m.specular.dielectric && f.rho->maxCoeff() > 0.0)
+      throw SceneError(where(name, f.line) + ": face colour " + rgb(*f.rho) + " on dielectric '" +
+                       m.name + "': a dielectric's diffuse reflectance must be 0");
+    if (!m.specular.dielectric && (*f.rho + m.specular.reflectance).maxCoeff() > 1.0)
+      throw SceneError(where(name, f.line) + ": face colour " + rgb(*f.rho) + " + Ks " +
+                       rgb(m.specular.reflectance) + " of mirror '" + m.name +
+                       "' exceeds 1 in some channel");
   }
 }
 
@@ -634,6 +655,7 @@ Scene load_obj_stream(std::istream& in, const std::string& name, const MtlOpener
   report_default_materials(obj, mats, users, name, options, diag, scene);
   const auto colored_lossless = report_face_colors(obj.colors, options, name, diag, scene);
   report_lossless(mats, colored_lossless, name, diag, scene);
+  check_specular_face_colors(scene, name);
   refuse_lossless_specular(scene, name);
   report_skipped(obj, name, diag, report);
   if (report.degenerate_faces_dropped > 0)

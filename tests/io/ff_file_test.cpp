@@ -468,4 +468,20 @@ TEST(FormFactorFile, TextRowSumsAllowTheRoundingOfTheDigitsWritten) {
   EXPECT_THROW(read_form_factors(mm("0.500002", "0.500000"), 0, -1), SceneError);
 }
 
+// Regression of the review: the specular bookkeeping (flag 4) is only meaningful for
+// extended form factors; a file that carries it with plain settings is a corrupt header.
+TEST(FormFactorFile, SpecularBookkeepingWithoutExtendedSettingsIsRefused) {
+  Fixture f;
+  testing::TempDir dir;
+  f.ff.specular_continued = Eigen::VectorXd::Zero(f.mesh.size());
+  write_ff_binary(dir.file("F.bin"), f.ff, f.info);
+  EXPECT_THROW(read_form_factors(dir.file("F.bin"), f.info.mesh_hash, f.mesh.size()), IoError);
+  // With extended settings it loads and keeps the vector.
+  FormFactorFileInfo extended = f.info;
+  extended.settings = "estimator=hybrid samples=4 seed=1 threshold=0 specular_depth=8 specular_rays=64";
+  write_ff_binary(dir.file("G.bin"), f.ff, extended);
+  const FormFactors back = read_form_factors(dir.file("G.bin"), f.info.mesh_hash, f.mesh.size());
+  EXPECT_EQ(back.specular_continued.size(), f.mesh.size());
+}
+
 }  // namespace lambert

@@ -164,8 +164,8 @@ TEST(MtlSpecular, OutOfRangeOrMalformedValuesNameFileAndLine) {
     const char* what;
   };
   const Case cases[] = {
-      {"Kd 0\nNi 0\nillum 7\n", "index of refraction Ni must be > 0"},
-      {"Kd 0\nNi -1.5\nillum 7\n", "index of refraction Ni must be > 0"},
+      {"Kd 0\nNi 0\nillum 7\n", "index of refraction Ni 0 of a dielectric (illum 7) must be > 0"},
+      {"Kd 0\nNi -1.5\nillum 7\n", "index of refraction Ni -1.5 of a dielectric (illum 7) must be > 0"},
       {"Kd 0\nTf 1.5 1 1\nillum 7\n", "transmission filter Tf must lie in [0, 1]"},
       {"Kd 0\nTf -0.1\nillum 7\n", "transmission filter Tf must lie in [0, 1]"},
       {"Kd 0\nillum 11\n", "illum must be an integer from 0 to 10"},
@@ -201,14 +201,10 @@ TEST(MtlSpecular, OutOfRangeOrMalformedValuesNameFileAndLine) {
     EXPECT_NE(err.find("s.mtl:" + std::to_string(kBodyLine + 1) + ": " + c.what), std::string::npos)
         << c.body << "-> " << err;
   }
-  // A specular statement before any newmtl.
-  std::string err;
-  try {
-    load_text(kObj, "Ks 1 1 1\n" + std::string(kMtlHead) + "Kd 0\n");
-  } catch (const SceneError& e) {
-    err = e.what();
-  }
-  EXPECT_NE(err.find("s.mtl:1: Ks before any newmtl"), std::string::npos) << err;
+  // A specular statement before any newmtl is ignored, as before specular materials (Kd and
+  // Ke there stay refused); `Ni 0` on a diffuse material (exporters write it) is accepted.
+  EXPECT_NO_THROW(load_text(kObj, "Ks 1 1 1\nillum 3\n" + std::string(kMtlHead) + "Kd 0\n"));
+  EXPECT_NO_THROW(load_text(kObj, std::string(kMtlHead) + "Kd 0.5\nNi 0\nillum 2\n"));
 }
 
 TEST(MtlSpecular, TrIsOneMinusDissolve) {
@@ -347,6 +343,50 @@ TEST(MtlSpecular, SpecularCornellBoxHasAMirrorBlockAndAGlassSphere) {
   EXPECT_EQ(lowest, 0.5);
   const PatchMesh m = mesh_scene(s, {});
   EXPECT_EQ(m.surface_specular.size(), s.surfaces.size());
+}
+
+}  // namespace lambert
+
+namespace lambert {
+
+// Regressions of the review: face colours (--vertex-colors-as-reflectance) replace Kd and
+// obey its rules on specular materials (0 on glass, colour + Ks <= 1 on mirrors), naming
+// the face's line; an unused mirror in the library does not turn a diffuse lossless scene
+// (Kd 1, a warning until F is known) into an error.
+TEST(MtlSpecular, FaceColoursOnSpecularMaterialsObeyKdsRules) {
+  const std::string obj =
+      "mtllib s.mtl\n"
+      "g floor\nusemtl white\nv 0 0 0 0.5 0.5 0.5\nv 0 0 1 0.5 0.5 0.5\nv 1 0 1 0.5 0.5 0.5\n"
+      "v 1 0 0 0.5 0.5 0.5\nf 1 2 3 4\n"
+      "g lamp\nusemtl lamp\nv 0 1 0\nv 1 1 0\nv 0 1 1\nf 5 6 7\n"
+      "g wall\nusemtl m\nv 0 0 0 0.4 0.4 0.4\nv 0 1 0 0.4 0.4 0.4\nv 0 1 1 0.4 0.4 0.4\n"
+      "v 0 0 1 0.4 0.4 0.4\nf 8 9 10 11\n";
+  LoadOptions o;
+  o.vertex_colors_as_reflectance = true;
+  auto error = [&](const std::string& body) {
+    std::istringstream in(obj);
+    const std::string mtl = std::string(kMtlHead) + body;
+    const MtlOpener open = [&](const std::string&) {
+      return MtlFile{std::make_unique<std::istringstream>(mtl), "s.mtl"};
+    };
+    try {
+      load_obj_stream(in, "s.obj", open, nullptr, o);
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error("Kd 0\nNi 1.5\nillum 7\n").find("s.obj:21: face colour"), std::string::npos)
+      << error("Kd 0\nNi 1.5\nillum 7\n");
+  EXPECT_NE(error("Kd 0\nKs 0.7\nillum 3\n").find("exceeds 1"), std::string::npos);
+  EXPECT_EQ(error("Kd 0\nKs 0.6\nillum 3\n"), "");  // 0.4 + 0.6 = 1: lossless, accepted
+}
+
+TEST(MtlSpecular, UnusedMirrorKeepsADiffuseLosslessSceneAWarning) {
+  const std::string obj = "mtllib s.mtl\ng a\nusemtl w\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  LoadReport report;
+  EXPECT_NO_THROW(load_text(obj, "newmtl w\nKd 1 1 1\nnewmtl unused\nKs 1\nillum 3\n", &report));
+  EXPECT_FALSE(report.warnings.empty());
 }
 
 }  // namespace lambert
