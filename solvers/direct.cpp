@@ -4,8 +4,9 @@
 // scene with full visibility is nearly dense) a dense partial-pivoting LU is used instead,
 // which is much faster than SparseLU on a dense pattern: O(N^3) time, 8 N^2 bytes (factorised
 // in place: no second copy).
-// K is strictly row diagonally dominant (row sums of rho F are < 1), so LU without or with
-// partial pivoting is stable. The true relative residual is checked; above tol the status is
+// K is strictly row diagonally dominant (row sums of rho F are < 1; extended form factors
+// may break this, where partial pivoting keeps the factorisation stable), so LU without or
+// with partial pivoting is stable. The true relative residual is checked; above tol the status is
 // numerical-issue. Iterations: 1; matvecs: 1 (the residual check).
 //
 // Memory (direct_memory_bytes, checked by solve_radiosity against SolveOptions::memory_limit

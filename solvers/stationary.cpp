@@ -6,7 +6,9 @@
 // SOR:           B_i <- (1 - omega) B_i + omega g_i, omega in (0, 2).
 // Convergence: since ||diag(rho) F||_inf <= rho_max < 1 (row sums of F are <= 1), all three
 // converge for omega in (0, 1]; for omega > 1 SOR converges on the symmetrisable radiosity
-// systems (K is similar to an SPD matrix, Ostrowski-Reich). Cost per iteration: one pass
+// systems (K is similar to an SPD matrix, Ostrowski-Reich). Extended form factors (mirrors,
+// glass) have rows above 1; there the spectral radius of diag(rho) F stays below 1 because
+// light is absorbed (a scene that absorbs nothing is refused at load), not the row sums. Cost per iteration: one pass
 // over F, O(nnz). Initial guess B = E (or SolveOptions::initial_guess).
 //
 // Stopping rule (the one rule): ||E - K B||_2 / ||E||_2 <= tol on the true residual.

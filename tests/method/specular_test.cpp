@@ -36,6 +36,16 @@ Material glass(double ior, double tf) {
   return {"glass", Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), sp};
 }
 
+// A glass slab [lo, hi]² x [z0, z1]: a closed box of six faces wound outward.
+void add_slab(Scene& s, const Material& g, double lo, double hi, double z0, double z1) {
+  add_polygon(s, "slab", g, {{lo, lo, z0}, {lo, hi, z0}, {hi, hi, z0}, {hi, lo, z0}});
+  add_polygon(s, "slab", g, {{lo, lo, z1}, {hi, lo, z1}, {hi, hi, z1}, {lo, hi, z1}});
+  add_polygon(s, "slab", g, {{lo, lo, z0}, {hi, lo, z0}, {hi, lo, z1}, {lo, lo, z1}});
+  add_polygon(s, "slab", g, {{lo, hi, z0}, {lo, hi, z1}, {hi, hi, z1}, {hi, hi, z0}});
+  add_polygon(s, "slab", g, {{lo, lo, z0}, {lo, lo, z1}, {lo, hi, z1}, {lo, hi, z0}});
+  add_polygon(s, "slab", g, {{hi, lo, z0}, {hi, hi, z0}, {hi, hi, z1}, {hi, lo, z1}});
+}
+
 FormFactors extended(const PatchMesh& mesh, const std::string& estimator, int rays,
                      std::uint64_t seed = 1, int threads = 0, int depth = 8) {
   FormFactorOptions o;
@@ -130,14 +140,7 @@ TEST(ExtendedFormFactors, PathsThroughGlassAreReversibleFromEitherEnd) {
   Scene s;
   add_polygon(s, "a", diffuse(0.5), {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});
   add_polygon(s, "b", diffuse(0.5), {{0.2, 0.1, 1}, {0.2, 0.5, 1}, {0.8, 0.5, 1}, {0.8, 0.1, 1}});
-  const Material g = glass(1.5, 1.0);
-  const double z0 = 0.4, z1 = 0.6, lo = -2, hi = 3;
-  add_polygon(s, "slab", g, {{lo, lo, z0}, {lo, hi, z0}, {hi, hi, z0}, {hi, lo, z0}});
-  add_polygon(s, "slab", g, {{lo, lo, z1}, {hi, lo, z1}, {hi, hi, z1}, {lo, hi, z1}});
-  add_polygon(s, "slab", g, {{lo, lo, z0}, {hi, lo, z0}, {hi, lo, z1}, {lo, lo, z1}});
-  add_polygon(s, "slab", g, {{lo, hi, z0}, {lo, hi, z1}, {hi, hi, z1}, {hi, hi, z0}});
-  add_polygon(s, "slab", g, {{lo, lo, z0}, {lo, lo, z1}, {lo, hi, z1}, {lo, hi, z0}});
-  add_polygon(s, "slab", g, {{hi, lo, z0}, {hi, hi, z0}, {hi, hi, z1}, {hi, lo, z1}});
+  add_slab(s, glass(1.5, 1.0), -2, 3, 0.4, 0.6);
   const PatchMesh mesh = mesh_scene(s, {});  // one patch per face
   const Bvh bvh(mesh);
   FormFactorOptions o;
@@ -171,14 +174,7 @@ TEST(ExtendedFormFactors, AreDeterministicForAnyThreadCount) {
 TEST(ExtendedFormFactors, TransmitThroughIndexMatchedAndTintedGlass) {
   for (const double tf : {1.0, 0.5}) {
     Scene s = parallel_squares(1.0);  // "a" at z = 0 facing +z, "b" at z = 1 facing -z
-    const double z0 = 0.45, z1 = 0.55, lo = -1, hi = 2;
-    const Material g = glass(1.0, tf);
-    add_polygon(s, "slab", g, {{lo, lo, z0}, {lo, hi, z0}, {hi, hi, z0}, {hi, lo, z0}});
-    add_polygon(s, "slab", g, {{lo, lo, z1}, {hi, lo, z1}, {hi, hi, z1}, {lo, hi, z1}});
-    add_polygon(s, "slab", g, {{lo, lo, z0}, {hi, lo, z0}, {hi, lo, z1}, {lo, lo, z1}});
-    add_polygon(s, "slab", g, {{lo, hi, z0}, {lo, hi, z1}, {hi, hi, z1}, {hi, hi, z0}});
-    add_polygon(s, "slab", g, {{lo, lo, z0}, {lo, lo, z1}, {lo, hi, z1}, {lo, hi, z0}});
-    add_polygon(s, "slab", g, {{hi, lo, z0}, {hi, hi, z0}, {hi, hi, z1}, {hi, lo, z1}});
+    add_slab(s, glass(1.0, tf), -1, 2, 0.45, 0.55);
     const PatchMesh mesh = mesh_scene(s, {0.5, 0});
     const FormFactors ff = extended(mesh, "gather", 8192);
     const auto [f, se] = surface_factor(mesh, ff, 0, 1);
