@@ -10,7 +10,7 @@
 
 namespace lambert {
 
-void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load) {
+void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load, bool tol_alias) {
   std::vector<CLI::Option*> compute_only;
   compute_only.push_back(
       cmd->add_option("--estimator", args.estimator,
@@ -28,6 +28,12 @@ void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load) {
       cmd->add_option("--rays", args.rays, "Rays per patch (estimator gather)")
           ->check(CLI::Range(1, 1 << 24))
           ->each([&args](const std::string&) { args.rays_given = true; })
+          ->capture_default_str());
+  compute_only.push_back(
+      cmd->add_option(tol_alias ? "--tol,--ff-tol" : "--ff-tol", args.tol,
+                      "Absolute error target of every form factor (estimator analytic)")
+          ->check(finite_number(1e-15, 1.0))
+          ->each([&args](const std::string&) { args.tol_given = true; })
           ->capture_default_str());
   compute_only.push_back(
       cmd->add_option("--threshold", args.threshold, "Drop form factors below this value")
@@ -90,12 +96,13 @@ FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run
   o.progress = !run.quiet;
   o.specular_depth = args.specular_depth;
   o.specular_rays = args.specular_rays;
+  o.tol = args.tol;
   if (args.estimator != "auto") {
     const std::vector<std::string> unused = unused_count_options(args, args.estimator);
     if (!unused.empty())
       throw UsageError(unused.front() + " does not apply to --estimator " + args.estimator +
                        " (--samples is per patch pair for mc and hybrid, --rays per patch for "
-                       "gather)");
+                       "gather, --ff-tol the error target of analytic)");
   }
   return o;
 }
@@ -105,8 +112,9 @@ std::vector<std::string> unused_count_options(const FormFactorArgs& args,
   const std::string used = estimator_count_option(estimator);
   std::vector<std::string> out;
   if (args.rays_given && used != "rays") out.push_back("--rays");
-  // The hemicube has ignored --samples since it existed; only gather refuses it.
-  if (args.samples_given && used == "rays") out.push_back("--samples");
+  // The hemicube has ignored --samples since it existed; gather and analytic refuse it.
+  if (args.samples_given && (used == "rays" || used == "tol")) out.push_back("--samples");
+  if (args.tol_given && used != "tol") out.push_back("--ff-tol");
   return out;
 }
 
@@ -203,6 +211,7 @@ Json ff_settings_json(const FormFactorOptions& o, const std::string& loaded_from
           {"seed", known(o.seed)},
           {"threshold", known(o.threshold)},
           {"hemicube_resolution", known(o.hemicube_resolution)},
+          {"tol", o.estimator == "analytic" ? Json(o.tol) : Json()},
           {"reciprocity", known(o.reciprocity)},
           {"symmetrize", known(o.reciprocity == "average")},
           {"extended", known(o.extended)},  // specular paths included (specular.hpp)

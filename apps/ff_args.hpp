@@ -23,6 +23,8 @@ struct FormFactorArgs {
   bool symmetrize = false;     ///< alias of --reciprocity average
   bool samples_given = false;  ///< --samples was on the command line
   bool rays_given = false;     ///< --rays was on the command line
+  double tol = 1e-6;           ///< --ff-tol (--tol in formfactors): estimator analytic
+  bool tol_given = false;      ///< --ff-tol was on the command line
   std::string ff_file;  ///< load F from this file instead of computing it
   /// --specular-depth: specular bounces followed by the extended form factors and by the
   /// ray-traced view pass (with --ff it steers the view pass only; F keeps its own).
@@ -33,7 +35,9 @@ struct FormFactorArgs {
 /// Adds the form-factor options to a subcommand. `with_load` adds --ff FILE, which excludes
 /// the options that only steer a computation (--estimator, --samples, --rays, --threshold,
 /// --hemicube-res, --reciprocity, --symmetrize): given together, they are a usage error.
-void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load = true);
+/// `tol_alias` also names --ff-tol --tol (the formfactors command, which has no solver).
+void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load = true,
+                    bool tol_alias = false);
 
 /// Adds F to a job plan: --ff as an input, or the computation's options for the memory
 /// estimate.
@@ -46,7 +50,7 @@ void plan_form_factors(JobPlan& plan, const FormFactorArgs& args, const RunArgs&
 FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run);
 
 /// The count options given on the command line that `estimator` (resolved) ignores, as
-/// option names ("--rays", "--samples"); empty when none.
+/// option names ("--rays", "--samples", "--ff-tol"); empty when none.
 std::vector<std::string> unused_count_options(const FormFactorArgs& args,
                                               const std::string& estimator);
 
@@ -69,7 +73,7 @@ void check_closed_lossless(const PatchMesh& mesh, const FormFactors& ff, bool so
 
 /// The settings that made F, for reports: {estimator (the resolved one),
 /// estimator_requested ("auto" or null), samples, rays_per_patch (--rays), seed, threshold,
-/// hemicube_resolution, reciprocity, symmetrize (reciprocity == average), extended (F holds
+/// hemicube_resolution, tol (analytic's --ff-tol, else null), reciprocity, symmetrize (reciprocity == average), extended (F holds
 /// specular paths), specular_depth and specular_rays (null unless extended), loaded_from} (""
 /// when computed here), every setting null when unknown (see obtain_form_factors).
 Json ff_settings_json(const FormFactorOptions& options, const std::string& loaded_from);

@@ -122,7 +122,7 @@ CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts) {
   opts.scene.default_patches = 2000;
   add_scene_options(cmd, opts.scene);
   add_run_options(cmd, opts.run);
-  add_ff_options(cmd, opts.ff, false);
+  add_ff_options(cmd, opts.ff, false, /*tol_alias=*/true);
   cmd->add_option("-o,--output", opts.output,
                   "Output: F.mtx (Matrix Market), F.bin (binary), or JSON with --by-surface/--point")
       ->check(output_file_check());
@@ -163,7 +163,11 @@ int run_formfactors(const FormFactorsOptions& opts) {
     plan.outputs.push_back({"--report", report});
     plan_form_factors(plan, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
   }
-  const LoadedScene scene = load_scene(opts.scene, plan);
+  // The analytic estimator integrates over whole polygons: one patch per face unless
+  // --max-edge or --patches asks for more.
+  SceneArgs scene_args = opts.scene;
+  if (opts.ff.estimator == "analytic") scene_args.default_patches = 0;
+  const LoadedScene scene = load_scene(scene_args, plan);
   if (!opts.point.empty()) {
     const FormFactorOptions o = make_ff_options(opts.ff, opts.run);
     if (scene.mesh.has_specular())

@@ -145,6 +145,27 @@ bool Bvh::occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& directi
   return ray.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
 }
 
+namespace {
+// Point-query callback: collects the primitive (= patch) ids Embree hands over.
+bool collect_patch(RTCPointQueryFunctionArguments* args) {
+  static_cast<std::vector<std::int32_t>*>(args->userPtr)->push_back(static_cast<std::int32_t>(args->primID));
+  return false;  // the query radius is unchanged
+}
+}  // namespace
+
+void Bvh::patches_near(const Eigen::Vector3d& centre, double radius,
+                       std::vector<std::int32_t>& out) const {
+  RTCPointQuery query;
+  query.x = static_cast<float>(centre.x());
+  query.y = static_cast<float>(centre.y());
+  query.z = static_cast<float>(centre.z());
+  query.time = 0.0f;
+  query.radius = static_cast<float>(radius * (1.0 + 1e-6) + 1e-6 * centre.lpNorm<Eigen::Infinity>());
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  rtcPointQuery(impl_->scene.get(), &query, &context, collect_patch, &out);
+}
+
 RayHit Bvh::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
                       float tnear, float tfar) const {
   RTCIntersectContext context;

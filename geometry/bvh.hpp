@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <vector>
 
 #include "geometry/mesh.hpp"
 
@@ -38,6 +39,12 @@ class Bvh {
   RayHit intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
                    float tnear = 0.0f,
                    float tfar = std::numeric_limits<float>::infinity()) const;
+
+  /// Appends to `out` every patch whose bounds may meet the ball (centre, radius), a
+  /// superset of those that do (Embree's point query over the BVH's float boxes, the
+  /// radius widened by 1e-6 relative to cover their rounding). Unordered: callers sort.
+  void patches_near(const Eigen::Vector3d& centre, double radius,
+                    std::vector<std::int32_t>& out) const;
 
   /// BVHs built and Embree devices created so far by this process (for tests and logs).
   static std::int64_t builds();

@@ -145,4 +145,16 @@ std::vector<std::array<int, 3>> triangulate(const std::vector<Eigen::Vector3d>& 
   return tris;
 }
 
+PlaneFrame plane_frame(const std::vector<Eigen::Vector3d>& poly) {
+  PlaneFrame f;
+  f.o = poly[0];
+  f.w = newell_normal(poly).normalized();
+  Eigen::Vector3d e = Eigen::Vector3d::Zero();
+  for (size_t k = 1; k < poly.size(); ++k)
+    if ((poly[k] - poly[0]).squaredNorm() > e.squaredNorm()) e = poly[k] - poly[0];
+  f.u = (e - e.dot(f.w) * f.w).normalized();
+  f.v = f.w.cross(f.u);
+  return f;
+}
+
 }  // namespace lambert

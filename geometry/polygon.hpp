@@ -31,6 +31,17 @@ double polygon_diameter(const std::vector<Eigen::Vector3d>& poly);
 double polygon_extent(const std::vector<Eigen::Vector3d>& poly);
 
 
+/// A planar polygon's frame: origin o (its first corner), unit front normal w (Newell), and
+/// in-plane axes u (along the longest edge from o) and v = w x u, so counter-clockwise about
+/// w is counter-clockwise in (u, v).
+struct PlaneFrame {
+  Eigen::Vector3d o, u, v, w;
+  Eigen::Vector2d to2d(const Eigen::Vector3d& p) const { return {(p - o).dot(u), (p - o).dot(v)}; }
+  Eigen::Vector3d to3d(const Eigen::Vector2d& q) const { return o + q.x() * u + q.y() * v; }
+  double height(const Eigen::Vector3d& p) const { return w.dot(p - o); }  ///< above the plane
+};
+PlaneFrame plane_frame(const std::vector<Eigen::Vector3d>& poly);
+
 /// Triangulates a simple polygon by ear clipping in its Newell plane; returns index
 /// triples into `poly`, wound like the polygon. Works for convex and concave polygons;
 /// O(n) for strictly convex ones (the fan ear clipping would produce), O(n^2) or more else.

@@ -549,6 +549,8 @@ bool parse_double(const std::string& s, double& v) {
 std::string format_ff_settings(const FormFactorOptions& o) {
   char threshold[32];
   std::snprintf(threshold, sizeof threshold, "%.17g", o.threshold);
+  char tol[32];
+  std::snprintf(tol, sizeof tol, "%.17g", o.tol);
   // symmetrize= stays for readers older than reciprocity= (and is what they parse).
   const bool average = o.reciprocity == "average";
   return "estimator=" + o.estimator + " samples=" + std::to_string(o.samples) +
@@ -557,7 +559,8 @@ std::string format_ff_settings(const FormFactorOptions& o) {
          " reciprocity=" + (average ? "average" : "none") + " symmetrize=" + (average ? "1" : "0") +
          (o.extended ? " specular_depth=" + std::to_string(o.specular_depth) +
                            " specular_rays=" + std::to_string(o.specular_rays)
-                     : "");
+                     : "") +
+         (o.estimator == "analytic" ? std::string(" tol=") + tol : std::string());
 }
 
 bool parse_ff_settings(const std::string& text, FormFactorOptions& options) {
@@ -595,6 +598,8 @@ bool parse_ff_settings(const std::string& text, FormFactorOptions& options) {
     } else if (key == "specular_rays") {
       if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
       o.specular_rays = static_cast<int>(k);
+    } else if (key == "tol") {
+      if (!parse_double(value, o.tol) || !(o.tol > 0.0)) return false;
     } else if (key == "symmetrize") {
       if (value != "0" && value != "1") return false;
       if (!reciprocity) o.reciprocity = value == "1" ? "average" : "none";

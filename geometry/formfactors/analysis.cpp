@@ -258,6 +258,10 @@ PointFactors point_form_factors(const PatchMesh& mesh, const Eigen::Vector3d& po
       const auto j = static_cast<std::int32_t>(jj);
       const double unocc = ff::point_to_patch(point, n, geom[j]);
       if (unocc <= 0.0) continue;
+      if (options.estimator == "analytic") {  // exact: the visible part by the booleans
+        f[j] = ff::exact_point_factor(bvh, geom, j, point, n);
+        continue;
+      }
       // The shared visible-fraction kernel (visibility.hpp), in replicates for the error.
       const int R = ff::replicate_count(options.samples);
       double replicate[ff::kReplicates];

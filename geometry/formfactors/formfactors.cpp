@@ -32,7 +32,8 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
   Timer timer;
   const std::int32_t n = mesh.size();
   const std::vector<PatchGeom> geom = patch_geometry(mesh);
-  const PairContext ctx{geom, bvh, options.samples, options.seed, kRayOffset * mesh.scale};
+  const PairContext ctx{geom, bvh, options.samples, options.seed, kRayOffset * mesh.scale,
+                       options.tol};
   const double plane_eps = kPlaneEps * mesh.scale;
   const std::int64_t total_pairs = static_cast<std::int64_t>(n) * (n - 1) / 2;
 
@@ -96,8 +97,9 @@ namespace {
 
 struct EstimatorEntry {
   const char* name;
-  bool traces_rays;  ///< needs a BVH and reports replicate standard errors (needs count >= 4)
-  const char* count_option;  ///< "samples", "rays" or "" (estimator_count_option)
+  bool traces_rays;  ///< reports replicate standard errors (needs count >= 4); follows mirrors
+  bool uses_bvh;     ///< queries a BVH (rays, or the analytic estimator's blocker search)
+  const char* count_option;  ///< "samples", "rays", "tol" or "" (estimator_count_option)
   /// "auto" reciprocity averages: gather (noisy one-sided rows; averaging halves the variance
   /// of a pair and makes F reciprocal). Not the pair estimators (reciprocal by
   /// construction) nor the hemicube (its non-reciprocity is a result `accuracy` studies).
@@ -150,26 +152,31 @@ double gather_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
 
 const std::vector<EstimatorEntry>& registry() {
   static const std::vector<EstimatorEntry> table = {
-      {"hybrid", true, "samples", false,
+      {"hybrid", true, true, "samples", false,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
          return ff::compute_pairwise(m, o, *b, ff::estimate_hybrid);
        },
        pairwise_peak_bytes},
-      {"mc", true, "samples", false,
+      {"mc", true, true, "samples", false,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
          return ff::compute_pairwise(m, o, *b, ff::estimate_mc);
        },
        pairwise_peak_bytes},
-      {"hemicube", false, "", false,
+      {"hemicube", false, false, "", false,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh*) {
          return ff::compute_hemicube(m, o);  // rasterises: no rays
        },
        hemicube_peak_bytes},
-      {"gather", true, "rays", true,
+      {"gather", true, true, "rays", true,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
          return ff::compute_gather(m, o, *b);
        },
        gather_peak_bytes},
+      {"analytic", false, true, "tol", false,
+       [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
+         return ff::compute_pairwise(m, o, *b, ff::estimate_analytic);
+       },
+       pairwise_peak_bytes},
   };
   return table;
 }
@@ -249,6 +256,8 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
                                  const Bvh* bvh) {
   if (options.samples < 1) throw UsageError("--samples must be at least 1");
   if (options.rays < 1) throw UsageError("--rays must be at least 1");
+  if (!(options.tol > 0.0) || !std::isfinite(options.tol))
+    throw UsageError("--ff-tol must be a positive number");
   if (mesh.patches.empty()) throw UsageError("the scene has no patches");
   const FormFactorOptions o = resolve_form_factor_options(options, mesh.size());
   const EstimatorEntry& e = find_estimator(o.estimator);
@@ -265,7 +274,7 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
                      "(specular surfaces then only receive and block)");
   if (specular) ff::check_grey_specular(mesh);
   std::unique_ptr<Bvh> own;
-  if (!bvh && e.traces_rays) {
+  if (!bvh && e.uses_bvh) {
     own = std::make_unique<Bvh>(mesh, o.threads);
     bvh = own.get();
   }

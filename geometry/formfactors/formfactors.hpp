@@ -32,6 +32,9 @@ struct FormFactorOptions {
   double threshold = 0.0;            ///< drop entries with F_ij < threshold (after estimation)
   bool with_stderr = false;          ///< also estimate the standard error of each entry
   int hemicube_resolution = 128;     ///< hemicube top-face resolution (estimator "hemicube")
+  /// Estimator "analytic": absolute error target of every entry F_ij (its quadrature error
+  /// estimate, reported as the standard error).
+  double tol = 1e-6;
   /// "average": replace A_i F_ij and A_j F_ji by their mean (reciprocity.hpp); "none";
   /// "auto": average for gather, none for the others (the pair estimators are reciprocal by
   /// construction; the hemicube keeps its historical default, --symmetrize to average).
@@ -124,7 +127,7 @@ constexpr std::int64_t kAutoGatherPatches = 6000;
 std::string auto_estimator(std::int64_t patches);
 
 /// Which per-count option an estimator reads: "samples" (pair estimators), "rays"
-/// (gather) or "" (hemicube). Throws UsageError for an unknown name (not "auto").
+/// (gather), "tol" (analytic: --ff-tol) or "" (hemicube). Throws UsageError for an unknown name (not "auto").
 std::string estimator_count_option(const std::string& estimator);
 
 /// `options` with "auto" resolved for `patches` patches: estimator (estimator_requested

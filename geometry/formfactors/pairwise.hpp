@@ -23,6 +23,7 @@ struct PairContext {
   int samples;
   std::uint64_t seed;
   double offset;  ///< ray ends are lifted this far off their patches (scene units)
+  double tol = 0.0;  ///< estimator "analytic": absolute error target of F_ij and F_ji
 };
 
 /// One pair's estimate.
@@ -44,6 +45,18 @@ PairEstimate estimate_mc(const PairContext& ctx, std::int32_t i, std::int32_t j)
 /// over the smaller patch) times an unbiased visible fraction from rays drawn with the
 /// kernel's density. Exact (to quadrature, < 1e-6) for unoccluded pairs.
 PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_t j);
+
+/// Estimator "analytic" (analytic.hpp): exact point factors past the blockers the BVH
+/// finds in the pair's bounding ball, integrated over the smaller patch to an error
+/// estimate of ctx.tol on both factors; var is the estimate squared, unverified when the
+/// evaluation budget ran out first. Traces no rays.
+PairEstimate estimate_analytic(const PairContext& ctx, std::int32_t i, std::int32_t j);
+
+/// The exact point factor F_{dx->j, visible} at x (unit normal n) past the patches in the
+/// ball around x and patch j (shadow.hpp's shadowed_point_factor): `formfactors --point`
+/// with the analytic estimator.
+double exact_point_factor(const Bvh& bvh, const std::vector<PatchGeom>& geom, std::int32_t j,
+                          const Eigen::Vector3d& x, const Eigen::Vector3d& n);
 
 /// Runs `estimator` over all pairs in parallel, tracing against `bvh` (built over `mesh`), and assembles F (and stderr if asked).
 FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& options,

@@ -7,6 +7,7 @@
 #include "apps/cli.hpp"
 #include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
+#include "geometry/analytic.hpp"
 #include "io/ff_file.hpp"
 
 namespace lambert {
@@ -174,6 +175,82 @@ TEST(FormFactorsCommand, CountOptionsOfAnotherEstimatorAreUsageErrors) {
                  "-o", out}),
             kExitUsage);
   ::testing::internal::GetCapturedStderr();
+}
+
+}  // namespace lambert
+
+namespace lambert {
+namespace {
+
+// The partial-shadow scene of geometry/analytic.hpp as an OBJ: floor [0,4]² (z = 0, up),
+// light [1.5,2.5]² (z = 3, down), blocker [1.6,2.6] x [1.3,2.1] (z = 1.5, up).
+const char* kPartialShadowObj =
+    "o floor\nv 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\nf 1 2 3 4\n"
+    "o light\nv 1.5 1.5 3\nv 1.5 2.5 3\nv 2.5 2.5 3\nv 2.5 1.5 3\nf 5 6 7 8\n"
+    "o blocker\nv 1.6 1.3 1.5\nv 2.6 1.3 1.5\nv 2.6 2.1 1.5\nv 1.6 2.1 1.5\nf 9 10 11 12\n";
+
+}  // namespace
+
+TEST(FormFactorsCommand, AnalyticBySurfaceMatchesTheExactOccludedFactor) {
+  testing::TempDir dir;
+  const std::string obj = dir.write("s.obj", kPartialShadowObj);
+  const std::string out = dir.file("s.json");
+  ASSERT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--by-surface", "--tol",
+                 "1e-10", "-o", out}),
+            kExitOk);
+  const nlohmann::json json = parse_json_file(out);
+  const auto names = json.at("surfaces").get<std::vector<std::string>>();
+  ASSERT_EQ(names, (std::vector<std::string>{"floor", "light", "blocker"}));
+  // One patch per face (no meshing): the floor's row is that of the whole floor.
+  const double exact = partial_shadow_floor_light_factor(24);
+  const double F = json.at("F")[0][1].get<double>(), err = json.at("stderr")[0][1].get<double>();
+  // --tol 1e-10, the estimate calibrated to within 10x (tests/geometry/analytic_ff_test.cpp).
+  EXPECT_NEAR(F, exact, 1e-9);
+  EXPECT_GT(err, 0.0);
+  EXPECT_LE(err, 1e-10);
+  const nlohmann::json report = parse_json_file(dir.file("s.report.json"));
+  EXPECT_EQ(report.at("form_factors").at("tol").get<double>(), 1e-10);
+  // Reciprocity: the light's row holds A_floor F / A_light exactly (one integral per pair).
+  EXPECT_DOUBLE_EQ(json.at("F")[1][0].get<double>(), 16.0 * F);
+}
+
+TEST(FormFactorsCommand, AnalyticSensorPointIsExact) {
+  testing::TempDir dir;
+  const std::string obj = dir.write("s.obj", kPartialShadowObj);
+  const std::string out = dir.file("p.json");
+  // A floor point in the penumbra: the light's factor is the exact occluded point factor.
+  ASSERT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--point", "2.1,1.9,0",
+                 "--normal", "0,0,1", "-o", out}),
+            kExitOk);
+  const double exact = partial_shadow_floor_radiosity({2.1, 1.9, 0.0}) / 0.5;  // B = 0.5 F
+  EXPECT_NEAR(parse_json_file(out).at("F")[1].get<double>(), exact, 1e-14);
+}
+
+TEST(FormFactorsCommand, AnalyticRefusesCountsAndOtherEstimatorsRefuseTol) {
+  testing::TempDir dir;
+  const std::string obj = dir.write("s.obj", kPartialShadowObj);
+  const std::string out = dir.file("F.bin");
+  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--samples", "8", "-o", out}), kExitUsage);
+  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--rays", "8", "-o", out}), kExitUsage);
+  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "hybrid", "--tol", "1e-8", "-o", out}), kExitUsage);
+  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--tol", "0", "-o", out}), kExitUsage);
+  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--tol", "nan", "-o", out}), kExitUsage);
+}
+
+TEST(FormFactorsCommand, AnalyticFileKeepsItsTolerance) {
+  testing::TempDir dir;
+  const std::string obj = dir.write("s.obj", kPartialShadowObj);
+  const std::string bin = dir.file("F.bin");
+  ASSERT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--tol", "1e-7",
+                 "--max-edge", "2", "-o", bin}),
+            kExitOk);
+  const std::string report = dir.file("B.json");  // solve's report next to -o
+  ASSERT_EQ(run({"solve", obj, "-q", "--max-edge", "2", "--ff", bin, "--emit", "light=1,1,1",
+                 "-o", dir.file("B.csv")}),
+            kExitOk);
+  const nlohmann::json settings = parse_json_file(report).at("form_factors");
+  EXPECT_EQ(settings.at("estimator").get<std::string>(), "analytic");
+  EXPECT_EQ(settings.at("tol").get<double>(), 1e-7);
 }
 
 }  // namespace lambert

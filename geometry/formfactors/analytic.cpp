@@ -1,0 +1,633 @@
+#include "geometry/formfactors/analytic.hpp"
+
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <queue>
+
+#include "geometry/formfactors/kernels.hpp"
+#include "geometry/formfactors/pairwise.hpp"
+#include "geometry/shadow.hpp"
+
+namespace lambert::ff {
+namespace {
+
+using K = CGAL::Exact_predicates_exact_constructions_kernel;
+using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, CGAL::Default,
+                                                       CGAL::Exact_intersections_tag>;
+using Point2 = K::Point_2;
+
+// Gauss-Legendre orders per direction of a triangle's two rules (the value is the low one's,
+// the estimate their difference). On an analytic integrand the order-8 rule's error is
+// about (h/2d)^6 times the order-5 rule's, so the difference is the order-5 error to a few
+// per cent for cells up to the size of their distance to b, which refinement ensures.
+constexpr int kLowOrder = 5;
+constexpr int kHighOrder = 8;
+// Rounding floor of a pair's error estimate, relative to G: the contour formula and the
+// booleans' rounded corners are good to ~1e-15 relative per point, and a sum of cells
+// cannot be trusted below ~10x that (so --tol below it is met at the floor, not chased).
+constexpr double kRoundingFloor = 1e-14;
+// Identification of the visible polygon's corners with their features, relative to b's size:
+// a corner matches a feature within kMatchTol, and two features closer than kSameTol are the
+// same point (a blocker corner is also the crossing of its two edges' lines).
+constexpr double kMatchTol = 1e-9;
+constexpr double kSameTol = 1e-12;
+// Verification of the identification against the booleans, relative to the unoccluded
+// point factor: a change of combinatorics between the centroid and a check point changes the
+// factor by far more (the check points sit a few per cent of the cell inside its corners).
+constexpr double kVerifyTol = 1e-10;
+// Check points are the cell's corners moved this fraction towards its centroid.
+constexpr double kCheckInset = 0.05;
+// Event segments closer than this to a singular point (the line through v and the edge runs
+// parallel to a's plane) are cut there, relative to the edge's parameter.
+constexpr double kParamMargin = 1e-9;
+
+using Frame = PlaneFrame;
+
+Frame frame_of(const Polygon3& p) { return plane_frame(p); }
+
+// The part of a convex polygon with height >= 0 above f's plane (Sutherland-Hodgman).
+Polygon3 clip_front(const Polygon3& in, const Frame& f) {
+  Polygon3 out;
+  for (size_t k = 0; k < in.size(); ++k) {
+    const Eigen::Vector3d& a = in[k];
+    const Eigen::Vector3d& b = in[(k + 1) % in.size()];
+    const double ha = f.height(a), hb = f.height(b);
+    if (ha >= 0.0) out.push_back(a);
+    if ((ha > 0.0 && hb < 0.0) || (ha < 0.0 && hb > 0.0)) out.push_back(a + (ha / (ha - hb)) * (b - a));
+  }
+  if (out.size() < 3 || !(polygon_area(out) > 0.0)) return {};
+  return out;
+}
+
+// A line s a + t b + c = 0 in b's plane (2-D coordinates of Frame fb).
+using Line = Eigen::Vector3d;
+
+// A corner of the visible polygon by what defines it.
+struct Source {
+  enum Kind : int { kEmitterCorner, kBlockerCorner, kCrossing } kind;
+  int i = 0, j = 0;  // corner index, or the two line indices (i < j) of a crossing
+};
+using Pattern = std::vector<std::vector<Source>>;  // loops of corners
+
+// The geometry a pair's visible polygon is built from.
+struct Features {
+  Frame fa, fb;
+  Polygon3 emitter;                      // b in front of a's plane
+  std::vector<Eigen::Vector2d> emitter2;  // its corners in fb
+  std::vector<Polygon3> pieces;          // blockers in front of both planes
+  std::vector<Eigen::Vector3d> corners;  // the pieces' distinct corners
+  std::vector<std::array<int, 2>> edges;  // the pieces' distinct edges (corner indices)
+  double scale = 1.0;                    // b's diameter
+
+  int line_count() const { return static_cast<int>(emitter2.size() + edges.size()); }
+
+  // Line k at x: the emitter's edge k (fixed), or blocker edge k - nE projected from x.
+  Line line(int k, const Eigen::Vector3d& x) const {
+    const int ne = static_cast<int>(emitter2.size());
+    if (k < ne) {
+      const Eigen::Vector2d& p = emitter2[k];
+      const Eigen::Vector2d d = emitter2[(k + 1) % ne] - p;
+      return {d.y(), -d.x(), d.x() * p.y() - d.y() * p.x()};
+    }
+    const auto& e = edges[k - ne];
+    const Eigen::Vector3d m = (corners[e[0]] - x).cross(corners[e[1]] - x);
+    return {m.dot(fb.u), m.dot(fb.v), m.dot(fb.o - x)};
+  }
+
+  // The point of `s` at x (2-D in fb); false when it is undefined there.
+  bool point(const Source& s, const Eigen::Vector3d& x, double dx, Eigen::Vector2d& out) const {
+    switch (s.kind) {
+      case Source::kEmitterCorner:
+        out = emitter2[s.i];
+        return true;
+      case Source::kBlockerCorner: {
+        const Eigen::Vector3d& c = corners[s.i];
+        const double denom = dx - fb.height(c);
+        if (!(denom > 0.0)) return false;
+        out = fb.to2d(x + (c - x) * (dx / denom));
+        return true;
+      }
+      case Source::kCrossing: {
+        const Line l1 = line(s.i, x), l2 = line(s.j, x);
+        const double det = l1.x() * l2.y() - l2.x() * l1.y();
+        const double norm = l1.head<2>().norm() * l2.head<2>().norm();
+        if (!(std::abs(det) > 1e-14 * norm)) return false;
+        out = {(l1.y() * l2.z() - l2.y() * l1.z()) / det, (l2.x() * l1.z() - l1.x() * l2.z()) / det};
+        return true;
+      }
+    }
+    return false;
+  }
+};
+
+// The unoccluded point factor of the emitter at x (normal n).
+double unoccluded(const Features& f, const Eigen::Vector3d& x, const Eigen::Vector3d& n) {
+  std::vector<Eigen::Vector3d> r;
+  for (const auto& p : f.emitter) r.push_back(p - x);
+  return -contour_sum(n, r.data(), static_cast<int>(r.size())) / (2.0 * M_PI);
+}
+
+// The factor of the visible polygon given by `pattern` at x; NaN when a corner is undefined.
+double pattern_factor(const Features& f, const Pattern& pattern, const Eigen::Vector3d& x,
+                      const Eigen::Vector3d& n, std::vector<Eigen::Vector3d>& r) {
+  const double dx = f.fb.height(x);
+  double sum = 0.0;
+  for (const auto& loop : pattern) {
+    r.clear();
+    for (const Source& s : loop) {
+      Eigen::Vector2d q;
+      if (!f.point(s, x, dx, q)) return std::nan("");
+      r.push_back(f.fb.to3d(q) - x);
+    }
+    sum += contour_sum(n, r.data(), static_cast<int>(r.size()));
+  }
+  return -sum / (2.0 * M_PI);
+}
+
+double boolean_factor(const Features& f, const Eigen::Vector3d& x, const Eigen::Vector3d& n) {
+  return shadowed_point_factor(x, n, f.emitter, f.pieces);
+}
+
+// Identifies the corners of the visible polygon at x with their features; false when some
+// corner matches none, or two different ones.
+bool identify(const Features& f, const Eigen::Vector3d& x, const Eigen::Vector3d& n,
+              Pattern& pattern) {
+  pattern.clear();
+  const std::vector<Polygon3> loops = visible_emitter_region(x, n, f.emitter, f.pieces);
+  if (loops.empty()) return true;
+  // Every candidate at x, in priority order (corners before crossings).
+  const double dx = f.fb.height(x);
+  std::vector<std::pair<Source, Eigen::Vector2d>> candidates;
+  auto add = [&](Source s) {
+    Eigen::Vector2d q;
+    if (f.point(s, x, dx, q)) candidates.emplace_back(s, q);
+  };
+  for (int k = 0; k < static_cast<int>(f.emitter2.size()); ++k) add({Source::kEmitterCorner, k, 0});
+  for (int k = 0; k < static_cast<int>(f.corners.size()); ++k) add({Source::kBlockerCorner, k, 0});
+  const int lines = f.line_count();
+  for (int a = 0; a < lines; ++a)
+    for (int b = a + 1; b < lines; ++b) add({Source::kCrossing, a, b});
+  const double match = kMatchTol * f.scale, same = kSameTol * f.scale;
+  for (const auto& loop : loops) {
+    // Rounding slivers (the booleans' output between blocker pieces meeting along an edge)
+    // carry no light worth a pattern.
+    if (polygon_area(loop) <= kSameTol * f.scale * f.scale) continue;
+    std::vector<Source> out;
+    for (const auto& p : loop) {
+      const Eigen::Vector2d q = f.fb.to2d(p);
+      int best = -1;
+      double best_d = INFINITY;
+      for (size_t c = 0; c < candidates.size(); ++c) {
+        const double d = (candidates[c].second - q).norm();
+        if (d < best_d - same) {
+          best = static_cast<int>(c);
+          best_d = d;
+        }
+      }
+      if (best < 0 || best_d > match) return false;
+      for (size_t c = 0; c < candidates.size(); ++c) {
+        const double d = (candidates[c].second - q).norm();
+        if (d <= match && (candidates[c].second - candidates[best].second).norm() > same)
+          return false;
+      }
+      out.push_back(candidates[best].first);
+    }
+    pattern.push_back(std::move(out));
+  }
+  return true;
+}
+
+// One triangle of the partition of a.
+struct Cell {
+  std::array<Eigen::Vector3d, 3> p;
+  bool fast = true;  // integrand from `pattern`; else through the booleans at every point
+  int pattern = -1;
+  double low = 0.0, high = 0.0, est = 0.0;
+};
+
+struct Integrator {
+  const Features& f;
+  Eigen::Vector3d n;  // a's normal
+  std::vector<Pattern> patterns;
+  std::vector<Eigen::Vector3d> scratch;
+  AnalyticEstimate out;
+
+  double integrand(const Cell& c, const Eigen::Vector3d& x) {
+    ++out.evaluations;
+    if (c.fast) return c.pattern < 0 ? 0.0 : pattern_factor(f, patterns[c.pattern], x, n, scratch);
+    ++out.boolean_evaluations;
+    return boolean_factor(f, x, n);
+  }
+
+  // Classifies a cell: its pattern from the centroid, verified at the inset corners.
+  void classify(Cell& c) {
+    const Eigen::Vector3d centre = (c.p[0] + c.p[1] + c.p[2]) / 3.0;
+    Pattern pattern;
+    out.boolean_evaluations += 1;
+    c.fast = identify(f, centre, n, pattern);
+    for (int k = 0; k < 3 && c.fast; ++k) {
+      const Eigen::Vector3d y = c.p[k] + kCheckInset * (centre - c.p[k]);
+      const double exact = boolean_factor(f, y, n);
+      ++out.boolean_evaluations;
+      const double fast = pattern.empty() ? 0.0 : pattern_factor(f, pattern, y, n, scratch);
+      c.fast = std::abs(fast - exact) <= kVerifyTol * std::abs(unoccluded(f, y, n)) + 1e-300;
+    }
+    if (!c.fast) return;
+    if (pattern.empty()) {
+      c.pattern = -1;
+    } else {
+      patterns.push_back(std::move(pattern));
+      c.pattern = static_cast<int>(patterns.size()) - 1;
+    }
+  }
+
+  // Both rules on the collapsed map x = p0 + u (p1 - p0) + u v (p2 - p1), J = 2 A u.
+  void integrate(Cell& c) {
+    const double area = 0.5 * (c.p[1] - c.p[0]).cross(c.p[2] - c.p[0]).norm();
+    if (c.fast && c.pattern < 0) {
+      c.low = c.high = c.est = 0.0;  // umbra: exactly 0
+      return;
+    }
+    double q[2] = {0.0, 0.0};
+    const int orders[2] = {kLowOrder, kHighOrder};
+    for (int r = 0; r < 2; ++r) {
+      const GaussRule g = gauss_legendre(orders[r]);
+      for (int i = 0; i < g.n; ++i) {
+        const double u = g.x[i];
+        double inner = 0.0;
+        for (int j = 0; j < g.n; ++j) {
+          const Eigen::Vector3d x = c.p[0] + u * (c.p[1] - c.p[0]) + u * g.x[j] * (c.p[2] - c.p[1]);
+          inner += g.w[j] * integrand(c, x);
+        }
+        q[r] += g.w[i] * 2.0 * area * u * inner;
+      }
+    }
+    c.low = q[0];
+    c.high = q[1];
+    c.est = std::isfinite(q[0]) && std::isfinite(q[1]) ? std::abs(q[1] - q[0]) : INFINITY;
+  }
+};
+
+// The error estimate of a sum of low-rule cells from the cells' differences d = high - low:
+// the signed sum Σd is the sum's error where the high rule is the more accurate (errors of
+// different cells cancel in the sum as they do in the estimate), widened by kErrorSafety for
+// the high rule's own error, plus kAbsShare of Σ|d| in case Σd cancelled by accident.
+// Calibrated on the closed-form cases of tests/geometry/analytic_ff_test.cpp (true/estimate
+// between 0.1 and 1 in every run).
+constexpr double kErrorSafety = 1.25;
+constexpr double kAbsShare = 0.05;
+double pair_error(double diff, double abs_diff) {
+  return kErrorSafety * std::abs(diff) + kAbsShare * abs_diff;
+}
+
+// Clips the 2-D segment [p, q] to the convex counter-clockwise polygon r; false when nothing
+// of it lies inside (or it runs along an edge).
+bool clip_segment(Eigen::Vector2d& p, Eigen::Vector2d& q, const std::vector<Eigen::Vector2d>& r,
+                  double eps) {
+  double t0 = 0.0, t1 = 1.0;
+  const Eigen::Vector2d d = q - p;
+  for (size_t k = 0; k < r.size(); ++k) {
+    const Eigen::Vector2d e = r[(k + 1) % r.size()] - r[k];
+    const double len = e.norm();
+    const double f0 = (e.x() * (p - r[k]).y() - e.y() * (p - r[k]).x()) / len;  // distance inside
+    const double fd = (e.x() * d.y() - e.y() * d.x()) / len;
+    if (std::abs(fd) * (t1 - t0) <= eps) {  // parallel to the edge (over what is left)
+      if (f0 + fd * t0 <= eps) return false;
+      continue;
+    }
+    const double t = -f0 / fd;
+    if (fd > 0.0) t0 = std::max(t0, t);
+    else t1 = std::min(t1, t);
+    if (t1 <= t0) return false;
+  }
+  const Eigen::Vector2d a = p + t0 * d, b = p + t1 * d;
+  if ((b - a).norm() <= eps) return false;
+  p = a;
+  q = b;
+  return true;
+}
+
+// The event segments on a (2-D in fa), clipped to the receiver polygon r2.
+std::vector<std::array<Eigen::Vector2d, 2>> event_segments(const Features& f,
+                                                            const std::vector<Eigen::Vector2d>& r2,
+                                                            double eps) {
+  std::vector<std::array<Eigen::Vector2d, 2>> out;
+  double radius = 0.0;
+  for (const auto& q : r2) radius = std::max(radius, (q - r2[0]).norm());
+  auto add = [&](Eigen::Vector2d p, Eigen::Vector2d q) {
+    if (!clip_segment(p, q, r2, eps)) return;
+    for (const auto& s : out)
+      if (((s[0] - p).norm() <= eps && (s[1] - q).norm() <= eps) ||
+          ((s[0] - q).norm() <= eps && (s[1] - p).norm() <= eps))
+        return;
+    out.push_back({p, q});
+  };
+  // Objects: 0 the emitter, 1.. the pieces; each as corners and edges.
+  std::vector<const Polygon3*> objects{&f.emitter};
+  for (const auto& piece : f.pieces) objects.push_back(&piece);
+  for (size_t A = 0; A < objects.size(); ++A) {
+    for (size_t B = 0; B < objects.size(); ++B) {
+      if (A == B) continue;
+      const Polygon3& va = *objects[A];
+      const Polygon3& eb = *objects[B];
+      for (const auto& v : va) {
+        const double hv = f.fa.height(v);
+        if (!(hv > 0.0)) continue;  // on a's plane: every line through it meets a at v
+        for (size_t k = 0; k < eb.size(); ++k) {
+          const Eigen::Vector3d& p = eb[k];
+          const Eigen::Vector3d& q = eb[(k + 1) % eb.size()];
+          const double hp = f.fa.height(p), hq = f.fa.height(q);
+          // x(t) = v + (s - v) hv / (hv - hs) for s = p + t (q - p): undefined where hs = hv.
+          std::vector<double> cuts{0.0, 1.0};
+          if (hq != hp) {
+            const double ts = (hv - hp) / (hq - hp);
+            if (ts > 0.0 && ts < 1.0) cuts = {0.0, ts - kParamMargin, ts + kParamMargin, 1.0};
+            else if (ts == 0.0) cuts = {kParamMargin, 1.0};
+            else if (ts == 1.0) cuts = {0.0, 1.0 - kParamMargin};
+          } else if (hp == hv) {
+            continue;  // the edge runs at v's height: its lines through v are parallel to a
+          }
+          auto at = [&](double t) {
+            const Eigen::Vector3d s = p + t * (q - p);
+            const double hs = hp + t * (hq - hp);
+            return f.fa.to2d(v + (s - v) * (hv / (hv - hs)));
+          };
+          for (size_t c = 0; c + 1 < cuts.size(); c += 2) add(at(cuts[c]), at(cuts[c + 1]));
+        }
+      }
+    }
+  }
+  // Where a piece's plane meets a's plane (seen edge-on from there).
+  for (const auto& piece : f.pieces) {
+    const Eigen::Vector3d m = newell_normal(piece).normalized();
+    const Eigen::Vector3d l(m.dot(f.fa.u), m.dot(f.fa.v), m.dot(f.fa.o - piece[0]));
+    const double g = l.head<2>().norm();
+    if (!(g > 1e-12)) continue;
+    const Eigen::Vector2d normal = l.head<2>() / g, foot = -(l.z() / g) * normal;
+    const Eigen::Vector2d dir(-normal.y(), normal.x());
+    const double reach = (foot - r2[0]).norm() + 2.0 * radius;
+    add(foot - reach * dir, foot + reach * dir);
+  }
+  return out;
+}
+
+// The side planes of the shaft between two convex polygons (Haines & Wallace): the planes
+// through an edge of one and a corner of the other with both polygons on their inner side
+// (n . p + d <= eps), i.e. the faces of their convex hull other than the polygons' own.
+std::vector<Eigen::Vector4d> shaft_planes(const Polygon3& a, const Polygon3& b, double eps) {
+  std::vector<Eigen::Vector4d> planes;
+  auto side = [&](const Polygon3& e, const Polygon3& c) {
+    for (size_t k = 0; k < e.size(); ++k) {
+      const Eigen::Vector3d& p = e[k];
+      const Eigen::Vector3d& q = e[(k + 1) % e.size()];
+      for (const auto& r : c) {
+        Eigen::Vector3d n = (q - p).cross(r - p);
+        if (!(n.norm() > 0.0)) continue;
+        n.normalize();
+        double lo = INFINITY, hi = -INFINITY;
+        for (const Polygon3* poly : {&a, &b})
+          for (const auto& v : *poly) {
+            lo = std::min(lo, n.dot(v - p));
+            hi = std::max(hi, n.dot(v - p));
+          }
+        if (hi <= eps) planes.push_back({n.x(), n.y(), n.z(), -n.dot(p)});
+        else if (lo >= -eps) planes.push_back({-n.x(), -n.y(), -n.z(), n.dot(p)});
+      }
+    }
+  };
+  side(a, b);
+  side(b, a);
+  return planes;
+}
+
+// True when the piece lies outside the shaft or on its boundary (then no segment between the
+// polygons passes through its inside: it touches them at most).
+bool outside_shaft(const Polygon3& piece, const std::vector<Eigen::Vector4d>& planes, double eps) {
+  for (const auto& pl : planes) {
+    bool out = true;
+    for (const auto& v : piece) out = out && pl.head<3>().dot(v) + pl.w() >= -eps;
+    if (out) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
+                                 const std::vector<Polygon3>& blockers, double tol_G,
+                                 std::int64_t max_evaluations) {
+  Features f;
+  f.fa = frame_of(a);
+  f.fb = frame_of(b);
+  const Polygon3 receiver = clip_front(a, f.fb);
+  f.emitter = clip_front(b, f.fa);
+  if (receiver.empty() || f.emitter.empty()) return {};
+  for (const auto& p : f.emitter) f.emitter2.push_back(f.fb.to2d(p));
+  f.scale = polygon_diameter(f.emitter);
+  const double scale = std::max(polygon_diameter(a), f.scale);
+  const double plane_eps = 1e-12 * scale;
+
+  const std::vector<Eigen::Vector4d> shaft = shaft_planes(receiver, f.emitter, plane_eps);
+  // The blockers' parts in front of both planes (convex pieces), their corners and edges.
+  for (const auto& blocker : blockers) {
+    if (blocker.size() < 3 || !(polygon_area(blocker) > 0.0)) continue;
+    std::vector<Polygon3> convex;
+    if (is_convex(blocker)) {
+      convex.push_back(blocker);
+    } else {
+      for (const auto& t : triangulate(blocker)) convex.push_back({blocker[t[0]], blocker[t[1]], blocker[t[2]]});
+    }
+    for (const auto& c : convex) {
+      Polygon3 piece = clip_front(c, f.fa);
+      if (!piece.empty()) piece = clip_front(piece, f.fb);
+      if (piece.empty()) continue;
+      double ha = 0.0, hb = 0.0;
+      for (const auto& p : piece) {
+        ha = std::max(ha, f.fa.height(p));
+        hb = std::max(hb, f.fb.height(p));
+      }
+      if (ha <= plane_eps || hb <= plane_eps) continue;  // in a's or b's plane: hides nothing
+      if (outside_shaft(piece, shaft, plane_eps)) continue;
+      f.pieces.push_back(std::move(piece));
+    }
+  }
+  auto corner_index = [&](const Eigen::Vector3d& p) {
+    for (size_t k = 0; k < f.corners.size(); ++k)
+      if (f.corners[k] == p) return static_cast<int>(k);
+    f.corners.push_back(p);
+    return static_cast<int>(f.corners.size()) - 1;
+  };
+  for (const auto& piece : f.pieces) {
+    for (size_t k = 0; k < piece.size(); ++k) {
+      int i = corner_index(piece[k]), j = corner_index(piece[(k + 1) % piece.size()]);
+      if (i > j) std::swap(i, j);
+      if (i != j && std::find(f.edges.begin(), f.edges.end(), std::array<int, 2>{i, j}) == f.edges.end())
+        f.edges.push_back({i, j});
+    }
+  }
+
+  // The partition of the receiver: its fan, or its CDT with the event segments.
+  std::vector<Eigen::Vector2d> r2;
+  for (const auto& p : receiver) r2.push_back(f.fa.to2d(p));
+  std::vector<Cell> cells;
+  std::int64_t events = 0;
+  if (f.pieces.empty()) {
+    for (size_t k = 1; k + 1 < receiver.size(); ++k) cells.push_back({{receiver[0], receiver[k], receiver[k + 1]}});
+  } else {
+    const auto segments = event_segments(f, r2, plane_eps);
+    CDT cdt;
+    std::vector<Point2> boundary;
+    for (const auto& q : r2) boundary.emplace_back(q.x(), q.y());
+    cdt.insert_constraint(boundary.begin(), boundary.end(), true);
+    for (const auto& s : segments) cdt.insert_constraint(Point2(s[0].x(), s[0].y()), Point2(s[1].x(), s[1].y()));
+    for (auto fh = cdt.finite_faces_begin(); fh != cdt.finite_faces_end(); ++fh) {
+      const Point2 c = CGAL::centroid(fh->vertex(0)->point(), fh->vertex(1)->point(), fh->vertex(2)->point());
+      bool inside = true;
+      for (size_t k = 0; k < boundary.size() && inside; ++k)
+        inside = CGAL::orientation(boundary[k], boundary[(k + 1) % boundary.size()], c) == CGAL::LEFT_TURN;
+      if (!inside) continue;
+      Cell cell;
+      for (int k = 0; k < 3; ++k) {
+        const Point2& q = fh->vertex(k)->point();
+        cell.p[k] = f.fa.to3d({CGAL::to_double(q.x()), CGAL::to_double(q.y())});
+      }
+      if ((cell.p[1] - cell.p[0]).cross(cell.p[2] - cell.p[0]).dot(f.fa.w) <= 0.0) continue;
+      cells.push_back(cell);
+    }
+    events = static_cast<std::int64_t>(segments.size());
+  }
+  Integrator in{f, f.fa.w, {}, {}, {}};
+  in.out.events = events;
+  if (f.pieces.empty()) {  // unoccluded: the whole emitter everywhere
+    Pattern full(1);
+    for (int k = 0; k < static_cast<int>(f.emitter2.size()); ++k) full[0].push_back({Source::kEmitterCorner, k, 0});
+    in.patterns.push_back(full);
+    for (Cell& c : cells) c.pattern = 0;
+  } else {
+    for (Cell& c : cells) in.classify(c);
+  }
+  for (Cell& c : cells) in.integrate(c);
+
+  // Global refinement: split the cell with the largest estimate until the sum meets the
+  // tolerance (or the rounding floor), or the budget is spent.
+  auto by_est = [&](int x, int y) { return cells[x].est < cells[y].est; };
+  std::priority_queue<int, std::vector<int>, decltype(by_est)> queue(by_est);
+  std::vector<char> leaf(cells.size(), 1);
+  double total_est = 0.0, total = 0.0, total_diff = 0.0;
+  for (size_t k = 0; k < cells.size(); ++k) {
+    queue.push(static_cast<int>(k));
+    total_est += cells[k].est;
+    total += cells[k].low;
+    total_diff += cells[k].high - cells[k].low;
+  }
+  while (!queue.empty()) {
+    const double tol = std::max(tol_G, kRoundingFloor * std::abs(total));
+    if (!(std::max(total_est, pair_error(total_diff, total_est)) > tol)) break;
+    if (in.out.evaluations >= max_evaluations) {
+      in.out.converged = false;
+      break;
+    }
+    const int k = queue.top();
+    queue.pop();
+    const Cell parent = cells[k];
+    leaf[k] = 0;
+    total_est -= parent.est;
+    total -= parent.low;
+    total_diff -= parent.high - parent.low;
+    const Eigen::Vector3d m01 = 0.5 * (parent.p[0] + parent.p[1]), m12 = 0.5 * (parent.p[1] + parent.p[2]),
+                          m20 = 0.5 * (parent.p[2] + parent.p[0]);
+    const std::array<std::array<Eigen::Vector3d, 3>, 4> children = {
+        {{parent.p[0], m01, m20}, {m01, parent.p[1], m12}, {m20, m12, parent.p[2]}, {m12, m20, m01}}};
+    for (const auto& corners : children) {
+      Cell child;
+      child.p = corners;
+      child.fast = parent.fast;
+      child.pattern = parent.pattern;
+      if (!parent.fast) in.classify(child);
+      in.integrate(child);
+      cells.push_back(child);
+      leaf.push_back(1);
+      total_est += child.est;
+      total += child.low;
+      total_diff += child.high - child.low;
+      queue.push(static_cast<int>(cells.size()) - 1);
+    }
+  }
+  AnalyticEstimate out = in.out;
+  out.G = 0.0;
+  double diff = 0.0, abs_diff = 0.0;
+  for (size_t k = 0; k < cells.size(); ++k) {
+    if (!leaf[k]) continue;
+    out.G += cells[k].low;
+    diff += cells[k].high - cells[k].low;
+    abs_diff += cells[k].est;
+    ++out.cells;
+  }
+  out.G = std::max(0.0, out.G);
+  out.error = std::max(pair_error(diff, abs_diff), kRoundingFloor * out.G);
+  return out;
+}
+
+}  // namespace lambert::ff
+
+namespace lambert::ff {
+
+namespace {
+
+Polygon3 polygon_of(const PatchGeom& g) { return Polygon3(g.p.begin(), g.p.begin() + g.n); }
+
+// The patches other than `skip` in the ball around `box` whose boxes meet it (every segment
+// between two points of the box lies in both): the candidate blockers.
+std::vector<Polygon3> blockers_in(const Bvh& bvh, const std::vector<PatchGeom>& geom,
+                                  const Eigen::AlignedBox3d& box, std::int32_t skip1,
+                                  std::int32_t skip2) {
+  std::vector<std::int32_t> near;
+  bvh.patches_near(box.center(), 0.5 * box.diagonal().norm(), near);
+  std::sort(near.begin(), near.end());
+  near.erase(std::unique(near.begin(), near.end()), near.end());
+  std::vector<Polygon3> blockers;
+  for (const std::int32_t k : near) {
+    if (k == skip1 || k == skip2) continue;
+    const PatchGeom& g = geom[k];
+    Eigen::AlignedBox3d gb;
+    for (int c = 0; c < g.n; ++c) gb.extend(g.p[c]);
+    if (gb.intersects(box)) blockers.push_back(polygon_of(g));
+  }
+  return blockers;
+}
+
+}  // namespace
+
+PairEstimate estimate_analytic(const PairContext& ctx, std::int32_t i, std::int32_t j) {
+  // Integrate over the smaller patch (fewer cells for the same accuracy per unit area).
+  const PatchGeom& gi = ctx.geom[i];
+  const PatchGeom& gj = ctx.geom[j];
+  const bool i_smaller = gi.area <= gj.area;
+  const PatchGeom& a = i_smaller ? gi : gj;
+  const PatchGeom& b = i_smaller ? gj : gi;
+  Eigen::AlignedBox3d box;
+  for (int k = 0; k < a.n; ++k) box.extend(a.p[k]);
+  for (int k = 0; k < b.n; ++k) box.extend(b.p[k]);
+  const AnalyticEstimate e = analytic_pair_G(polygon_of(a), polygon_of(b),
+                                             blockers_in(ctx.bvh, ctx.geom, box, i, j),
+                                             ctx.tol * std::min(gi.area, gj.area));
+  PairEstimate out;
+  out.G = e.G;
+  out.var = e.error * e.error;
+  out.unverified = !e.converged;
+  return out;
+}
+
+double exact_point_factor(const Bvh& bvh, const std::vector<PatchGeom>& geom, std::int32_t j,
+                          const Eigen::Vector3d& x, const Eigen::Vector3d& n) {
+  Eigen::AlignedBox3d box(x, x);
+  for (int k = 0; k < geom[j].n; ++k) box.extend(geom[j].p[k]);
+  return shadowed_point_factor(x, n, polygon_of(geom[j]), blockers_in(bvh, geom, box, j, j));
+}
+
+}  // namespace lambert::ff

@@ -1,0 +1,199 @@
+// The analytic estimator: exact point factors past polygonal blockers, integrated to a
+// tolerance (geometry/formfactors/analytic.hpp), against closed forms and exact references.
+#include "geometry/formfactors/analytic.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/occluded_reference.hpp"
+#include "geometry/analytic.hpp"
+#include "geometry/formfactors/formfactors.hpp"
+#include "geometry/mesh.hpp"
+
+namespace lambert {
+namespace {
+
+// An axis-aligned rectangle at height z, facing +z (up) or -z.
+Polygon3 rect(double x0, double x1, double y0, double y1, double z, bool up) {
+  Polygon3 p{{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}};
+  if (!up) std::reverse(p.begin(), p.end());
+  return p;
+}
+
+// One case with a known exact G.
+struct Case {
+  const char* name;
+  Polygon3 a, b;
+  std::vector<Polygon3> blockers;
+  double exact;
+};
+
+std::vector<Case> cases() {
+  const PartialShadowGeometry g = partial_shadow_geometry();
+  // The partial-shadow reference: cut along its event lines and integrated at order 24
+  // (orders 12 and 20 agree to ~1e-16, geometry/analytic.hpp).
+  const double shadow = 16.0 * partial_shadow_floor_light_factor(24);
+  Polygon3 floor = g.floor;
+  return {
+      {"unit squares", rect(0, 1, 0, 1, 0, true), rect(0, 1, 0, 1, 1, false), {},
+       parallel_rectangles_G(0, 1, 0, 1, 0, 1, 0, 1, 1)},
+      // 1:20 sizes, offset and close: the integrand varies on the small square's distance.
+      {"small over large", rect(0.3, 0.4, 0.5, 0.6, 0, true), rect(0, 2, 0, 2, 0.15, false), {},
+       parallel_rectangles_G(0.3, 0.4, 0.5, 0.6, 0, 2, 0, 2, 0.15)},
+      {"offset thin", rect(0, 3, 0, 0.05, 0, true), rect(1, 2, 0.5, 1.5, 0.4, false), {},
+       parallel_rectangles_G(0, 3, 0, 0.05, 1, 2, 0.5, 1.5, 0.4)},
+      {"partial shadow", floor, g.light, {g.blocker}, shadow},
+      // Independent references (tests/common/occluded_reference.hpp: Howell's element-to-
+      // rectangle factors integrated over cells cut at every kink, ~1e-15).
+      {"centred blocker", rect(0, 1, 0, 1, 0, true), rect(0, 1, 0, 1, 1, false),
+       {rect(0.25, 0.75, 0.25, 0.75, 0.5, true)},
+       ref::parallel_blocked_G({0, 1, 0, 1}, {0, 1, 0, 1}, 1.0, {0.25, 0.75, 0.25, 0.75}, 0.5, 32)},
+      {"corner blocker", rect(0, 1, 0, 1, 0, true), rect(0, 1, 0, 1, 1, false),
+       {rect(0, 0.5, 0, 0.5, 0.5, false)},  // facing away: blockers block from both sides
+       ref::parallel_blocked_G({0, 1, 0, 1}, {0, 1, 0, 1}, 1.0, {0, 0.5, 0, 0.5}, 0.5, 32)},
+      {"off-centre blocker", rect(0, 1, 0, 1, 0, true), rect(0, 1, 0, 1, 1, false),
+       {rect(0.1, 0.45, 0.3, 0.95, 0.3, true)},
+       ref::parallel_blocked_G({0, 1, 0, 1}, {0, 1, 0, 1}, 1.0, {0.1, 0.45, 0.3, 0.95}, 0.3, 32)},
+      {"unequal offset", rect(0, 2, 0, 1, 0, true), rect(0.5, 1.5, -0.5, 1.5, 1, false),
+       {rect(0.2, 1, 0.1, 0.6, 0.4, true)},
+       ref::parallel_blocked_G({0, 2, 0, 1}, {0.5, 1.5, -0.5, 1.5}, 1.0, {0.2, 1, 0.1, 0.6}, 0.4, 32)},
+      {"large receiver", rect(0, 1, 0, 1, 0, true), rect(-1, 2, -1, 2, 2, false),
+       {rect(0.4, 0.9, -0.2, 0.3, 1.5, true)},
+       ref::parallel_blocked_G({0, 1, 0, 1}, {-1, 2, -1, 2}, 2.0, {0.4, 0.9, -0.2, 0.3}, 1.5, 32)},
+      // Perpendicular squares sharing an edge, a fin on the plane x = z from that edge.
+      {"fin 0.1", rect(0, 1, 0, 1, 0, true), {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}},
+       {{{0, 0, 0}, {0, 1, 0}, {0.1, 1, 0.1}, {0.1, 0, 0.1}}}, ref::perpendicular_fin_G(0.1, 32)},
+      {"fin 0.3", rect(0, 1, 0, 1, 0, true), {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}},
+       {{{0, 0, 0}, {0, 1, 0}, {0.3, 1, 0.3}, {0.3, 0, 0.3}}}, ref::perpendicular_fin_G(0.3, 32)},
+  };
+}
+
+TEST(AnalyticPair, UnblockedPairsMatchTheClosedFormTo1e12) {
+  for (const Case& c : cases()) {
+    if (!c.blockers.empty()) continue;
+    const ff::AnalyticEstimate e = ff::analytic_pair_G(c.a, c.b, {}, 1e-13);
+    // The estimate is the low rule's error to a few per cent (calibration test below), so
+    // a request of 1e-13 leaves the value within 1e-12 of the exact G (G <= 1 here).
+    EXPECT_TRUE(e.converged) << c.name;
+    EXPECT_NEAR(e.G, c.exact, 1e-12) << c.name << " estimate " << e.error;
+  }
+}
+
+TEST(AnalyticPair, BlockedPairsMatchIndependentReferencesTo1e9) {
+  for (const Case& c : cases()) {
+    if (c.blockers.empty()) continue;
+    const ff::AnalyticEstimate e = ff::analytic_pair_G(c.a, c.b, c.blockers, 1e-10);
+    // Requested 1e-10 (G <= 0.4): the issue's 1e-9 with a margin of 10 for the estimate's
+    // calibration (at most 10x optimistic, test below).
+    EXPECT_TRUE(e.converged) << c.name;
+    EXPECT_NEAR(e.G, c.exact, 1e-9) << c.name << " estimate " << e.error;
+  }
+}
+
+TEST(AnalyticPair, PartialShadowMatchesTheExactOccludedFactorTo1e9) {
+  const Case c = cases()[3];
+  const ff::AnalyticEstimate e = ff::analytic_pair_G(c.a, c.b, c.blockers, 1e-10);
+  // Requested 1e-10 of G = 0.27 (F_floor->light x 16): the 1e-9 the issue asks for with a
+  // margin of 10 for the estimate's calibration (at most 10x optimistic, test below).
+  EXPECT_NEAR(e.G, c.exact, 1e-9) << "estimate " << e.error;
+  EXPECT_GT(e.events, 0);
+  // The combinatorial identification carries the integral: booleans only to classify.
+  EXPECT_LT(e.boolean_evaluations, e.evaluations / 5);
+}
+
+TEST(AnalyticPair, FinHidingTheWholeWallGivesExactlyZero) {
+  // The fin to x = z = 0.5: light gets through only from floor points x0 > c / (1 - c) = 1.
+  const ff::AnalyticEstimate e = ff::analytic_pair_G(
+      rect(0, 1, 0, 1, 0, true), {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}},
+      {{{0, 0, 0}, {0, 1, 0}, {0.5, 1, 0.5}, {0.5, 0, 0.5}}}, 1e-12);
+  EXPECT_EQ(ref::perpendicular_fin_G(0.5, 32), 0.0);
+  EXPECT_EQ(e.G, 0.0);
+}
+
+TEST(AnalyticPair, FullyBlockedPairIsExactlyZero) {
+  // A blocker larger than both squares' shadow cone, mid-way, and one touching b.
+  for (double z : {0.5, 0.999}) {
+    const ff::AnalyticEstimate e = ff::analytic_pair_G(
+        rect(0, 1, 0, 1, 0, true), rect(0, 1, 0, 1, 1, false), {rect(-1.5, 2.5, -1.5, 2.5, z, true)}, 1e-12);
+    EXPECT_EQ(e.G, 0.0) << z;
+    EXPECT_EQ(e.error, 0.0) << z;
+  }
+}
+
+TEST(AnalyticPair, ErrorEstimateIsCalibrated) {
+  // Over every case and tolerance, the true error must lie below the estimate in at least
+  // 95 % of the runs, and not more than 10x below it (the estimator issue's rule), for
+  // errors above the rounding floor (1e-14 relative, where the estimate is floored).
+  int runs = 0, above = 0, far_below = 0;
+  for (const Case& c : cases()) {
+    for (double tol : {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9}) {
+      const ff::AnalyticEstimate e = ff::analytic_pair_G(c.a, c.b, c.blockers, tol);
+      const double err = std::abs(e.G - c.exact);
+      if (e.error <= 1e-13 * c.exact) {
+        std::printf("%-16s tol %.0e  estimate %.3e at the floor\n", c.name, tol, e.error);
+        continue;
+      }
+      ++runs;
+      above += err > e.error;
+      far_below += err < e.error / 10.0;
+      std::printf("%-16s tol %.0e  estimate %.3e  true %.3e  ratio %.3f\n", c.name, tol, e.error, err,
+                  err / e.error);
+    }
+  }
+  ASSERT_GT(runs, 10);
+  EXPECT_LE(above, runs / 20) << runs << " runs";
+  EXPECT_LE(far_below, runs / 20) << runs << " runs";
+}
+
+// The inside of the unit cube with a two-sided plate (two faces back to back), tilted so that
+// its edge-on line and contact-free shadows cut every face's integral.
+Scene cube_with_plate() {
+  Scene s = unit_cube();
+  const Material m{"plate", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
+  const Polygon3 plate{{0.2, 0.3, 0.35}, {0.75, 0.3, 0.5}, {0.75, 0.7, 0.55}, {0.2, 0.7, 0.4}};
+  add_polygon(s, "plate up", m, plate);
+  add_polygon(s, "plate down", m, Polygon3(plate.rbegin(), plate.rend()));
+  return s;
+}
+
+TEST(AnalyticEstimator, ClosedBoxWithTiltedPlateRowsSumToOne) {
+  const PatchMesh mesh = mesh_scene(cube_with_plate(), {});  // one patch per face
+  ASSERT_EQ(mesh.size(), 8);
+  FormFactorOptions o;
+  o.estimator = "analytic";
+  // 1e-7: the twelve pairs of faces sharing a cube edge converge algebraically at the contact
+  // (isotropic splitting; README "analytic"), about 0.3 s each here; 1e-9 takes 10 s.
+  o.tol = 1e-7;
+  o.progress = false;
+  o.with_stderr = true;
+  o.threads = 1;
+  const FormFactors ff = compute_form_factors(mesh, o);
+  o.threads = 2;
+  const FormFactors ff2 = compute_form_factors(mesh, o);
+  ASSERT_EQ(ff.F.nonZeros(), ff2.F.nonZeros());
+  for (Eigen::Index k = 0; k < ff.F.nonZeros(); ++k)
+    EXPECT_EQ(ff.F.valuePtr()[k], ff2.F.valuePtr()[k]) << "entry " << k << " depends on threads";
+  EXPECT_EQ(ff.stats.pairs_unverified, 0);
+  for (Eigen::Index i = 0; i < ff.F.rows(); ++i) {
+    // Every direction from a face ends on another face: the row sums to 1 exactly. Each of
+    // its <= 7 entries is within its estimate (<= tol when converged, calibrated).
+    double sum = 0.0, err = 0.0;
+    for (SparseF::InnerIterator it(ff.F, i); it; ++it) {
+      sum += it.value();
+      err += ff.stderr_F.coeff(i, it.col());
+      // Reciprocity: both entries come from one G (divided by each area).
+      const double a = mesh.patches[i].area * it.value(), b = mesh.patches[it.col()].area * ff.F.coeff(it.col(), i);
+      EXPECT_NEAR(a, b, 1e-15 * a);
+    }
+    EXPECT_LE(err, 7 * o.tol) << "row " << i;
+    EXPECT_NEAR(sum, 1.0, 7 * o.tol) << "row " << i << " (" << mesh.surface_names[mesh.patches[i].surface] << ")";
+  }
+  // The cube's faces see a little less of the opposite face than the empty cube's exact
+  // opposite factor; the plate takes the difference.
+  EXPECT_LT(ff.F.coeff(4, 5), kCubeOpposite);
+}
+
+}  // namespace
+}  // namespace lambert
