@@ -45,6 +45,13 @@ constexpr double kCheckInset = 0.05;
 // Event segments closer than this to a singular point (the line through v and the edge runs
 // parallel to a's plane) are cut there, relative to the edge's parameter.
 constexpr double kParamMargin = 1e-9;
+// Event segments a pair's partition takes at most: a CDT of k crossing segments has O(k²)
+// cells, each classified by the booleans. Beyond it, the blocker-blocker events are left to
+// refinement first, then all.
+constexpr size_t kMaxEvents = 400;
+// Point factors through the polygon booleans a pair may spend (~0.1-2 ms each, growing
+// with the blockers), beside the budget on all point factors.
+constexpr std::int64_t kMaxBooleanEvaluations = 5000;
 
 using Frame = PlaneFrame;
 
@@ -160,18 +167,22 @@ bool identify(const Features& f, const Eigen::Vector3d& x, const Eigen::Vector3d
   pattern.clear();
   const std::vector<Polygon3> loops = visible_emitter_region(x, n, f.emitter, f.pieces);
   if (loops.empty()) return true;
-  // Every candidate at x, in priority order (corners before crossings).
+  // The features at x: corners (b's, and the blockers' projected), and every edge line
+  // normalised so that |l . (q, 1)| is the distance of q from it.
   const double dx = f.fb.height(x);
-  std::vector<std::pair<Source, Eigen::Vector2d>> candidates;
-  auto add = [&](Source s) {
+  std::vector<std::pair<Source, Eigen::Vector2d>> corners;
+  auto add_corner = [&](Source s) {
     Eigen::Vector2d q;
-    if (f.point(s, x, dx, q)) candidates.emplace_back(s, q);
+    if (f.point(s, x, dx, q)) corners.emplace_back(s, q);
   };
-  for (int k = 0; k < static_cast<int>(f.emitter2.size()); ++k) add({Source::kEmitterCorner, k, 0});
-  for (int k = 0; k < static_cast<int>(f.corners.size()); ++k) add({Source::kBlockerCorner, k, 0});
-  const int lines = f.line_count();
-  for (int a = 0; a < lines; ++a)
-    for (int b = a + 1; b < lines; ++b) add({Source::kCrossing, a, b});
+  for (int k = 0; k < static_cast<int>(f.emitter2.size()); ++k) add_corner({Source::kEmitterCorner, k, 0});
+  for (int k = 0; k < static_cast<int>(f.corners.size()); ++k) add_corner({Source::kBlockerCorner, k, 0});
+  std::vector<Line> lines(f.line_count());
+  for (int k = 0; k < f.line_count(); ++k) {
+    lines[k] = f.line(k, x);
+    const double g = lines[k].head<2>().norm();
+    lines[k] = g > 0.0 ? Line(lines[k] / g) : Line(0.0, 0.0, INFINITY);
+  }
   const double match = kMatchTol * f.scale, same = kSameTol * f.scale;
   for (const auto& loop : loops) {
     // Rounding slivers (the booleans' output between blocker pieces meeting along an edge)
@@ -180,6 +191,20 @@ bool identify(const Features& f, const Eigen::Vector3d& x, const Eigen::Vector3d
     std::vector<Source> out;
     for (const auto& p : loop) {
       const Eigen::Vector2d q = f.fb.to2d(p);
+      // The candidates near q, in priority order: corners, then the crossings of the lines
+      // that pass near q (O(corners + lines) per vertex, not all crossings).
+      std::vector<std::pair<Source, Eigen::Vector2d>> candidates;
+      for (const auto& c : corners)
+        if ((c.second - q).norm() <= match) candidates.push_back(c);
+      std::vector<int> near;
+      for (int k = 0; k < static_cast<int>(lines.size()); ++k)
+        if (std::abs(lines[k].x() * q.x() + lines[k].y() * q.y() + lines[k].z()) <= match) near.push_back(k);
+      for (size_t i = 0; i < near.size(); ++i)
+        for (size_t j = i + 1; j < near.size(); ++j) {
+          const Source s{Source::kCrossing, near[i], near[j]};
+          Eigen::Vector2d c;
+          if (f.point(s, x, dx, c)) candidates.emplace_back(s, c);
+        }
       int best = -1;
       double best_d = INFINITY;
       for (size_t c = 0; c < candidates.size(); ++c) {
@@ -207,6 +232,7 @@ struct Cell {
   std::array<Eigen::Vector3d, 3> p;
   bool fast = true;  // integrand from `pattern`; else through the booleans at every point
   int pattern = -1;
+  bool crude = false;  // over the boolean budget: the centroid rule, est = |value|
   double low = 0.0, high = 0.0, est = 0.0;
 };
 
@@ -251,6 +277,15 @@ struct Integrator {
     const double area = 0.5 * (c.p[1] - c.p[0]).cross(c.p[2] - c.p[0]).norm();
     if (c.fast && c.pattern < 0) {
       c.low = c.high = c.est = 0.0;  // umbra: exactly 0
+      return;
+    }
+    if (!c.fast && out.boolean_evaluations >= kMaxBooleanEvaluations) {
+      // Over budget: the centroid's value for the cell, wholly uncertain (it is 0 to twice
+      // that as far as anyone knows); the pair ends unconverged.
+      c.low = c.high = area * integrand(c, (c.p[0] + c.p[1] + c.p[2]) / 3.0);
+      c.est = std::abs(c.low);
+      c.crude = true;
+      out.converged = false;
       return;
     }
     double q[2] = {0.0, 0.0};
@@ -312,21 +347,42 @@ bool clip_segment(Eigen::Vector2d& p, Eigen::Vector2d& q, const std::vector<Eige
   return true;
 }
 
+// Whether the lines through v and the points s(t) = p + t (q - p), t in [t0, t1], meet b's
+// plane inside the emitter (else their event changes nothing b shows): conservative where
+// the meeting point runs off to infinity.
+bool reaches_emitter(const Features& f, const Eigen::Vector3d& v, const Eigen::Vector3d& p,
+                     const Eigen::Vector3d& q, double t0, double t1, double eps) {
+  const double hv = f.fb.height(v), hp = f.fb.height(p), hq = f.fb.height(q);
+  if (hq != hp) {
+    const double ts = (hv - hp) / (hq - hp);
+    if (ts >= t0 && ts <= t1) return true;
+  } else if (hp == hv) {
+    return true;
+  }
+  auto at = [&](double t) {
+    const Eigen::Vector3d s = p + t * (q - p);
+    const double hs = hp + t * (hq - hp);
+    return f.fb.to2d(v + (s - v) * (hv / (hv - hs)));
+  };
+  Eigen::Vector2d y0 = at(t0), y1 = at(t1);
+  if (!y0.allFinite() || !y1.allFinite()) return true;
+  if ((y1 - y0).norm() <= eps) y1 = y0 + Eigen::Vector2d(2.0 * eps, 0.0);
+  return clip_segment(y0, y1, f.emitter2, 0.0);
+}
+
 // The event segments on a (2-D in fa), clipped to the receiver polygon r2.
 std::vector<std::array<Eigen::Vector2d, 2>> event_segments(const Features& f,
                                                             const std::vector<Eigen::Vector2d>& r2,
                                                             double eps) {
-  std::vector<std::array<Eigen::Vector2d, 2>> out;
+  std::vector<std::array<Eigen::Vector2d, 2>> direct, between;  // with b; blocker-blocker
   double radius = 0.0;
   for (const auto& q : r2) radius = std::max(radius, (q - r2[0]).norm());
-  auto add = [&](Eigen::Vector2d p, Eigen::Vector2d q) {
+  auto add = [&](std::vector<std::array<Eigen::Vector2d, 2>>& out, Eigen::Vector2d p, Eigen::Vector2d q) {
     if (!clip_segment(p, q, r2, eps)) return;
-    for (const auto& s : out)
-      if (((s[0] - p).norm() <= eps && (s[1] - q).norm() <= eps) ||
-          ((s[0] - q).norm() <= eps && (s[1] - p).norm() <= eps))
-        return;
+    if (q.x() < p.x() || (q.x() == p.x() && q.y() < p.y())) std::swap(p, q);
     out.push_back({p, q});
   };
+  const double eps_b = kSameTol * f.scale;
   // Objects: 0 the emitter, 1.. the pieces; each as corners and edges.
   std::vector<const Polygon3*> objects{&f.emitter};
   for (const auto& piece : f.pieces) objects.push_back(&piece);
@@ -357,7 +413,13 @@ std::vector<std::array<Eigen::Vector2d, 2>> event_segments(const Features& f,
             const double hs = hp + t * (hq - hp);
             return f.fa.to2d(v + (s - v) * (hv / (hv - hs)));
           };
-          for (size_t c = 0; c + 1 < cuts.size(); c += 2) add(at(cuts[c]), at(cuts[c + 1]));
+          for (size_t c = 0; c + 1 < cuts.size(); c += 2) {
+            if (A == 0 || B == 0) {
+              add(direct, at(cuts[c]), at(cuts[c + 1]));
+            } else if (reaches_emitter(f, v, p, q, cuts[c], cuts[c + 1], eps_b)) {
+              add(between, at(cuts[c]), at(cuts[c + 1]));
+            }
+          }
         }
       }
     }
@@ -371,9 +433,28 @@ std::vector<std::array<Eigen::Vector2d, 2>> event_segments(const Features& f,
     const Eigen::Vector2d normal = l.head<2>() / g, foot = -(l.z() / g) * normal;
     const Eigen::Vector2d dir(-normal.y(), normal.x());
     const double reach = (foot - r2[0]).norm() + 2.0 * radius;
-    add(foot - reach * dir, foot + reach * dir);
+    add(direct, foot - reach * dir, foot + reach * dir);
   }
-  return out;
+  // Duplicates (aligned geometry repeats lines) sorted together and dropped; beyond
+  // kMaxEvents the blocker-blocker events go first, then all (refinement takes over).
+  auto dedupe = [&](std::vector<std::array<Eigen::Vector2d, 2>>& v) {
+    std::sort(v.begin(), v.end(), [](const auto& x, const auto& y) {
+      return x[0].x() != y[0].x() ? x[0].x() < y[0].x() : x[0].y() < y[0].y();
+    });
+    std::vector<std::array<Eigen::Vector2d, 2>> out;
+    for (const auto& seg : v) {
+      bool dup = false;
+      for (size_t k = out.size(); k-- > 0 && out[k][0].x() >= seg[0].x() - eps && !dup;)
+        dup = (out[k][0] - seg[0]).norm() <= eps && (out[k][1] - seg[1]).norm() <= eps;
+      if (!dup) out.push_back(seg);
+    }
+    v.swap(out);
+  };
+  dedupe(direct);
+  dedupe(between);
+  if (direct.size() > kMaxEvents) return {};
+  if (direct.size() + between.size() <= kMaxEvents) direct.insert(direct.end(), between.begin(), between.end());
+  return direct;
 }
 
 // The side planes of the shaft between two convex polygons (Haines & Wallace): the planes
@@ -509,7 +590,10 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
     in.patterns.push_back(full);
     for (Cell& c : cells) c.pattern = 0;
   } else {
-    for (Cell& c : cells) in.classify(c);
+    for (Cell& c : cells) {
+      if (in.out.boolean_evaluations < kMaxBooleanEvaluations) in.classify(c);
+      else c.fast = false;  // over budget: integrate() takes the centroid only
+    }
   }
   for (Cell& c : cells) in.integrate(c);
 
@@ -528,7 +612,7 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
   while (!queue.empty()) {
     const double tol = std::max(tol_G, kRoundingFloor * std::abs(total));
     if (!(std::max(total_est, pair_error(total_diff, total_est)) > tol)) break;
-    if (in.out.evaluations >= max_evaluations) {
+    if (in.out.evaluations >= max_evaluations || in.out.boolean_evaluations >= kMaxBooleanEvaluations) {
       in.out.converged = false;
       break;
     }
@@ -560,16 +644,20 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
   }
   AnalyticEstimate out = in.out;
   out.G = 0.0;
-  double diff = 0.0, abs_diff = 0.0;
+  double diff = 0.0, abs_diff = 0.0, crude = 0.0;
   for (size_t k = 0; k < cells.size(); ++k) {
     if (!leaf[k]) continue;
     out.G += cells[k].low;
-    diff += cells[k].high - cells[k].low;
-    abs_diff += cells[k].est;
+    if (cells[k].crude) {
+      crude += cells[k].est;
+    } else {
+      diff += cells[k].high - cells[k].low;
+      abs_diff += cells[k].est;
+    }
     ++out.cells;
   }
   out.G = std::max(0.0, out.G);
-  out.error = std::max(pair_error(diff, abs_diff), kRoundingFloor * out.G);
+  out.error = std::max(pair_error(diff, abs_diff) + crude, kRoundingFloor * out.G);
   return out;
 }
 
