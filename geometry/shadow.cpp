@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "geometry/formfactors/constants.hpp"
 #include "geometry/formfactors/kernels.hpp"
 #include "geometry/polygon.hpp"
 
@@ -107,7 +108,11 @@ std::vector<Polygon3> visible_emitter_region(const Eigen::Vector3d& x, const Eig
   if (emitter.size() < 3 || !(polygon_area(emitter) > 0.0)) return {};
   const ExactFrame f = frame_of(emitter);
   const double dx = (x - f.o).dot(f.w);  // x's height above the emitter's front side
-  if (!(dx > 0.0)) return {};
+  // x within rounding of the emitter's plane sees it edge-on (factor 0); projections from it
+  // would divide by rounding noise (a patch touching the emitter's plane along an edge puts
+  // refined quadrature points there). The rounding of dx is relative to the coordinates'
+  // magnitude, so the tolerance is too (ff::kPlaneEps, the one plane epsilon).
+  if (!(dx > ff::kPlaneEps * (x.norm() + f.o.norm() + polygon_extent(emitter)))) return {};
   PolygonSet2 visible = polygon_set(emitter, f);
 
   // The horizon: emitter points y with n . (y - x) > 0, the half-plane a + b s + c t > 0.
@@ -182,8 +187,11 @@ std::vector<Polygon3> visible_emitter_region(const Eigen::Vector3d& x, const Eig
       for (size_t k = 0; k < side_normals.size() && part.size() >= 3; ++k)
         part = clip(part, [&](const Eigen::Vector3d& p) { return side_normals[k].dot(p - x); });
       if (part.size() < 3) continue;
+      // The clips keep every height <= hi up to rounding: the denominator is bounded below
+      // by dx - hi = kSlabMargin dx > 0, so every projection is finite.
       std::vector<Point2> pts;
-      for (const auto& p : part) pts.push_back(f.to2d(x + (p - x) * (dx / (dx - height(p)))));
+      for (const auto& p : part)
+        pts.push_back(f.to2d(x + (p - x) * (dx / std::max(dx - height(p), dx - hi))));
       Polygon2 shadow = simple_ccw(pts);
       if (!shadow.is_empty()) shadows.push_back(std::move(shadow));
     }

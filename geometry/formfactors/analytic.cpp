@@ -377,8 +377,13 @@ std::vector<std::array<Eigen::Vector2d, 2>> event_segments(const Features& f,
   std::vector<std::array<Eigen::Vector2d, 2>> direct, between;  // with b; blocker-blocker
   double radius = 0.0;
   for (const auto& q : r2) radius = std::max(radius, (q - r2[0]).norm());
-  auto add = [&](std::vector<std::array<Eigen::Vector2d, 2>>& out, Eigen::Vector2d p, Eigen::Vector2d q) {
-    if (!clip_segment(p, q, r2, eps)) return;
+  // A line through v nearly parallel to a's plane meets it at rounding-noise distances
+  // (hv / (hv - hs) overflows or is 0/0): such a segment is dropped, which only leaves its
+  // event to refinement (events speed the quadrature up; they are never needed for it).
+  auto add = [&](std::vector<std::array<Eigen::Vector2d, 2>>& out, Eigen::Vector2d p,
+                 Eigen::Vector2d q) {
+    if (!p.allFinite() || !q.allFinite() || !clip_segment(p, q, r2, eps)) return;
+    if (!p.allFinite() || !q.allFinite()) return;
     if (q.x() < p.x() || (q.x() == p.x() && q.y() < p.y())) std::swap(p, q);
     out.push_back({p, q});
   };

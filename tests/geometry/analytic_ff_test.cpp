@@ -147,6 +147,39 @@ TEST(AnalyticPair, ErrorEstimateIsCalibrated) {
   EXPECT_LE(far_below, runs / 20) << runs << " runs";
 }
 
+TEST(AnalyticPair, CornellBlockFaceToTiltedWallIsFinite) {
+  // Regression: a pair of the measured Cornell box at 20 patches (mm; the tall block's side
+  // face, standing on the floor, to half of the slightly tilted right wall, past the floor,
+  // walls and the block's other faces). Event lines through corners on the floor, at a's
+  // height, met a's plane at overflowing coordinates (inf, 0/0), and CGAL's CDT raised
+  // SIGFPE in GMP on them. G must be finite, 0 <= G <= min(A_a, A_b) (G = A_a F_ab with
+  // F <= 1 both ways), with a finite estimate, whatever the budget.
+  const Polygon3 a{
+      {423.0, 0.0, 247.0}, {423.0, 330.0, 247.0}, {472.0, 330.0, 406.0}, {472.0, 0.0, 406.0}};
+  const Polygon3 b{{552.8, 0.0, 0.0}, {549.6, 0.0, 559.2}, {556.0, 548.8, 559.2}};
+  const std::vector<Polygon3> blockers{
+      {{552.8, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 559.2}, {549.6, 0.0, 559.2}},
+      {{556.0, 548.8, 0.0}, {556.0, 548.8, 227.0}, {0.0, 548.8, 227.0}, {0.0, 548.8, 0.0}},
+      {{556.0, 548.8, 332.0}, {556.0, 548.8, 559.2}, {0.0, 548.8, 559.2}, {0.0, 548.8, 332.0}},
+      {{556.0, 548.8, 227.0}, {556.0, 548.8, 332.0}, {343.0, 548.8, 332.0}, {343.0, 548.8, 227.0}},
+      {{549.6, 0.0, 559.2}, {0.0, 0.0, 559.2}, {0.0, 548.8, 559.2}, {556.0, 548.8, 559.2}},
+      {{552.8, 0.0, 0.0}, {556.0, 548.8, 559.2}, {556.0, 548.8, 0.0}},
+      {{423.0, 330.0, 247.0}, {265.0, 330.0, 296.0}, {314.0, 330.0, 456.0}, {472.0, 330.0, 406.0}},
+      {{472.0, 0.0, 406.0}, {472.0, 330.0, 406.0}, {314.0, 330.0, 456.0}, {314.0, 0.0, 456.0}},
+      {{265.0, 0.0, 296.0}, {265.0, 330.0, 296.0}, {423.0, 330.0, 247.0}, {423.0, 0.0, 247.0}}};
+  const double bound = std::min(polygon_area(a), polygon_area(b));
+  std::vector<ff::AnalyticEstimate> runs;
+  for (std::int64_t budget : {std::int64_t{200}, std::int64_t{20000}}) {
+    const ff::AnalyticEstimate e = ff::analytic_pair_G(a, b, blockers, 1e-6 * bound, budget);
+    ASSERT_TRUE(std::isfinite(e.G) && std::isfinite(e.error)) << budget;
+    EXPECT_GE(e.G, 0.0);
+    EXPECT_LE(e.G, bound * (1 + 1e-12));
+    runs.push_back(e);
+  }
+  // The two budgets agree within their estimates (each the low rule's error, calibrated).
+  EXPECT_NEAR(runs[0].G, runs[1].G, runs[0].error + runs[1].error);
+}
+
 // The inside of the unit cube with a two-sided plate (two faces back to back), tilted so that
 // its edge-on line and contact-free shadows cut every face's integral.
 Scene cube_with_plate() {

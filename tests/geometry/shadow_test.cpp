@@ -163,5 +163,40 @@ TEST(ShadowKernel, ContactAndDegenerateBlockersDoNotBreakIt) {
   EXPECT_NEAR(shadowed_point_factor(x, kUp, g.light, {flat, two}), open, 1e-14);
 }
 
+TEST(ShadowKernel, PointsWithinRoundingOfTheEmitterPlaneSeeNothingAndNeverCrash) {
+  // Regression: the analytic estimator's refined quadrature points next to a contact edge of
+  // the Cornell box (mm coordinates, tilted walls) sat 1e-14 above the emitter's plane, where
+  // the recomputed heights of clipped blocker corners exceed x's by rounding: the projection
+  // divided by zero and GMP raised SIGFPE on the non-finite corner. A point that close sees
+  // the emitter edge-on: its factor is 0 up to O(height / distance).
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Eigen::Vector3d w = Eigen::Vector3d(0.3, 1.0, 0.2).normalized();
+  const Eigen::Vector3d e1 = w.unitOrthogonal(), e2 = w.cross(e1);
+  const Eigen::Vector3d c(400.0, 300.0, 500.0);  // Cornell-box magnitudes (mm)
+  const Polygon3 emitter{c - 150 * e1 - 150 * e2, c + 150 * e1 - 150 * e2, c + 150 * e1 + 150 * e2,
+                         c - 150 * e1 + 150 * e2};
+  ASSERT_GT(newell_normal(emitter).dot(w), 0.0);
+  for (int trial = 0; trial < 2000; ++trial) {
+    // x beside the emitter (60 to 100 mm past its edge), within 1e-16 .. 1e-11 of the
+    // coordinates' magnitude of its plane.
+    const double height = std::pow(10.0, -16.0 + 5.0 * (0.5 + 0.5 * u(rng))) * c.norm();
+    const Eigen::Vector3d x = c + (230 + 20 * u(rng)) * e1 + 100 * u(rng) * e2 + height * w;
+    const Eigen::Vector3d n = (w + 0.5 * u(rng) * e1).normalized();
+    // A plate crossing the emitter's plane between x and the emitter, at a random tilt.
+    const Eigen::Vector3d m = c + (180 + 5 * u(rng)) * e1 + 30 * u(rng) * e2;
+    const Eigen::Vector3d s = (e2 + 0.3 * u(rng) * e1).normalized(),
+                          t = (w + 0.3 * u(rng) * e1).normalized();
+    const Polygon3 plate{m - 80 * s - 40 * t, m + 80 * s - 40 * t, m + 80 * s + 40 * t,
+                         m - 80 * s + 40 * t};
+    const double f = shadowed_point_factor(x, n, emitter, {plate});
+    ASSERT_TRUE(std::isfinite(f)) << trial;
+    // F = (1/pi) ∫ cos cos' / r² dA with cos' = height / r <= height / 60 at the emitter
+    // (x is >= 60 mm beside it) and ∫ cos dω <= pi: F <= height / 60 (+ rounding, 1e-15).
+    EXPECT_LE(f, height / 60 + 1e-15) << trial << " height " << height;
+    EXPECT_GE(f, 0.0);
+  }
+}
+
 }  // namespace
 }  // namespace lambert
