@@ -97,6 +97,7 @@ FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run
   o.specular_depth = args.specular_depth;
   o.specular_rays = args.specular_rays;
   o.tol = args.tol;
+  o.tol_given = args.tol_given;
   if (args.estimator != "auto") {
     const std::vector<std::string> unused = unused_count_options(args, args.estimator);
     if (!unused.empty())
@@ -124,9 +125,12 @@ namespace {
 // picked estimator ignores.
 void log_auto_pick(const FormFactors& ff, const FormFactorArgs& args, std::int32_t patches) {
   if (ff.options.estimator_requested != "auto") return;
-  log_info("form factors: auto picked " + ff.options.estimator + " (" + std::to_string(patches) +
-           " patches " + (ff.options.estimator == "gather" ? ">= " : "< ") +
-           std::to_string(kAutoGatherPatches) + ")");
+  const std::string why = ff.options.tol_given
+                              ? "--ff-tol given"
+                              : std::to_string(patches) + " patches " +
+                                    (ff.options.estimator == "gather" ? ">= " : "< ") +
+                                    std::to_string(kAutoGatherPatches);
+  log_info("form factors: auto picked " + ff.options.estimator + " (" + why + ")");
   for (const std::string& opt : unused_count_options(args, ff.options.estimator))
     log_warn(opt + " is ignored: --estimator auto picked " + ff.options.estimator);
 }
@@ -180,7 +184,13 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
                                       " of them on specular paths (depth " +
                                       std::to_string(ff.options.specular_depth) + ")"
                                 : ""));
-  if (ff.stats.pairs_unverified > 0)
+  if (ff.stats.pairs_unverified > 0 && ff.options.estimator == "analytic")
+    log_warn(std::to_string(ff.stats.pairs_unverified) +
+             " patch pairs did not reach --ff-tol within their budget of point factors: their "
+             "entries carry a larger error estimate (--stderr shows it); many blockers per pair "
+             "or blockers standing on both patches are the likely cause (README \"The analytic "
+             "estimator\": hybrid or gather suit such scenes)");
+  else if (ff.stats.pairs_unverified > 0)
     log_warn(std::to_string(ff.stats.pairs_unverified) +
              " patch pairs could not have their visibility sampled as designed (no ray could be "
              "traced, or the kernel sampler gave up): their factors are unoccluded values or "

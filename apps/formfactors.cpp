@@ -163,10 +163,12 @@ int run_formfactors(const FormFactorsOptions& opts) {
     plan.outputs.push_back({"--report", report});
     plan_form_factors(plan, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
   }
-  // The analytic estimator integrates over whole polygons: one patch per face unless
-  // --max-edge or --patches asks for more.
+  // The analytic estimator (named, or auto's pick for --ff-tol) integrates over whole
+  // polygons: one patch per face unless --max-edge or --patches asks for more.
   SceneArgs scene_args = opts.scene;
-  if (opts.ff.estimator == "analytic") scene_args.default_patches = 0;
+  if ((opts.ff.estimator == "auto" ? auto_estimator(0, opts.ff.tol_given) : opts.ff.estimator) ==
+      "analytic")
+    scene_args.default_patches = 0;
   const LoadedScene scene = load_scene(scene_args, plan);
   if (!opts.point.empty()) {
     const FormFactorOptions o = make_ff_options(opts.ff, opts.run);

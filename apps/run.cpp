@@ -252,8 +252,9 @@ int run_matrix(const RunOptions& opts) {
   log_info("      " + std::to_string(loaded.mesh.size()) + " patches on " +
            std::to_string(loaded.mesh.surface_names.size()) + " surfaces");
 
-  const std::string estimator =
-      opts.ff.estimator == "auto" ? auto_estimator(loaded.mesh.size()) : opts.ff.estimator;
+  const std::string estimator = opts.ff.estimator == "auto"
+                                    ? auto_estimator(loaded.mesh.size(), opts.ff.tol_given)
+                                    : opts.ff.estimator;
   const std::string count = estimator_count_option(estimator);
   const std::string per =
       count == "rays"      ? ", " + std::to_string(opts.ff.rays) + " rays per patch"

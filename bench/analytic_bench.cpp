@@ -4,13 +4,14 @@
 //     edge, the partial-shadow scene): per --tol, the median time of one pair integral over
 //     5 runs, its true error, the stated error estimate and their ratio, point factors
 //     evaluated and how many went through the polygon booleans;
-//  2. a closed 101-polygon room with 19 boxes (one patch per face): full F per --tol, time,
+//  2. a closed room with 0..19 boxes (--room-boxes; 101 polygons with 19, one patch per
+//     face): full F per --tol, time,
 //     the largest |row sum - 1| (exactly 0 for exact factors: every direction ends on a face)
 //     and the largest entry difference to the tightest run, next to hybrid at 32 and 1024
 //     samples on the same mesh;
 //  3. the crossover against hybrid on the Cornell box at a few patch counts (auto's rule).
-// Usage: analytic_bench [--tols 1e-4,1e-6,1e-8] [--room-tols 1e-4] [--cornell 50,150] [-j N]
-//                       [--sections few,room,cornell]
+// Usage: analytic_bench [--tols 1e-4,1e-6,1e-8] [--room-tols 1e-4] [--room-boxes 19]
+//                       [--cornell 50,150] [-j N] [--sections few,room,cornell]
 
 #include <algorithm>
 #include <cmath>
@@ -96,9 +97,9 @@ void few_polygons(const std::vector<double>& tols) {
   std::printf("\n");
 }
 
-// A closed 10 x 8 x 3 room (faces inward) with 19 boxes standing on the floor (5 faces each,
-// outward): 101 polygons.
-Scene furnished_room() {
+// A closed 10 x 8 x 3 room (faces inward) with up to 19 boxes standing on the floor (5 faces
+// each, outward): 6 + 5 boxes polygons (101 with all 19).
+Scene furnished_room(int boxes) {
   Scene s;
   const Material grey("grey", Eigen::Vector3d::Constant(0.5));
   const double X = 10, Y = 8, Z = 3;
@@ -112,6 +113,7 @@ Scene furnished_room() {
   for (int i = 0; i < 5; ++i)
     for (int j = 0; j < 4; ++j) {
       if (i == 2 && j == 2) continue;  // 19 boxes
+      if (n == boxes) return s;
       const double x0 = 0.6 + 1.9 * i + 0.1 * (j % 2), y0 = 0.7 + 1.8 * j + 0.15 * (i % 3);
       const double x1 = x0 + 0.8 + 0.1 * ((i + j) % 3), y1 = y0 + 0.6 + 0.1 * ((i * j) % 4);
       const double h = 0.5 + 0.25 * ((i + 2 * j) % 5);
@@ -135,9 +137,10 @@ double max_difference(const SparseF& a, const SparseF& b) {
   return (SparseF(a - b)).coeffs().cwiseAbs().maxCoeff();
 }
 
-void room(const std::vector<double>& tols, int threads) {
-  const PatchMesh mesh = mesh_scene(furnished_room(), {});
-  std::printf("2. furnished room: %d polygons, one patch each, -j %d\n", mesh.size(), threads);
+void room(const std::vector<double>& tols, int boxes, int threads) {
+  const PatchMesh mesh = mesh_scene(furnished_room(boxes), {});
+  std::printf("2. furnished room: %d boxes, %d polygons, one patch each, -j %d\n", boxes,
+              mesh.size(), threads);
   std::printf("%-22s %10s %14s %14s %8s\n", "estimator", "s", "max|rowsum-1|", "max|F-F_tight|", "nnz");
   std::vector<FormFactors> runs;
   std::vector<std::string> names;
@@ -192,7 +195,7 @@ void cornell(const std::vector<double>& sizes, int threads) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<double> tols{1e-4, 1e-6, 1e-8}, room_tols{1e-4}, sizes{50, 150};
+  std::vector<double> tols{1e-4, 1e-6, 1e-8}, room_tols{1e-4}, sizes{50, 150}, boxes{19};
   int threads = 0;
   std::string sections = "few,cornell,room";
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -200,6 +203,8 @@ int main(int argc, char** argv) {
     if (a == "--tols") tols = parse_list(v);
     else if (a == "--room-tols") room_tols = parse_list(v);
     else if (a == "--cornell") sizes = parse_list(v);
+    else if (a == "--room-boxes")
+      boxes = parse_list(v);
     else if (a == "-j") threads = std::atoi(v.c_str());
     else if (a == "--sections") sections = v;
     else {
@@ -210,6 +215,7 @@ int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // figures as they come
   if (sections.find("few") != std::string::npos) few_polygons(tols);
   if (sections.find("cornell") != std::string::npos) cornell(sizes, threads);
-  if (sections.find("room") != std::string::npos) room(room_tols, threads);
+  if (sections.find("room") != std::string::npos)
+    for (double k : boxes) room(room_tols, static_cast<int>(k), threads);
   return 0;
 }

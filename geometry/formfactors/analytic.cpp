@@ -694,20 +694,48 @@ std::vector<Polygon3> blockers_in(const Bvh& bvh, const std::vector<PatchGeom>& 
   return blockers;
 }
 
+// Whether a blocker corner lies on p's plane strictly inside p (a blocker standing on it),
+// within kMatchTol of p's size; corners on p's boundary (walls meeting a floor's edge)
+// do not count.
+bool blocker_stands_on(const Polygon3& p, const std::vector<Polygon3>& blockers) {
+  const Frame f = frame_of(p);
+  const double scale = polygon_extent(p), eps = kMatchTol * scale;
+  std::vector<Eigen::Vector2d> q;
+  for (const auto& c : p) q.push_back(f.to2d(c));
+  for (const auto& b : blockers) {
+    for (const auto& c : b) {
+      if (std::abs(f.height(c)) > eps) continue;
+      const Eigen::Vector2d x = f.to2d(c);
+      bool inside = true;
+      for (size_t k = 0; k < q.size() && inside; ++k) {
+        const Eigen::Vector2d e = q[(k + 1) % q.size()] - q[k];
+        inside = (e.x() * (x - q[k]).y() - e.y() * (x - q[k]).x()) / e.norm() > eps;
+      }
+      if (inside) return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 PairEstimate estimate_analytic(const PairContext& ctx, std::int32_t i, std::int32_t j) {
-  // Integrate over the smaller patch (fewer cells for the same accuracy per unit area).
   const PatchGeom& gi = ctx.geom[i];
   const PatchGeom& gj = ctx.geom[j];
-  const bool i_smaller = gi.area <= gj.area;
-  const PatchGeom& a = i_smaller ? gi : gj;
-  const PatchGeom& b = i_smaller ? gj : gi;
   Eigen::AlignedBox3d box;
-  for (int k = 0; k < a.n; ++k) box.extend(a.p[k]);
-  for (int k = 0; k < b.n; ++k) box.extend(b.p[k]);
-  const AnalyticEstimate e = analytic_pair_G(polygon_of(a), polygon_of(b),
-                                             blockers_in(ctx.bvh, ctx.geom, box, i, j),
+  for (int k = 0; k < gi.n; ++k) box.extend(gi.p[k]);
+  for (int k = 0; k < gj.n; ++k) box.extend(gj.p[k]);
+  const std::vector<Polygon3> blockers = blockers_in(ctx.bvh, ctx.geom, box, i, j);
+  // Integrate over the side no blocker stands on: next to a contact inside the integrated
+  // patch (a box on a floor) blockers project arbitrarily large and the visible polygon
+  // changes without end, so refinement converges slowly there; seen from the other side the
+  // same blockers are far and the integrand smooth. Else over the smaller patch (fewer
+  // cells for the same accuracy per unit area).
+  const Polygon3 pi = polygon_of(gi), pj = polygon_of(gj);
+  const bool contact_i = blocker_stands_on(pi, blockers),
+             contact_j = blocker_stands_on(pj, blockers);
+  const bool over_i = contact_i != contact_j ? contact_j : gi.area <= gj.area;
+  const AnalyticEstimate e = analytic_pair_G(over_i ? pi : pj, over_i ? pj : pi, blockers,
                                              ctx.tol * std::min(gi.area, gj.area));
   PairEstimate out;
   out.G = e.G;

@@ -225,7 +225,8 @@ std::vector<std::string> form_factor_estimator_choices() {
   return names;
 }
 
-std::string auto_estimator(std::int64_t patches) {
+std::string auto_estimator(std::int64_t patches, bool tol_given) {
+  if (tol_given) return "analytic";
   return patches >= kAutoGatherPatches ? "gather" : "hybrid";
 }
 
@@ -237,7 +238,7 @@ FormFactorOptions resolve_form_factor_options(const FormFactorOptions& options,
                                               std::int64_t patches) {
   FormFactorOptions o = options;
   if (o.estimator == "auto") {
-    o.estimator = auto_estimator(patches);
+    o.estimator = auto_estimator(patches, o.tol_given);
     o.estimator_requested = "auto";
   }
   const EstimatorEntry& e = find_estimator(o.estimator);

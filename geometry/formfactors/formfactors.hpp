@@ -20,8 +20,8 @@ using SparseF = SparseRowMatrix;
 
 /// Settings of one form-factor computation.
 struct FormFactorOptions {
-  /// A name from form_factor_estimators(), or "auto" (resolve_form_factor_options: hybrid
-  /// below kAutoGatherPatches patches, gather at or above).
+  /// A name from form_factor_estimators(), or "auto" (resolve_form_factor_options: analytic
+  /// when tol_given, else hybrid below kAutoGatherPatches patches, gather at or above).
   std::string estimator = "auto";
   /// What was asked for when `estimator` was resolved from "auto" ("" when it was named).
   std::string estimator_requested;
@@ -35,6 +35,9 @@ struct FormFactorOptions {
   /// Estimator "analytic": absolute error target of every entry F_ij (its quadrature error
   /// estimate, reported as the standard error).
   double tol = 1e-6;
+  /// The user asked for `tol` (--ff-tol): "auto" then picks analytic, the one estimator that
+  /// honours an error target (README "Choosing an estimator").
+  bool tol_given = false;
   /// "average": replace A_i F_ij and A_j F_ji by their mean (reciprocity.hpp); "none";
   /// "auto": average for gather, none for the others (the pair estimators are reciprocal by
   /// construction; the hemicube keeps its historical default, --symmetrize to average).
@@ -62,8 +65,9 @@ struct FormFactorStats {
   std::int64_t pairs_culled = 0;  ///< the other unordered pairs (facing away; gather: unseen)
   std::int64_t rays = 0;          ///< rays traced (occlusion; gather: closest-hit, N·K)
   /// Pairs whose visibility could not be sampled as designed (hybrid: no ray could be
-  /// traced, so the unoccluded value was kept; or a kernel-sampling rejection gave up):
-  /// reported and warned about, expected 0.
+  /// traced, so the unoccluded value was kept; or a kernel-sampling rejection gave up), or
+  /// (analytic) whose integral stopped at its budget before --ff-tol: reported and warned
+  /// about, expected 0.
   std::int64_t pairs_unverified = 0;
   double seconds = 0.0;           ///< wall time of the computation
   /// Reciprocity averaging (0 when not applied; see reciprocity.hpp), of its averaging step
@@ -123,8 +127,9 @@ std::vector<std::string> form_factor_estimator_choices();
 /// pairs take about a minute at this size, gather's O(N·K) rays about a second.
 constexpr std::int64_t kAutoGatherPatches = 6000;
 
-/// The estimator "auto" stands for at `patches` patches.
-std::string auto_estimator(std::int64_t patches);
+/// The estimator "auto" stands for at `patches` patches: "analytic" when an error target was
+/// given (`tol_given`), else by kAutoGatherPatches.
+std::string auto_estimator(std::int64_t patches, bool tol_given);
 
 /// Which per-count option an estimator reads: "samples" (pair estimators), "rays"
 /// (gather), "tol" (analytic: --ff-tol) or "" (hemicube). Throws UsageError for an unknown name (not "auto").

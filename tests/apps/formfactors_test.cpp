@@ -253,4 +253,19 @@ TEST(FormFactorsCommand, AnalyticFileKeepsItsTolerance) {
   EXPECT_EQ(settings.at("tol").get<double>(), 1e-7);
 }
 
+TEST(FormFactorsCommand, AutoWithAToleranceIsAnalyticOnWholeFaces) {
+  testing::TempDir dir;
+  const std::string obj = dir.write("s.obj", kPartialShadowObj);
+  const std::string out = dir.file("s.json");
+  // No --estimator: --tol alone asks for the estimator with an error target.
+  ASSERT_EQ(run({"formfactors", obj, "-q", "--by-surface", "--tol", "1e-9", "-o", out}), kExitOk);
+  const nlohmann::json report = parse_json_file(dir.file("s.report.json"));
+  EXPECT_EQ(report.at("form_factors").at("estimator").get<std::string>(), "analytic");
+  EXPECT_EQ(report.at("form_factors").at("estimator_requested").get<std::string>(), "auto");
+  EXPECT_EQ(report.at("patches").get<int>(), 3);  // one patch per face, as named analytic
+  // --tol 1e-9, the estimate calibrated to within 10x: the exact factor within 1e-8.
+  EXPECT_NEAR(parse_json_file(out).at("F")[0][1].get<double>(),
+              partial_shadow_floor_light_factor(24), 1e-8);
+}
+
 }  // namespace lambert

@@ -227,9 +227,12 @@ TEST(Reciprocity, TinyPatchUnderABigOneStaysBelowOne) {
 }
 
 TEST(FormFactorAuto, PicksHybridBelowAndGatherAtTheThreshold) {
-  EXPECT_EQ(auto_estimator(1), "hybrid");
-  EXPECT_EQ(auto_estimator(kAutoGatherPatches - 1), "hybrid");
-  EXPECT_EQ(auto_estimator(kAutoGatherPatches), "gather");
+  EXPECT_EQ(auto_estimator(1, false), "hybrid");
+  EXPECT_EQ(auto_estimator(kAutoGatherPatches - 1, false), "hybrid");
+  EXPECT_EQ(auto_estimator(kAutoGatherPatches, false), "gather");
+  // An error target asks for the one estimator that honours it, at any size.
+  EXPECT_EQ(auto_estimator(1, true), "analytic");
+  EXPECT_EQ(auto_estimator(kAutoGatherPatches, true), "analytic");
   FormFactorOptions o;  // the defaults: auto estimator, auto reciprocity
   const FormFactorOptions small = resolve_form_factor_options(o, 100);
   EXPECT_EQ(small.estimator, "hybrid");
