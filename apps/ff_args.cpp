@@ -125,11 +125,16 @@ namespace {
 // picked estimator ignores.
 void log_auto_pick(const FormFactors& ff, const FormFactorArgs& args, std::int32_t patches) {
   if (ff.options.estimator_requested != "auto") return;
-  const std::string why = ff.options.tol_given
-                              ? "--ff-tol given"
-                              : std::to_string(patches) + " patches " +
-                                    (ff.options.estimator == "gather" ? ">= " : "< ") +
-                                    std::to_string(kAutoGatherPatches);
+  const std::string n = std::to_string(patches) + " patches";
+  const std::string why =
+      ff.options.estimator == "analytic"
+          ? "--ff-tol given, " + n + " <= " + std::to_string(kAutoAnalyticMaxPatches)
+          : n + (ff.options.estimator == "gather" ? " >= " : " < ") +
+                std::to_string(kAutoGatherPatches) +
+                (ff.options.tol_given
+                     ? "; analytic only up to " + std::to_string(kAutoAnalyticMaxPatches) +
+                           " patches, name it to force it"
+                     : "");
   log_info("form factors: auto picked " + ff.options.estimator + " (" + why + ")");
   for (const std::string& opt : unused_count_options(args, ff.options.estimator))
     log_warn(opt + " is ignored: --estimator auto picked " + ff.options.estimator);

@@ -226,7 +226,7 @@ std::vector<std::string> form_factor_estimator_choices() {
 }
 
 std::string auto_estimator(std::int64_t patches, bool tol_given) {
-  if (tol_given) return "analytic";
+  if (tol_given && patches <= kAutoAnalyticMaxPatches) return "analytic";
   return patches >= kAutoGatherPatches ? "gather" : "hybrid";
 }
 

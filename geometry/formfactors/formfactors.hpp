@@ -21,7 +21,8 @@ using SparseF = SparseRowMatrix;
 /// Settings of one form-factor computation.
 struct FormFactorOptions {
   /// A name from form_factor_estimators(), or "auto" (resolve_form_factor_options: analytic
-  /// when tol_given, else hybrid below kAutoGatherPatches patches, gather at or above).
+  /// when tol_given on up to kAutoAnalyticMaxPatches patches, else hybrid below
+  /// kAutoGatherPatches patches, gather at or above).
   std::string estimator = "auto";
   /// What was asked for when `estimator` was resolved from "auto" ("" when it was named).
   std::string estimator_requested;
@@ -127,8 +128,15 @@ std::vector<std::string> form_factor_estimator_choices();
 /// pairs take about a minute at this size, gather's O(N·K) rays about a second.
 constexpr std::int64_t kAutoGatherPatches = 6000;
 
+/// `--estimator auto` with `--ff-tol` picks "analytic" up to this many patches. Its O(N²)
+/// pairs cost 0.1-10 ms each on plates and panels and up to seconds with boxes standing on
+/// the faces (README "The analytic estimator"): 500 patches are 125k pairs, minutes for a
+/// clean enclosure. Above it, auto ignores --ff-tol with a warning (name the estimator to
+/// force it).
+constexpr std::int64_t kAutoAnalyticMaxPatches = 500;
+
 /// The estimator "auto" stands for at `patches` patches: "analytic" when an error target was
-/// given (`tol_given`), else by kAutoGatherPatches.
+/// given (`tol_given`) and patches <= kAutoAnalyticMaxPatches, else by kAutoGatherPatches.
 std::string auto_estimator(std::int64_t patches, bool tol_given);
 
 /// Which per-count option an estimator reads: "samples" (pair estimators), "rays"

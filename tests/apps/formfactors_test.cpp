@@ -1,3 +1,5 @@
+#include "geometry/formfactors/formfactors.hpp"
+
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -266,6 +268,12 @@ TEST(FormFactorsCommand, AutoWithAToleranceIsAnalyticOnWholeFaces) {
   // --tol 1e-9, the estimate calibrated to within 10x: the exact factor within 1e-8.
   EXPECT_NEAR(parse_json_file(out).at("F")[0][1].get<double>(),
               partial_shadow_floor_light_factor(24), 1e-8);
+  // Above kAutoAnalyticMaxPatches, auto ignores the tolerance (with a warning) and samples.
+  ASSERT_EQ(run({"formfactors", obj, "-q", "--tol", "1e-9", "--patches", "600", "-o", out}),
+            kExitOk);
+  const nlohmann::json big = parse_json_file(dir.file("s.report.json"));
+  EXPECT_GT(big.at("patches").get<int>(), kAutoAnalyticMaxPatches);
+  EXPECT_EQ(big.at("form_factors").at("estimator").get<std::string>(), "hybrid");
 }
 
 }  // namespace lambert

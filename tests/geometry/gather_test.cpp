@@ -230,9 +230,11 @@ TEST(FormFactorAuto, PicksHybridBelowAndGatherAtTheThreshold) {
   EXPECT_EQ(auto_estimator(1, false), "hybrid");
   EXPECT_EQ(auto_estimator(kAutoGatherPatches - 1, false), "hybrid");
   EXPECT_EQ(auto_estimator(kAutoGatherPatches, false), "gather");
-  // An error target asks for the one estimator that honours it, at any size.
+  // An error target asks for the one estimator that honours it, up to its size limit.
   EXPECT_EQ(auto_estimator(1, true), "analytic");
-  EXPECT_EQ(auto_estimator(kAutoGatherPatches, true), "analytic");
+  EXPECT_EQ(auto_estimator(kAutoAnalyticMaxPatches, true), "analytic");
+  EXPECT_EQ(auto_estimator(kAutoAnalyticMaxPatches + 1, true), "hybrid");
+  EXPECT_EQ(auto_estimator(kAutoGatherPatches, true), "gather");
   FormFactorOptions o;  // the defaults: auto estimator, auto reciprocity
   const FormFactorOptions small = resolve_form_factor_options(o, 100);
   EXPECT_EQ(small.estimator, "hybrid");
