@@ -6,6 +6,7 @@
 #include "apps/adapt_stage.hpp"
 #include "apps/common.hpp"
 #include "apps/ff_args.hpp"
+#include "apps/medium_stage.hpp"
 #include "apps/method.hpp"
 #include "apps/render_stages.hpp"
 #include "solvers/radiosity.hpp"
@@ -112,6 +113,7 @@ struct RunOptions {
   AdaptArgs adapt;
   CameraArgs camera;
   ShadeArgs shade;
+  MediumArgs medium;               ///< participating medium (matrix method)
   std::string output_dir = "out";  ///< -o: output directory, created if needed
   std::string name;                ///< file prefix; empty = scene stem ("cornell" built-in)
 };
