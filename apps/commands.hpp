@@ -92,6 +92,7 @@ struct RenderOptions {
   AdaptArgs adapt;
   CameraArgs camera;
   ShadeArgs shade;
+  MediumArgs medium;                    ///< participating medium (matrix method, F + solve here)
   std::string radiosity;                ///< per-patch CSV from `solve`; empty = F + solve here
   std::string output = "render.exr";    ///< linear HDR image
   std::string png;                      ///< sRGB preview; empty = output with .png

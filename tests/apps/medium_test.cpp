@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "apps/cli.hpp"
@@ -156,6 +157,38 @@ TEST(MediumFactors, SmallParallelPatchesAreAttenuatedByExpSigmaD) {
   EXPECT_LE(f, surface.F.coeff(0, 1) * t_hi + 1e-15);
   // Reciprocity by construction: A_0 F_01 = A_1 F_10 to rounding (equal areas).
   EXPECT_NEAR(ext.F.coeff(0, 1), ext.F.coeff(1, 0), 1e-15);
+}
+
+TEST(MediumFactors, BitwiseIdenticalForAnyThreadCount) {
+  const PatchMesh mesh = mesh_scene(unit_cube(), {0.5, 0});
+  const Medium medium =
+      homogeneous_medium({0.1, 0, 0}, {1, 0.8, 1}, {3, 2, 4}, Eigen::Vector3d(0.3, 0.5, 0.7),
+                         Eigen::Vector3d(0.7, 0.5, 0.3), Eigen::Vector3d::Zero());
+  const Zones zones = make_zones(medium);
+  const FormFactors surface = surface_factors(mesh, "hybrid");
+  const Bvh bvh(mesh);
+  MediumFactorOptions o;
+  o.rays = 64;
+  o.transmittance_samples = 8;
+  o.threads = 1;
+  const FormFactors one = extend_with_medium(mesh, medium, zones, surface, o, bvh);
+  o.threads = 2;
+  const FormFactors two = extend_with_medium(mesh, medium, zones, surface, o, bvh);
+  ASSERT_EQ(one.F.nonZeros(), two.F.nonZeros());
+  for (std::int64_t k = 0; k < one.F.nonZeros(); ++k) {
+    ASSERT_EQ(one.F.innerIndexPtr()[k], two.F.innerIndexPtr()[k]);
+    ASSERT_EQ(one.F.valuePtr()[k], two.F.valuePtr()[k]);
+  }
+  // Reciprocity by construction over every block: A_i F_ij = A_j F_ji to rounding.
+  std::vector<double> area(mesh.patches.size());
+  for (size_t i = 0; i < area.size(); ++i) area[i] = mesh.patches[i].area;
+  for (std::int32_t z = 0; z < zones.size(); ++z) area.push_back(zones.area[z]);
+  const SparseF T = one.F.transpose();
+  for (std::int32_t i = 0; i < one.F.rows(); ++i)
+    for (SparseF::InnerIterator it(one.F, i); it; ++it) {
+      const double g = area[i] * it.value(), h = area[it.col()] * T.coeff(i, it.col());
+      ASSERT_NEAR(g, h, 1e-12 * std::max(g, h)) << i << " " << it.col();  // a few roundings
+    }
 }
 
 TEST(MediumFurnace, PurelyScatteringMediumKeepsEOverOneMinusRho) {
@@ -317,6 +350,28 @@ TEST(MediumCli, FoggyCornellBoxEnergyBalanceCloses) {
   const double volume = 556 * 548.8 * 559.2;
   EXPECT_GT(report.at("energy_balance")[2].at("emitted").get<double>(), 1e-4 * volume * 0.999);
   EXPECT_NE(text.find("absorbed by surfaces / by the medium"), std::string::npos);
+}
+
+TEST(MediumCli, RenderTakesTheMediumToo) {
+  TempDir dir;
+  const std::vector<std::string> fog = {"--medium-box",  "0,0,0,556,548.8,559.2",
+                                        "--sigma-a",     "0.001,0.001,0.001",
+                                        "--voxels",      "3",
+                                        "--medium-rays", "32"};
+  std::vector<std::string> args = {
+      "render", "-o", dir.file("fog.exr"), "--patches", "100", "--samples", "4", "--size",
+      "32x32",  "-q"};
+  args.insert(args.end(), fog.begin(), fog.end());
+  ::testing::internal::CaptureStdout();
+  const int code = run(args);
+  const std::string text = ::testing::internal::GetCapturedStdout();
+  ASSERT_EQ(code, kExitOk) << text;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("fog.png")));
+  // A saved per-patch radiosity has no zones: refused with a medium.
+  const std::string csv = dir.write("b.csv", "patch,R,G,B\n");
+  std::vector<std::string> from_csv = {"render", "-o", dir.file("x.exr"), "--radiosity", csv, "-q"};
+  from_csv.insert(from_csv.end(), fog.begin(), fog.end());
+  EXPECT_EQ(run(from_csv), kExitUsage);
 }
 
 TEST(MediumCli, HeterogeneousGridFileIsRead) {
