@@ -49,6 +49,7 @@ struct SolveCommandOptions {
   FormFactorArgs ff;
   SolveOptions solve;
   AdaptArgs adapt;
+  MediumArgs medium;                     ///< participating medium (matrix method)
   std::string output = "radiosity.csv";  ///< per-patch CSV; summary JSON beside it
 };
 /// Registers `solve` on the app.

@@ -120,16 +120,17 @@ std::shared_ptr<const Medium> make_medium(const MediumArgs& args) {
   return m;
 }
 
-void check_medium_scene(const PatchMesh& mesh, const ShadeArgs& shade) {
+void check_medium_scene(const PatchMesh& mesh, const ShadeArgs* shade) {
   if (mesh.has_specular())
     throw UsageError(
         "a participating medium needs a diffuse scene: the extended form factors "
         "of specular surfaces are not attenuated by the medium");
-  if (resolve_shading(shade) == Shading::Raytrace)
+  if (shade == nullptr) return;
+  if (resolve_shading(*shade) == Shading::Raytrace)
     throw UsageError(
         "--shading raytrace and --final-gather trace light without the medium: use "
         "gouraud or flat shading with a participating medium");
-  check_vertex_interp(shade, false, "a participating medium");
+  check_vertex_interp(*shade, false, "a participating medium");
 }
 
 MediumResult solve_scene_with_medium(const LoadedScene& scene, const FormFactors& surface,

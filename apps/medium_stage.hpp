@@ -50,9 +50,10 @@ void add_medium_options(CLI::App* cmd, MediumArgs& args);
 std::shared_ptr<const Medium> make_medium(const MediumArgs& args);
 
 /// Refuses (UsageError) what the medium does not combine with, naming it: specular
-/// surfaces (their extended form factors are not attenuated), raytrace shading and
-/// --vertex-interp exact-direct (they compute light without the medium).
-void check_medium_scene(const PatchMesh& mesh, const ShadeArgs& shade);
+/// surfaces (their extended form factors are not attenuated) and, when the command renders
+/// (`shade` not null), raytrace shading and --vertex-interp exact-direct (they compute light
+/// without the medium).
+void check_medium_scene(const PatchMesh& mesh, const ShadeArgs* shade);
 
 /// What the extended solve produced.
 struct MediumResult {

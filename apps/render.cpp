@@ -101,7 +101,7 @@ int render_matrix(const RenderOptions& opts) {
   const Camera camera = make_camera(loaded.scene, opts.camera);
   RadiosityResult r;
   if (medium) {
-    check_medium_scene(loaded.mesh, opts.shade);
+    check_medium_scene(loaded.mesh, &opts.shade);
     const Timer timer;
     const FormFactors F = obtain_form_factors(loaded, opts.ff, opts.run);
     r.ff_seconds = timer.seconds();

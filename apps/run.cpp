@@ -276,7 +276,7 @@ int run_matrix(const RunOptions& opts) {
   const double load_seconds = timer.seconds();
   log_info("      " + std::to_string(loaded.mesh.size()) + " patches on " +
            std::to_string(loaded.mesh.surface_names.size()) + " surfaces");
-  if (medium) check_medium_scene(loaded.mesh, opts.shade);
+  if (medium) check_medium_scene(loaded.mesh, &opts.shade);
 
   const std::string estimator =
       opts.ff.estimator == "auto" ? auto_estimator(loaded.mesh.size()) : opts.ff.estimator;

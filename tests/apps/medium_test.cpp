@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -372,6 +373,25 @@ TEST(MediumCli, RenderTakesTheMediumToo) {
   std::vector<std::string> from_csv = {"render", "-o", dir.file("x.exr"), "--radiosity", csv, "-q"};
   from_csv.insert(from_csv.end(), fog.begin(), fog.end());
   EXPECT_EQ(run(from_csv), kExitUsage);
+}
+
+TEST(MediumCli, SolveWritesPatchesAndTheMediumSection) {
+  TempDir dir;
+  ::testing::internal::CaptureStdout();
+  const int code = run({"solve", "-o", dir.file("b.csv"), "--patches", "100", "--samples", "4",
+                        "-q", "--medium-box", "0,0,0,556,548.8,559.2", "--sigma-s",
+                        "0.001,0.001,0.001", "--voxels", "2", "--medium-rays", "32"});
+  const std::string text = ::testing::internal::GetCapturedStdout();
+  ASSERT_EQ(code, kExitOk) << text;
+  const nlohmann::json j = nlohmann::json::parse(slurp(dir.file("b.json")));
+  EXPECT_EQ(j.at("medium").at("zones").get<int>(), 8);
+  // Purely scattering: the medium absorbs nothing (sums of exact zeros).
+  EXPECT_EQ(j.at("medium").at("absorbed_medium")[0].get<double>(), 0.0);
+  // The CSV holds the patches only (header + one line per patch).
+  const std::string csv = slurp(dir.file("b.csv"));
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), j.at("patches").get<int>() + 1);
+  for (const auto& ch : j.at("channels"))  // as in the run test: tol 1e-8, margin 100
+    EXPECT_LE(ch.at("energy").at("relative_imbalance").get<double>(), 1e-6);
 }
 
 TEST(MediumCli, HeterogeneousGridFileIsRead) {
