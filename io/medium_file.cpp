@@ -32,6 +32,10 @@ std::vector<double> numbers(const std::vector<std::string_view>& tokens, size_t 
 Medium read_medium_grid(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open the medium grid file");
+  return read_medium_grid_stream(in, path);
+}
+
+Medium read_medium_grid_stream(std::istream& in, const std::string& path) {
   LineReader reader(in, path);
   Medium m;
   m.source = path;
@@ -42,6 +46,8 @@ Medium read_medium_grid(const std::string& path) {
   while (reader.next(line)) {
     split_tokens(line, tokens);
     if (tokens.empty()) continue;
+    if ((tokens[0] == "bounds" && have_bounds) || (tokens[0] == "resolution" && have_resolution))
+      throw SceneError(reader.where() + ": repeated '" + std::string(tokens[0]) + "'");
     if (tokens[0] == "bounds") {
       const std::vector<double> b = numbers(tokens, 1, 6, reader);
       m.lo = {b[0], b[1], b[2]};

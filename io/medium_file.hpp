@@ -9,6 +9,7 @@
 //
 // σa, σs in 1/scene unit, e in W per scene unit³ (geometry/medium.hpp); σa + σs must be grey.
 
+#include <istream>
 #include <string>
 
 #include "geometry/medium.hpp"
@@ -19,5 +20,8 @@ namespace lambert {
 /// SceneError naming the file and line for a malformed, negative or non-finite value, a
 /// missing header, or a voxel count that does not match the resolution.
 Medium read_medium_grid(const std::string& path);
+
+/// The same from a stream named `name` in messages (the medium's `source`).
+Medium read_medium_grid_stream(std::istream& in, const std::string& name);
 
 }  // namespace lambert
