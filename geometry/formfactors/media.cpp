@@ -80,19 +80,50 @@ void merge_row(Row& row) {
 }
 
 // Row i < N: the attenuated surface row and the deposits of K cosine rays.
+// T̄ of every stored entry of F (compressed), aligned with its storage. Each unordered pair
+// is estimated once: at its entry with j > i (pass 1), copied to the mirror entry found by
+// binary search in row j (pass 2; estimated there when the mirror is absent). T̄ is a pure
+// function of the pair, so the result does not depend on the thread count.
+std::vector<double> entry_transmittances(const SparseF& F, const std::vector<ff::PatchGeom>& geom,
+                                         const Medium& medium, const MediumFactorOptions& o) {
+  const auto* outer = F.outerIndexPtr();
+  const auto* cols = F.innerIndexPtr();
+  std::vector<double> t(static_cast<size_t>(F.nonZeros()), 0.0);
+  const auto estimate = [&](std::int64_t i, std::int64_t j) {
+    const auto lo = static_cast<std::int32_t>(std::min(i, j));
+    const auto hi = static_cast<std::int32_t>(std::max(i, j));
+    return pair_transmittance(medium, geom[lo], geom[hi], o.transmittance_samples,
+                              hash_keys(o.seed, lo, hi));
+  };
+  for (int pass = 0; pass < 2; ++pass)
+    parallel_for(F.rows(), 16, o.threads, [&](std::int64_t r0, std::int64_t r1) {
+      for (std::int64_t i = r0; i < r1; ++i)
+        for (std::int64_t k = outer[i]; k < outer[i + 1]; ++k) {
+          const std::int64_t j = cols[k];
+          if (pass == 0) {
+            if (j > i) t[k] = estimate(i, j);
+            continue;
+          }
+          if (j > i) continue;
+          const auto* first = cols + outer[j];
+          const auto* last = cols + outer[j + 1];
+          const auto* m = std::lower_bound(first, last, i);
+          t[k] = j < i && m != last && *m == i ? t[m - cols] : estimate(i, j);
+        }
+    });
+  return t;
+}
+
 Row patch_row(const PatchMesh& mesh, const std::vector<ff::PatchGeom>& geom, const Medium& medium,
-              const Zones& zones, const SparseF& F, const MediumFactorOptions& o, const Bvh& bvh,
-              std::int32_t i) {
+              const Zones& zones, const SparseF& F, const std::vector<double>& transmittances,
+              const MediumFactorOptions& o, const Bvh& bvh, std::int32_t i) {
   const std::int32_t n = mesh.size();
   Row row, hit_part, other_part;
   double deficit = 0.0;
-  for (SparseF::InnerIterator it(F, i); it; ++it) {
-    const auto j = static_cast<std::int32_t>(it.col());
-    const double t = pair_transmittance(medium, geom[std::min(i, j)], geom[std::max(i, j)],
-                                        o.transmittance_samples,
-                                        hash_keys(o.seed, std::min(i, j), std::max(i, j)));
-    row.push_back({j, it.value() * t});
-    deficit += it.value() * (1.0 - t);
+  for (std::int64_t k = F.outerIndexPtr()[i]; k < F.outerIndexPtr()[i + 1]; ++k) {
+    const double f = F.valuePtr()[k], t = transmittances[k];
+    row.push_back({static_cast<std::int32_t>(F.innerIndexPtr()[k]), f * t});
+    deficit += f * (1.0 - t);
   }
   const ff::PatchGeom& g = geom[i];
   Eigen::Vector3d t, b;
@@ -218,6 +249,13 @@ FormFactors extend_with_medium(const PatchMesh& mesh, const Medium& medium, cons
                 "surface form factors do not match the mesh");
   LAMBERT_CHECK(o.rays >= 1 && o.transmittance_samples >= 1, "medium factor counts must be >= 1");
   const std::vector<ff::PatchGeom> geom = ff::patch_geometry(mesh);
+  SparseF compressed;
+  if (!surface.F.isCompressed()) {
+    compressed = surface.F;
+    compressed.makeCompressed();
+  }
+  const SparseF& SF = surface.F.isCompressed() ? surface.F : compressed;
+  const std::vector<double> trans = entry_transmittances(SF, geom, medium, o);
   const std::int32_t m = zones.size();
   std::vector<Row> rows(static_cast<size_t>(n)), zone_rows(static_cast<size_t>(m));
   std::vector<double> reached(static_cast<size_t>(m), 0.0);
@@ -225,7 +263,7 @@ FormFactors extend_with_medium(const PatchMesh& mesh, const Medium& medium, cons
     for (std::int64_t r = r0; r < r1; ++r) {
       const auto i = static_cast<std::int32_t>(r);
       if (i < n)
-        rows[i] = patch_row(mesh, geom, medium, zones, surface.F, o, bvh, i);
+        rows[i] = patch_row(mesh, geom, medium, zones, SF, trans, o, bvh, i);
       else
         zone_rows[i - n] = zone_row(mesh, medium, zones, o, bvh, i - n, reached[i - n]);
     }
