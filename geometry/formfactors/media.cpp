@@ -25,6 +25,9 @@ using Row = std::vector<Entry>;
 
 constexpr std::uint64_t kZoneSalt = 0x7a6f6e65ull;   // "zone"
 constexpr std::uint64_t kPatchSalt = 0x6d656469ull;  // "medi"
+// Pair streams are salted too: the estimators key their own pair streams hash_keys(seed, i,
+// j), and the transmittance's points must not reuse their random numbers.
+constexpr std::uint64_t kPairSalt = 0x74726e73ull;  // "trns"
 
 double pair_transmittance(const Medium& medium, const ff::PatchGeom& a, const ff::PatchGeom& b,
                           int samples, std::uint64_t stream) {
@@ -79,7 +82,6 @@ void merge_row(Row& row) {
   row.resize(out);
 }
 
-// Row i < N: the attenuated surface row and the deposits of K cosine rays.
 // T̄ of every stored entry of F (compressed), aligned with its storage. Each unordered pair
 // is estimated once: at its entry with j > i (pass 1), copied to the mirror entry found by
 // binary search in row j (pass 2; estimated there when the mirror is absent). T̄ is a pure
@@ -93,7 +95,7 @@ std::vector<double> entry_transmittances(const SparseF& F, const std::vector<ff:
     const auto lo = static_cast<std::int32_t>(std::min(i, j));
     const auto hi = static_cast<std::int32_t>(std::max(i, j));
     return pair_transmittance(medium, geom[lo], geom[hi], o.transmittance_samples,
-                              hash_keys(o.seed, lo, hi));
+                              hash_keys(o.seed ^ kPairSalt, lo, hi));
   };
   for (int pass = 0; pass < 2; ++pass)
     parallel_for(F.rows(), 16, o.threads, [&](std::int64_t r0, std::int64_t r1) {
@@ -114,6 +116,7 @@ std::vector<double> entry_transmittances(const SparseF& F, const std::vector<ff:
   return t;
 }
 
+// Row i < N: the attenuated surface row and the deposits of K cosine rays.
 Row patch_row(const PatchMesh& mesh, const std::vector<ff::PatchGeom>& geom, const Medium& medium,
               const Zones& zones, const SparseF& F, const std::vector<double>& transmittances,
               const MediumFactorOptions& o, const Bvh& bvh, std::int32_t i) {
@@ -237,7 +240,8 @@ double pair_transmittance(const PatchMesh& mesh, const Medium& medium, std::int3
                           std::int32_t b, int samples, std::uint64_t seed) {
   const std::vector<ff::PatchGeom> geom = ff::patch_geometry(mesh);
   const std::int32_t lo = std::min(a, b), hi = std::max(a, b);
-  return pair_transmittance(medium, geom[lo], geom[hi], samples, hash_keys(seed, lo, hi));
+  return pair_transmittance(medium, geom[lo], geom[hi], samples,
+                            hash_keys(seed ^ kPairSalt, lo, hi));
 }
 
 FormFactors extend_with_medium(const PatchMesh& mesh, const Medium& medium, const Zones& zones,

@@ -69,7 +69,7 @@ struct Zones {
 Zones make_zones(const Medium& medium);
 
 /// Kernel-weighted mean transmittance between patches a and b of `mesh` (see above) with
-/// `samples` point pairs from the stream hash_keys(seed, min(a,b), max(a,b)); symmetric in
+/// `samples` point pairs from the stream hash_keys(seed ^ salt, min(a,b), max(a,b)); symmetric in
 /// (a, b) bit for bit. 1 when every sampled pair has a zero kernel.
 double pair_transmittance(const PatchMesh& mesh, const Medium& medium, std::int32_t a,
                           std::int32_t b, int samples, std::uint64_t seed);
