@@ -418,6 +418,34 @@ TEST(MediumCli, SolveWritesPatchesAndTheMediumSection) {
     EXPECT_LE(ch.at("energy").at("relative_imbalance").get<double>(), 1e-6);
 }
 
+TEST(MediumCli, SavedSurfaceFactorsTakeTheMediumOnTop) {
+  // --ff loads the surfaces' F; the medium is added on top: the same B as computing F here
+  // with the same settings (the file stores doubles: bitwise the same F).
+  TempDir dir;
+  const std::vector<std::string> mesh = {"--patches", "80", "--samples", "4", "-q"};
+  const std::vector<std::string> fog = {"--medium-box",  "0,0,0,556,548.8,559.2",
+                                        "--sigma-a",     "0.001,0.001,0.001",
+                                        "--voxels",      "2",
+                                        "--medium-rays", "16"};
+  auto args = [&](std::vector<std::string> a, bool with_mesh_counts) {
+    if (with_mesh_counts)
+      a.insert(a.end(), mesh.begin(), mesh.end());
+    else
+      a.insert(a.end(), {"--patches", "80", "-q"});
+    a.insert(a.end(), fog.begin(), fog.end());
+    return a;
+  };
+  ::testing::internal::CaptureStdout();
+  ASSERT_EQ(
+      run({"formfactors", "-o", dir.file("F.bin"), "--patches", "80", "--samples", "4", "-q"}),
+      kExitOk);
+  ASSERT_EQ(run(args({"solve", "-o", dir.file("a.csv")}, true)), kExitOk);
+  ASSERT_EQ(run(args({"solve", "-o", dir.file("b.csv"), "--ff", dir.file("F.bin")}, false)),
+            kExitOk);
+  ::testing::internal::GetCapturedStdout();
+  EXPECT_EQ(slurp(dir.file("a.csv")), slurp(dir.file("b.csv")));
+}
+
 TEST(MediumCli, HeterogeneousGridFileIsRead) {
   TempDir dir;
   std::string grid = "# two voxels along x\nbounds 0 0 0 556 548.8 559.2\nresolution 2 1 1\n";
