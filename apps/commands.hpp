@@ -6,6 +6,7 @@
 #include "apps/adapt_stage.hpp"
 #include "apps/common.hpp"
 #include "apps/ff_args.hpp"
+#include "apps/medium_stage.hpp"
 #include "apps/method.hpp"
 #include "apps/render_stages.hpp"
 #include "solvers/radiosity.hpp"
@@ -48,6 +49,7 @@ struct SolveCommandOptions {
   FormFactorArgs ff;
   SolveOptions solve;
   AdaptArgs adapt;
+  MediumArgs medium;                     ///< participating medium (matrix method)
   std::string output = "radiosity.csv";  ///< per-patch CSV; summary JSON beside it
 };
 /// Registers `solve` on the app.
@@ -91,6 +93,7 @@ struct RenderOptions {
   AdaptArgs adapt;
   CameraArgs camera;
   ShadeArgs shade;
+  MediumArgs medium;                    ///< participating medium (matrix method, F + solve here)
   std::string radiosity;                ///< per-patch CSV from `solve`; empty = F + solve here
   std::string output = "render.exr";    ///< linear HDR image
   std::string png;                      ///< sRGB preview; empty = output with .png
@@ -112,6 +115,7 @@ struct RunOptions {
   AdaptArgs adapt;
   CameraArgs camera;
   ShadeArgs shade;
+  MediumArgs medium;               ///< participating medium (matrix method)
   std::string output_dir = "out";  ///< -o: output directory, created if needed
   std::string name;                ///< file prefix; empty = scene stem ("cornell" built-in)
 };

@@ -3,17 +3,19 @@
 #include <algorithm>
 #include <limits>
 
+#include "apps/medium_stage.hpp"
 #include "core/error.hpp"
 
 namespace lambert {
 
-const std::vector<Method>& methods() {
-  static const std::vector<Method> kMethods = {
+namespace {
+std::vector<Method> base_methods() {
+  return {
       {"matrix",
        "mesh the scene, compute F, solve (I - rho F) B = E",
        {"--patches", "--max-edge", "--discontinuity", "--discontinuity-sources", "--adapt",
-        "--adapt-patches", "--estimator", "--samples", "--rays", "--threshold",
-        "--hemicube-res", "--reciprocity", "--symmetrize", "--ff"},
+        "--adapt-patches", "--estimator", "--samples", "--rays", "--threshold", "--hemicube-res",
+        "--reciprocity", "--symmetrize", "--ff"},
        {"--solver", "--solvers", "--omega", "--preconditioner", "--restart", "--ambient",
         "--radiosity"},
        "matrix meshes with --patches or --max-edge and computes F"},
@@ -24,6 +26,22 @@ const std::vector<Method>& methods() {
        "hierarchical meshes adaptively and computes no F: it takes --epsilon, --min-area "
        "(the smallest element), --link-rays, --tol and --max-iter"},
   };
+}
+
+// methods() with the medium's options added to the matrix row (the medium is one of its
+// problem options: apps/medium_stage.hpp owns the list).
+std::vector<Method> with_medium_options() {
+  std::vector<Method> out = base_methods();
+  for (Method& m : out)
+    if (m.name == "matrix")
+      m.problem_options.insert(m.problem_options.end(), medium_option_names().begin(),
+                               medium_option_names().end());
+  return out;
+}
+}  // namespace
+
+const std::vector<Method>& methods() {
+  static const std::vector<Method> kMethods = with_medium_options();
   return kMethods;
 }
 

@@ -15,17 +15,23 @@ Eigen::MatrixX3d indirect_irradiance(const PatchMesh& mesh, const SparseRowMatri
   return F * reflected;
 }
 
-RadiosityProblem make_problem(const PatchMesh& mesh, const SparseRowMatrix& F) {
+RadiosityProblem make_extended_problem(const PatchMesh& mesh, const SparseRowMatrix& F,
+                                       const Eigen::MatrixX3d& extra_rho,
+                                       const Eigen::MatrixX3d& extra_emission,
+                                       const Eigen::VectorXd& extra_area) {
   const std::int32_t n = mesh.size();
-  if (F.rows() != n || F.cols() != n)
+  const auto m = static_cast<std::int32_t>(extra_area.size());
+  LAMBERT_CHECK(extra_rho.rows() == m && extra_emission.rows() == m,
+                "extra unknowns' reflectance, emission and area differ in count");
+  if (F.rows() != n + m || F.cols() != n + m)
     throw SceneError("form factors are " + std::to_string(F.rows()) + "x" +
                      std::to_string(F.cols()) + " but the mesh has " + std::to_string(n) +
-                     " patches");
+                     " patches" + (m > 0 ? " and " + std::to_string(m) + " zones" : std::string()));
   RadiosityProblem p;
   p.F = std::make_shared<CsrOperator>(F);
-  p.rho.resize(n, 3);
-  p.emission.resize(n, 3);
-  p.area.resize(n);
+  p.rho.resize(n + m, 3);
+  p.emission.resize(n + m, 3);
+  p.area.resize(n + m);
   for (std::int32_t i = 0; i < n; ++i) {
     const Patch& patch = mesh.patches[i];
     // rho = 1 (lossless) is passed as it is: check_closed_lossless has ruled out the one
@@ -34,7 +40,15 @@ RadiosityProblem make_problem(const PatchMesh& mesh, const SparseRowMatrix& F) {
     p.emission.row(i) = patch.emission.transpose();
     p.area[i] = patch.area;
   }
+  p.rho.bottomRows(m) = extra_rho;
+  p.emission.bottomRows(m) = extra_emission;
+  p.area.tail(m) = extra_area;
   return p;
+}
+
+RadiosityProblem make_problem(const PatchMesh& mesh, const SparseRowMatrix& F) {
+  return make_extended_problem(mesh, F, Eigen::MatrixX3d(0, 3), Eigen::MatrixX3d(0, 3),
+                               Eigen::VectorXd(0));
 }
 
 RadiosityProblem make_problem(const PatchMesh& mesh, const FormFactors& ff) {

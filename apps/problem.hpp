@@ -15,6 +15,14 @@ namespace lambert {
 /// RadiosityProblem for `mesh` with a CsrOperator over F (which must outlive it). Throws SceneError if
 /// F's size does not match the mesh.
 RadiosityProblem make_problem(const PatchMesh& mesh, const SparseRowMatrix& F);
+/// The problem over the patches and M extra unknowns after them (participating-media zones,
+/// geometry/formfactors/media.hpp): F is (N + M)², and the extra unknowns' reflectance,
+/// emission (M x 3) and effective area (M) follow the patches'. F must outlive the problem.
+/// Throws SceneError when the sizes do not match.
+RadiosityProblem make_extended_problem(const PatchMesh& mesh, const SparseRowMatrix& F,
+                                       const Eigen::MatrixX3d& extra_rho,
+                                       const Eigen::MatrixX3d& extra_emission,
+                                       const Eigen::VectorXd& extra_area);
 /// The same over a FormFactors (its specular_continued goes with it: the energy balance of
 /// extended form factors).
 RadiosityProblem make_problem(const PatchMesh& mesh, const FormFactors& ff);

@@ -9,6 +9,7 @@
 #include "apps/solve_args.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/timer.hpp"
 #include "io/radiosity_csv.hpp"
 
 namespace lambert {
@@ -50,11 +51,12 @@ std::string png_path(const RenderOptions& opts) {
 // Shades, renders and writes B on the loaded mesh; prints what was written.
 void render_and_write(const RenderOptions& opts, const LoadedScene& loaded,
                       const Eigen::MatrixX3d& B, const Eigen::MatrixX3d* indirect,
-                      const Camera& camera, const std::string& method_settings) {
+                      const Camera& camera, const std::string& method_settings,
+                      const MediumView* medium = nullptr) {
   const ShadedField shaded = shade_vertices(loaded, B, indirect, opts.shade, opts.run.threads);
   RenderStats stats;
   const Image image = render_scene(loaded, B, shaded.field, camera, opts.shade,
-                                   opts.ff.specular_depth, opts.run, &stats);
+                                   opts.ff.specular_depth, opts.run, &stats, medium);
   const double ev = choose_exposure(opts.shade, image);
   OutputPaths paths;
   paths.image_exr = opts.output;
@@ -82,6 +84,11 @@ JobPlan render_plan(const RenderOptions& opts) {
 
 // --method matrix: B from --radiosity, or F and a solve.
 int render_matrix(const RenderOptions& opts) {
+  const std::shared_ptr<const Medium> medium = make_medium(opts.medium);
+  if (medium && !opts.radiosity.empty())
+    throw UsageError(
+        "--radiosity holds the patches' radiosity only: a participating medium "
+        "needs F and a solve here (drop --radiosity)");
   JobPlan plan = render_plan(opts);
   if (opts.radiosity.empty()) {
     plan_form_factors(plan, opts.ff, opts.run);
@@ -93,6 +100,18 @@ int render_matrix(const RenderOptions& opts) {
   const LoadedScene loaded = load_scene(opts.scene, plan);
   const Camera camera = make_camera(loaded.scene, opts.camera);
   RadiosityResult r;
+  if (medium) {
+    check_medium_scene(loaded.mesh, &opts.shade);
+    const Timer timer;
+    const FormFactors F = obtain_form_factors(loaded, opts.ff, opts.run);
+    r.ff_seconds = timer.seconds();
+    const MediumResult m =
+        solve_scene_with_medium(loaded, F, medium, opts.medium, opts.solver, opts.run, r);
+    render_and_write(opts, loaded, r.B, nullptr, camera,
+                     matrix_settings(opts, loaded, r) + ' ' + medium_settings_text(m, opts.medium),
+                     &m.view);
+    return r.solution.status != SolveStatus::Converged ? kExitNotConverged : kExitOk;
+  }
   if (!opts.radiosity.empty()) {
     r.B = read_radiosity_csv(opts.radiosity, loaded.mesh);
     log_info("radiosity: read " + std::to_string(loaded.mesh.size()) + " patches from " +
@@ -131,6 +150,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opts) {
   add_solve_options(cmd, opts.solver, true);
   add_camera_options(cmd, opts.camera);
   add_shade_options(cmd, opts.shade);
+  add_medium_options(cmd, opts.medium);
   cmd->add_option(
       "--radiosity", opts.radiosity,
       "Per-patch radiosity CSV from `lambert solve` (instead of computing F and solving)");

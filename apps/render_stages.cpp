@@ -211,7 +211,7 @@ ShadedField shade_vertices(const LoadedScene& scene, const Eigen::MatrixX3d& B,
 
 Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const VertexField& field,
                    const Camera& camera, const ShadeArgs& args, int specular_depth,
-                   const RunArgs& run, RenderStats* stats) {
+                   const RunArgs& run, RenderStats* stats, const MediumView* medium) {
   const Timer timer;
   const PatchMesh& mesh = scene.mesh;
   const Bvh& bvh = scene_bvh(scene, run.threads);
@@ -224,6 +224,7 @@ Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const Ve
   settings.seed = run.seed;
   settings.threads = run.threads;
   settings.progress = !run.quiet;
+  settings.medium = medium;
   std::unique_ptr<DirectLight> direct;
   if (args.final_gather > 0) direct = std::make_unique<DirectLight>(scene.scene);
   Image img = render(mesh, bvh, camera, B, field, settings, stats, direct.get());

@@ -102,10 +102,11 @@ ShadedField shade_vertices(const LoadedScene& scene, const Eigen::MatrixX3d& B,
                            const Eigen::MatrixX3d* indirect, const ShadeArgs& args, int threads);
 
 /// Renders the scene through `camera` (with the run's shared BVH, scene_bvh); raytraced
-/// paths follow at most `specular_depth` specular bounces (--specular-depth).
+/// paths follow at most `specular_depth` specular bounces (--specular-depth). Camera rays
+/// pass through `medium` when given (render.hpp's MediumView).
 Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const VertexField& field,
                    const Camera& camera, const ShadeArgs& args, int specular_depth,
-                   const RunArgs& run, RenderStats* stats);
+                   const RunArgs& run, RenderStats* stats, const MediumView* medium = nullptr);
 
 /// The exposure (EV) to use: --exposure, or automatic from the image.
 double choose_exposure(const ShadeArgs& args, const Image& image);

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -52,6 +53,7 @@ struct MethodOutcome {
   const LoadedScene& loaded;  ///< the mesh B lives on (and its BVH, for rendering)
   const Eigen::MatrixX3d& B;
   const Eigen::MatrixX3d* indirect = nullptr;  ///< I = F (B - E) when B came with F
+  const MediumView* medium = nullptr;          ///< the participating medium, when there is one
   std::string settings;            ///< the method's part of the settings line
   Json sections = Json::object();  ///< the method's report sections, in report order
   Json energy = Json::array();     ///< energy_balance: one object per channel
@@ -182,7 +184,7 @@ int finish_run(const RunOptions& opts, const RunPaths& paths, const MethodOutcom
   stages.next("rendering " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
   RenderStats rs;
   const Image image = render_scene(m.loaded, m.B, shaded.field, camera, opts.shade,
-                                   opts.ff.specular_depth, opts.run, &rs);
+                                   opts.ff.specular_depth, opts.run, &rs, m.medium);
   const double ev = choose_exposure(opts.shade, image);
 
   stages.next("writing " + opts.output_dir + "/" + paths.name + ".*");
@@ -237,8 +239,31 @@ std::string loading_what(const RunOptions& opts, const char* verb) {
          (opts.scene.scene.empty() ? std::string("the built-in Cornell box") : opts.scene.scene);
 }
 
+// The medium's part of the report and summary.
+void describe_medium(const RunOptions& opts, const MediumResult& medium, MethodOutcome& m) {
+  m.medium = &medium.view;
+  m.settings += ' ' + medium_settings_text(medium, opts.medium);
+  m.sections["medium"] = medium_json(medium, opts.medium);
+  const Eigen::Vector3i& res = medium.medium->resolution;
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "medium     %s, %dx%dx%d voxels, %d zones; exchange factors %s (%lld entries)",
+                medium.medium->source.c_str(), res.x(), res.y(), res.z(), medium.zones.size(),
+                format_duration(medium.seconds).c_str(), static_cast<long long>(medium.entries));
+  m.summary.push_back(line);
+  m.summary.push_back("           absorbed by surfaces / by the medium (W):");
+  for (int c = 0; c < 3; ++c) {
+    std::snprintf(line, sizeof line, "           %s %.6g / %.6g", channel_name(c),
+                  medium.absorbed_surfaces[c], medium.absorbed_medium[c]);
+    m.summary.push_back(line);
+  }
+}
+
 // --method matrix: mesh, F, solve (stages 1-3 of 6).
 int run_matrix(const RunOptions& opts) {
+  const std::shared_ptr<const Medium> medium = make_medium(opts.medium);
+  if (medium && opts.adapt.active())
+    throw UsageError("--adapt does not combine with a participating medium yet");
   Stages stages(6);
   Timer timer;
   stages.next(loading_what(opts, "loading and meshing "));
@@ -251,6 +276,7 @@ int run_matrix(const RunOptions& opts) {
   const double load_seconds = timer.seconds();
   log_info("      " + std::to_string(loaded.mesh.size()) + " patches on " +
            std::to_string(loaded.mesh.surface_names.size()) + " surfaces");
+  if (medium) check_medium_scene(loaded.mesh, &opts.shade);
 
   const std::string estimator = opts.ff.estimator == "auto"
                                     ? auto_estimator(loaded.mesh.size(), opts.ff.tol_given)
@@ -263,6 +289,7 @@ int run_matrix(const RunOptions& opts) {
   stages.next("form factors (" +
               (opts.ff.ff_file.empty() ? estimator + per : "from " + opts.ff.ff_file) + ")");
   RadiosityResult r;
+  std::optional<MediumResult> medium_result;
   timer.reset();
   std::vector<AdaptRound> rounds;
   if (opts.adapt.active()) {
@@ -286,17 +313,25 @@ int run_matrix(const RunOptions& opts) {
   } else {
     const FormFactors F = obtain_form_factors(loaded, opts.ff, opts.run);
     r.ff_seconds = timer.seconds();
-    stages.next("solving (I - rho F) B = E with " + opts.solver.solver);
-    solve_scene(loaded, F, opts.solver, opts.run, r);
+    if (medium) {
+      stages.next("medium zones and solving (I - rho F) B = E with " + opts.solver.solver);
+      medium_result =
+          solve_scene_with_medium(loaded, F, medium, opts.medium, opts.solver, opts.run, r);
+      r.ff_seconds += medium_result->seconds;  // the zones' exchange factors are form factors
+    } else {
+      stages.next("solving (I - rho F) B = E with " + opts.solver.solver);
+      solve_scene(loaded, F, opts.solver, opts.run, r);
+    }
   }
 
   MethodOutcome m{"matrix", loaded, r.B};
-  m.indirect = &r.indirect;
+  if (!medium_result) m.indirect = &r.indirect;
   std::ostringstream settings;
   settings << "patches=" << loaded.mesh.size() << " max_edge=" << loaded.max_edge << ' '
            << ff_settings_text(r.ff_options, opts.ff.ff_file) << " solver=" << opts.solver.solver
            << " tol=" << opts.solver.tol;
   m.settings = settings.str();
+  if (medium_result) describe_medium(opts, *medium_result, m);
   Json& ff = m.sections["form_factors"] = ff_settings_json(r.ff_options, opts.ff.ff_file);
   ff["entries"] = r.ff_entries;
   ff["pairs_tested"] = r.ff_stats.pairs_tested;
@@ -434,6 +469,7 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& opts) {
   add_adapt_options(cmd, opts.adapt);
   add_camera_options(cmd, opts.camera);
   add_shade_options(cmd, opts.shade);
+  add_medium_options(cmd, opts.medium);
   cmd->add_option("-o,--output", opts.output_dir, "Output directory (created if needed)")
       ->capture_default_str();
   cmd->add_option(

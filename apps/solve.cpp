@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <utility>
 
 #include "apps/cli.hpp"
@@ -9,6 +10,7 @@
 #include "apps/problem.hpp"
 #include "apps/solve_args.hpp"
 #include "core/atomic_file.hpp"
+#include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/timer.hpp"
 #include "io/json.hpp"
@@ -51,6 +53,9 @@ Json channel_json(const ChannelReport& r, const EnergyBalance& e, int c) {
 
 // --method matrix: mesh, F, one solver.
 int run_solve_matrix(const SolveCommandOptions& opts) {
+  const std::shared_ptr<const Medium> medium = make_medium(opts.medium);
+  if (medium && opts.adapt.active())
+    throw UsageError("--adapt does not combine with a participating medium yet");
   const Timer total;
   JobPlan plan = job_plan(opts.run);
   plan.outputs = {{"-o", opts.output}, {"the summary", summary_path(opts.output)}};
@@ -66,7 +71,17 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
   RadiositySolution sol;
   std::vector<AdaptRound> rounds;
   double ff_seconds = 0.0;
-  if (opts.adapt.active()) {
+  std::optional<MediumResult> medium_result;
+  std::int64_t nonzeros = 0;
+  if (medium) {
+    check_medium_scene(loaded.mesh, nullptr);
+    ff = obtain_form_factors(loaded, opts.ff, opts.run);
+    RadiosityResult r;
+    medium_result = solve_scene_with_medium(loaded, ff, medium, opts.medium, so, opts.run, r);
+    ff_seconds = ff_timer.seconds() - r.solve_seconds;
+    sol = r.solution;  // patches, then zones: the CSV and the averages read the patches
+    nonzeros = medium_result->entries;
+  } else if (opts.adapt.active()) {
     rounds = adapt_scene(loaded, opts.ff, so, opts.run, opts.adapt, ff, sol);
     ff_seconds = ff_timer.seconds() - sol.seconds;
     warn_about_lighting(loaded.mesh, ff.F);
@@ -78,6 +93,7 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
     check_closed_lossless(loaded.mesh, ff);
     sol = solve_radiosity(problem, so);
   }
+  if (!medium) nonzeros = ff.F.nonZeros();
 
   const std::string json_path = summary_path(opts.output);
   write_radiosity_csv(opts.output, loaded.mesh, sol.B);
@@ -108,7 +124,8 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
               {"form_factors_source", opts.ff.ff_file.empty() ? "computed" : opts.ff.ff_file},
               {"solve_seconds", sol.seconds}}},
             {"form_factors", ff_settings_json(ff.options, opts.ff.ff_file)},
-            {"form_factor_nonzeros", ff.F.nonZeros()}};
+            {"form_factor_nonzeros", nonzeros}};
+  if (medium_result) j["medium"] = medium_json(*medium_result, opts.medium);
   Json& channels = j["channels"] = Json::array();
   for (int c = 0; c < 3; ++c) channels.push_back(channel_json(sol.channels[c], sol.energy[c], c));
   j["surfaces"] = surface_averages_json(surfaces);
@@ -125,6 +142,11 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
         r.residual, r.seconds, sol.energy[c].emitted, sol.energy[c].absorbed, sol.energy[c].escaped,
         sol.energy[c].relative_imbalance, energy_split_text(sol.energy[c]).c_str());
   }
+  if (medium_result)
+    for (int c = 0; c < 3; ++c)
+      std::printf("  %s: absorbed by surfaces %.6g, by the medium %.6g (%d zones)\n",
+                  channel_name(c), medium_result->absorbed_surfaces[c],
+                  medium_result->absorbed_medium[c], medium_result->zones.size());
   std::printf("wrote %s and %s\n", opts.output.c_str(), json_path.c_str());
   if (sol.status != SolveStatus::Converged) {
     log_warn("solver " + so.solver + " did not converge (" + to_string(sol.status) +
@@ -197,6 +219,7 @@ CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts) {
   add_ff_options(cmd, opts.ff);
   add_solve_options(cmd, opts.solve, true);
   add_adapt_options(cmd, opts.adapt);
+  add_medium_options(cmd, opts.medium);
   cmd->add_option("-o,--output", opts.output,
                   "Per-patch radiosity CSV (patch,surface,area,R,G,B); the summary goes to the "
                   "same name with .json")

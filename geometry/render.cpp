@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "core/error.hpp"
@@ -18,6 +19,7 @@ namespace {
 struct Sample {
   Eigen::Vector3d value = Eigen::Vector3d::Zero();
   bool hit = false;
+  double t = std::numeric_limits<double>::infinity();  ///< ray parameter of the hit
 };
 
 // True when the hit lies within half a pixel footprint of its patch's boundary.
@@ -44,6 +46,7 @@ Sample trace(const PatchMesh& mesh, const Bvh& bvh, const Eigen::Vector3d& eye,
   const RayHit h = bvh.intersect(eye.cast<float>(), dir.cast<float>());
   if (h.patch < 0) return s;
   s.hit = true;
+  s.t = h.t;
   const Patch& p = mesh.patches[h.patch];
   const bool front = p.normal.dot(dir) < 0;
   if (wire_angle > 0 && (front || tracer) && on_wire(mesh, p, eye, dir, h.t, wire_angle))
@@ -61,6 +64,23 @@ Sample trace(const PatchMesh& mesh, const Bvh& bvh, const Eigen::Vector3d& eye,
   return s;
 }
 
+// The camera ray's radiosity seen through the medium: the surface's B times exp(-tau) to
+// the hit plus every voxel's B_v exp(-tau before)(1 - exp(-sigma_t l)) (render.hpp).
+Eigen::Vector3d through_medium(const MediumView& view, const Eigen::Vector3d& eye,
+                               const Eigen::Vector3d& dir, const Sample& s) {
+  const double norm = dir.norm();
+  const Eigen::Vector3d unit = dir / norm;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double tau = 0.0;
+  const Medium& m = *view.medium;
+  traverse_medium(m, eye, unit, 0.0, s.t * norm, [&](std::int32_t v, double a, double b) {
+    const double dtau = m.sigma_t(v) * (b - a);
+    sum += std::exp(-tau) * -std::expm1(-dtau) * view.voxel_B.row(v).transpose();
+    tau += dtau;
+  });
+  return std::exp(-tau) * s.value + sum;
+}
+
 }  // namespace
 
 Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
@@ -69,6 +89,10 @@ Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
   LAMBERT_CHECK(camera.width > 0 && camera.height > 0, "render: empty image");
   LAMBERT_CHECK(options.antialias >= 1, "render: antialias must be >= 1");
   LAMBERT_CHECK(patch_B.rows() == mesh.size(), "render: radiosity size does not match the mesh");
+  LAMBERT_CHECK(
+      !options.medium || (options.shading != Shading::Raytrace &&
+                          options.medium->voxel_B.rows() == options.medium->medium->voxels()),
+      "render: a medium needs Gouraud or flat shading and one value per voxel");
   const bool flat = options.shading == Shading::Flat;
   const bool gathers = options.shading == Shading::Raytrace && options.view.final_gather > 0;
   LAMBERT_CHECK(flat || gathers ||
@@ -114,7 +138,9 @@ Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
             const Sample s =
                 trace(mesh, bvh, camera.eye, camera.ray_direction(px, py), patch_B, vertices,
                       options.shading, wire_angle, tracer.get(), stream, row_rays[y]);
-            sum += s.value;
+            sum += options.medium ? through_medium(*options.medium, camera.eye,
+                                                   camera.ray_direction(px, py), s)
+                                  : s.value;
             hits += s.hit ? 1 : 0;
           }
         }

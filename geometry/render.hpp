@@ -21,6 +21,7 @@
 #include "geometry/bvh.hpp"
 #include "geometry/camera.hpp"
 #include "geometry/direct_light.hpp"
+#include "geometry/medium.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/raytrace.hpp"
 #include "geometry/vertex_field.hpp"
@@ -48,6 +49,16 @@ enum class Shading {
   Raytrace,  ///< the view pass: specular bounces, Gouraud or final gather at diffuse hits
 };
 
+/// A participating medium seen by the camera: each voxel's radiosity B_v = π S_v (S its
+/// source radiance: emitted plus in-scattered, W m⁻² sr⁻¹; zero where σt = 0). Along a camera
+/// ray the surface's B is dimmed by exp(−τ) to the hit, and voxel v adds
+/// B_v exp(−τ before v)(1 − exp(−σt_v ℓ_v)): the exact integral of σt S exp(−τ) for a source
+/// constant in each voxel (medium.hpp's walk, no marching step).
+struct MediumView {
+  const Medium* medium = nullptr;  ///< null: no medium
+  Eigen::MatrixX3d voxel_B;        ///< voxels x 3
+};
+
 /// Render settings.
 struct RenderSettings {
   Shading shading = Shading::Gouraud;
@@ -60,6 +71,8 @@ struct RenderSettings {
   std::uint64_t seed = 1;  ///< jitter seed (K > 1)
   int threads = 0;         ///< 0 = all cores
   bool progress = true;    ///< draw a progress bar (when stderr is a terminal)
+  /// Camera rays through a medium (Gouraud and flat shading; must outlive the render).
+  const MediumView* medium = nullptr;
 };
 
 /// What the render did.

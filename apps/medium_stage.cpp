@@ -1,0 +1,225 @@
+#include "apps/medium_stage.hpp"
+
+#include <limits>
+#include <sstream>
+
+#include "apps/problem.hpp"
+#include "apps/solve_args.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/progress.hpp"
+#include "core/timer.hpp"
+#include "geometry/bvh.hpp"
+#include "io/medium_file.hpp"
+
+namespace lambert {
+namespace {
+
+bool given(const MediumArgs& args, const std::string& option) {
+  if (args.command == nullptr) return false;
+  const CLI::Option* o = args.command->get_option_no_throw(option);
+  return o != nullptr && o->count() > 0;
+}
+
+Eigen::Vector3d rgb_or_zero(const std::vector<double>& v) {
+  return v.empty() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+}  // namespace
+
+const std::vector<std::string>& medium_option_names() {
+  static const std::vector<std::string> kNames = {
+      "--medium-box", "--sigma-a",    "--sigma-s",     "--medium-emission",      "--medium-grid",
+      "--voxels",     "--voxel-size", "--medium-rays", "--transmittance-samples"};
+  return kNames;
+}
+
+void add_medium_options(CLI::App* cmd, MediumArgs& args) {
+  args.command = cmd;
+  const CLI::Validator non_negative = finite_number(0.0, std::numeric_limits<double>::infinity());
+  cmd->add_option("--medium-box", args.box,
+                  "Participating medium: homogeneous box X0,Y0,Z0,X1,Y1,Z1 (scene units)")
+      ->delimiter(',')
+      ->expected(6)
+      ->check(any_finite_number());
+  cmd->add_option("--sigma-a", args.sigma_a, "Medium absorption R,G,B (1/scene unit)")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(non_negative);
+  cmd->add_option("--sigma-s", args.sigma_s,
+                  "Medium scattering R,G,B (1/scene unit, isotropic; sigma-a + sigma-s grey)")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(non_negative);
+  cmd->add_option("--medium-emission", args.emission,
+                  "Medium emitted power per volume R,G,B (W/scene unit^3)")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(non_negative);
+  cmd->add_option("--medium-grid", args.grid,
+                  "Heterogeneous medium from a grid file (README: bounds, resolution, voxels)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--voxels", args.voxels,
+                  "Medium zones along the box's longest axis (others in proportion)")
+      ->check(CLI::Range(1, 256))
+      ->capture_default_str();
+  cmd->add_option("--voxel-size", args.voxel_size,
+                  "Medium zone edge (scene units) instead of --voxels")
+      ->check(finite_number(0.0, std::numeric_limits<double>::infinity(), true));
+  cmd->add_option("--medium-rays", args.rays, "Medium: rays per patch and per zone")
+      ->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
+  cmd->add_option("--transmittance-samples", args.transmittance_samples,
+                  "Medium: point pairs per patch pair for the surface-to-surface transmittance")
+      ->check(CLI::Range(1, 1 << 16))
+      ->capture_default_str();
+}
+
+std::shared_ptr<const Medium> make_medium(const MediumArgs& args) {
+  const bool coefficients =
+      !args.sigma_a.empty() || !args.sigma_s.empty() || !args.emission.empty();
+  if (!args.active()) {
+    for (const std::string& o : medium_option_names())
+      if (given(args, o))
+        throw UsageError(o +
+                         " needs a medium: --medium-box (with --sigma-a/--sigma-s) or "
+                         "--medium-grid");
+    return nullptr;
+  }
+  if (!args.grid.empty()) {
+    if (!args.box.empty() || coefficients)
+      throw UsageError(
+          "--medium-grid carries its own bounds and coefficients: drop --medium-box, "
+          "--sigma-a, --sigma-s and --medium-emission");
+    if (given(args, "--voxels") || given(args, "--voxel-size"))
+      throw UsageError("--medium-grid sets its own resolution: drop --voxels and --voxel-size");
+    auto m = std::make_shared<Medium>(read_medium_grid(args.grid));
+    validate_medium(*m, args.grid);
+    return m;
+  }
+  if (given(args, "--voxels") && given(args, "--voxel-size"))
+    throw UsageError("give --voxels or --voxel-size, not both");
+  const Eigen::Vector3d lo(args.box[0], args.box[1], args.box[2]);
+  const Eigen::Vector3d hi(args.box[3], args.box[4], args.box[5]);
+  if (!((hi - lo).minCoeff() > 0.0))
+    throw UsageError("--medium-box: empty or inverted box (need X0 < X1, Y0 < Y1, Z0 < Z1)");
+  const Eigen::Vector3d sa = rgb_or_zero(args.sigma_a), ss = rgb_or_zero(args.sigma_s);
+  const Eigen::Vector3d st = sa + ss;
+  if (st.maxCoeff() - st.minCoeff() > 1e-12 * st.maxCoeff())
+    throw UsageError(
+        "--sigma-a + --sigma-s (the extinction) must be the same in every channel; "
+        "colour goes in the albedo sigma-s / (sigma-a + sigma-s) and the emission");
+  auto m = std::make_shared<Medium>(
+      homogeneous_medium(lo, hi, medium_resolution(lo, hi, args.voxels, args.voxel_size), sa, ss,
+                         rgb_or_zero(args.emission)));
+  std::ostringstream src;
+  src << "box " << lo.x() << ',' << lo.y() << ',' << lo.z() << ',' << hi.x() << ',' << hi.y() << ','
+      << hi.z();
+  m->source = src.str();
+  validate_medium(*m, "--medium-box");
+  return m;
+}
+
+void check_medium_scene(const PatchMesh& mesh, const ShadeArgs* shade) {
+  if (mesh.has_specular())
+    throw UsageError(
+        "a participating medium needs a diffuse scene: the extended form factors "
+        "of specular surfaces are not attenuated by the medium");
+  if (shade == nullptr) return;
+  if (resolve_shading(*shade) == Shading::Raytrace)
+    throw UsageError(
+        "--shading raytrace and --final-gather trace light without the medium: use "
+        "gouraud or flat shading with a participating medium");
+  check_vertex_interp(*shade, false, "a participating medium");
+}
+
+MediumResult solve_scene_with_medium(const LoadedScene& scene, const FormFactors& surface,
+                                     std::shared_ptr<const Medium> medium, const MediumArgs& args,
+                                     const SolveOptions& solver, const RunArgs& run,
+                                     RadiosityResult& r) {
+  MediumResult out;
+  out.medium = std::move(medium);
+  const Medium& m = *out.medium;
+  const PatchMesh& mesh = scene.mesh;
+  const std::int32_t n = mesh.size();
+  warn_about_lighting(mesh, surface.F);
+  check_closed_lossless(mesh, surface);
+  const Timer timer;
+  out.zones = make_zones(m);
+  const Zones& zones = out.zones;
+  MediumFactorOptions mo;
+  mo.rays = args.rays;
+  mo.transmittance_samples = args.transmittance_samples;
+  mo.seed = run.seed;
+  mo.threads = run.threads;
+  const FormFactors F =
+      extend_with_medium(mesh, m, zones, surface, mo, scene_bvh(scene, run.threads));
+  out.seconds = timer.seconds();
+  out.stats = F.stats;
+  out.entries = F.F.nonZeros();
+  log_info("medium: " + std::to_string(zones.size()) + " zones, " + std::to_string(out.entries) +
+           " entries in " + format_duration(out.seconds));
+
+  const RadiosityProblem problem =
+      make_extended_problem(mesh, F.F, zones.albedo, zones.emission, zones.area);
+  const std::int32_t total = n + zones.size();
+
+  r.ff_stats = out.stats;
+  r.ff_options = F.options;
+  r.ff_entries = out.entries;
+  const Timer solve_timer;
+  SolveOptions so = solver;
+  so.threads = run.threads;
+  set_memory_limit(so, run.max_memory);
+  r.solution = solve_radiosity(problem, so);
+  r.solve_seconds = solve_timer.seconds();
+  r.B = r.solution.B.topRows(n);
+  r.indirect.resize(0, 3);
+  r.solved = true;
+
+  // Absorbed power split: A_i (1 - rho_i) H_i over patches and over zones, H = F B.
+  for (int c = 0; c < 3; ++c) {
+    Eigen::VectorXd H(total);
+    problem.F->apply(r.solution.B.col(c), H, run.threads);
+    const Eigen::ArrayXd absorbed =
+        problem.area.array() * (1.0 - problem.rho.col(c).array()) * H.array();
+    out.absorbed_surfaces[c] = absorbed.head(n).sum();
+    out.absorbed_medium[c] = absorbed.tail(zones.size()).sum();
+  }
+  out.view.medium = out.medium.get();
+  out.view.voxel_B = Eigen::MatrixX3d::Zero(m.voxels(), 3);
+  for (std::int32_t z = 0; z < zones.size(); ++z)
+    out.view.voxel_B.row(zones.voxel[z]) = r.solution.B.row(n + z);
+  int iterations = 0;
+  for (const auto& c : r.solution.channels) iterations = std::max(iterations, c.iterations);
+  log_info("solve: " + solver.solver + " " + to_string(r.solution.status) + " after " +
+           std::to_string(iterations) + " iterations in " + format_duration(r.solve_seconds) +
+           " (" + std::to_string(n) + " patches + " + std::to_string(zones.size()) + " zones)");
+  return out;
+}
+
+Json medium_json(const MediumResult& m, const MediumArgs& args) {
+  const Medium& md = *m.medium;
+  Json j = {{"source", md.source},
+            {"bounds", {md.lo.x(), md.lo.y(), md.lo.z(), md.hi.x(), md.hi.y(), md.hi.z()}},
+            {"resolution", {md.resolution.x(), md.resolution.y(), md.resolution.z()}},
+            {"zones", m.zones.size()},
+            {"rays_per_unknown", args.rays},
+            {"transmittance_samples", args.transmittance_samples},
+            {"entries", m.entries},
+            {"seconds", m.seconds}};
+  j["absorbed_surfaces"] = {m.absorbed_surfaces[0], m.absorbed_surfaces[1], m.absorbed_surfaces[2]};
+  j["absorbed_medium"] = {m.absorbed_medium[0], m.absorbed_medium[1], m.absorbed_medium[2]};
+  return j;
+}
+
+std::string medium_settings_text(const MediumResult& m, const MediumArgs& args) {
+  const Medium& md = *m.medium;
+  std::ostringstream s;
+  s << "medium=\"" << md.source << "\" voxels=" << md.resolution.x() << 'x' << md.resolution.y()
+    << 'x' << md.resolution.z() << " medium_rays=" << args.rays
+    << " transmittance_samples=" << args.transmittance_samples;
+  return s.str();
+}
+
+}  // namespace lambert

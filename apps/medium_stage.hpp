@@ -1,0 +1,87 @@
+#pragma once
+// Participating media in a run (README "Participating media"): the CLI options, the medium
+// they describe, and the extended solve over patches and zones (geometry/formfactors/media.hpp).
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "apps/common.hpp"
+#include "apps/render_stages.hpp"
+#include "geometry/formfactors/media.hpp"
+#include "geometry/medium.hpp"
+#include "geometry/render.hpp"
+#include "io/json.hpp"
+#include "solvers/radiosity.hpp"
+
+namespace lambert {
+
+/// --medium-box, --sigma-a, --sigma-s, --medium-emission, --medium-grid, --voxels,
+/// --voxel-size, --medium-rays, --transmittance-samples.
+struct MediumArgs {
+  std::vector<double> box;         ///< X0,Y0,Z0,X1,Y1,Z1 (empty: no homogeneous medium)
+  std::vector<double> sigma_a;     ///< R,G,B (1/unit); empty = 0
+  std::vector<double> sigma_s;     ///< R,G,B (1/unit); empty = 0
+  std::vector<double> emission;    ///< R,G,B (W/unit³); empty = 0
+  std::string grid;                ///< --medium-grid FILE (io/medium_file.hpp)
+  int voxels = 16;                 ///< voxels along the box's longest axis
+  double voxel_size = 0.0;         ///< > 0: cubes of about this edge instead of --voxels
+  int rays = 256;                  ///< rays per patch and per zone
+  int transmittance_samples = 16;  ///< point pairs per patch pair
+  /// The subcommand (set by add_medium_options), asked after parsing what was given.
+  const CLI::App* command = nullptr;
+  /// True when a medium was asked for (--medium-box or --medium-grid).
+  bool active() const { return !box.empty() || !grid.empty(); }
+};
+
+/// The options "--medium-box", ... in the order add_medium_options adds them (the matrix
+/// method's row in apps/method.cpp lists them: the hierarchical method refuses them).
+const std::vector<std::string>& medium_option_names();
+
+/// Adds the medium options to a subcommand.
+void add_medium_options(CLI::App* cmd, MediumArgs& args);
+
+/// The medium the options describe (null when none), validated. Throws UsageError for
+/// coefficients without --medium-box, --medium-box with --medium-grid, --voxels or
+/// --voxel-size with --medium-grid, a bad box or coloured extinction; SceneError/IoError
+/// for a bad grid file.
+std::shared_ptr<const Medium> make_medium(const MediumArgs& args);
+
+/// Refuses (UsageError) what the medium does not combine with, naming it: specular
+/// surfaces (their extended form factors are not attenuated) and, when the command renders
+/// (`shade` not null), raytrace shading and --vertex-interp exact-direct (they compute light
+/// without the medium).
+void check_medium_scene(const PatchMesh& mesh, const ShadeArgs* shade);
+
+/// What the extended solve produced.
+struct MediumResult {
+  std::shared_ptr<const Medium> medium;
+  Zones zones;
+  FormFactorStats stats;     ///< of the extended F (rays include the surface estimator's)
+  std::int64_t entries = 0;  ///< stored entries of the extended F
+  double seconds = 0.0;      ///< the medium's exchange factors
+  /// Per channel: power absorbed by the surfaces and by the medium (W); together they are
+  /// the energy balance's `absorbed`.
+  std::array<double, 3> absorbed_surfaces{}, absorbed_medium{};
+  MediumView view;  ///< the per-voxel radiosity for rendering
+};
+
+/// Extends `surface` (the patches' F) with the medium's zones, solves the extended system
+/// and fills `r` (B: the patches' rows only; solution: every unknown; indirect: empty, since
+/// exact-direct vertices are refused with a medium) and the returned result.
+MediumResult solve_scene_with_medium(const LoadedScene& scene, const FormFactors& surface,
+                                     std::shared_ptr<const Medium> medium, const MediumArgs& args,
+                                     const SolveOptions& solver, const RunArgs& run,
+                                     RadiosityResult& r);
+
+/// The report section: {source, bounds, resolution, zones, rays, transmittance_samples,
+/// entries, seconds, absorbed_surfaces [R,G,B], absorbed_medium [R,G,B]}.
+Json medium_json(const MediumResult& m, const MediumArgs& args);
+
+/// One line of key=value text for metadata: "medium=SOURCE voxels=NXxNYxNZ medium_rays=K
+/// transmittance_samples=S".
+std::string medium_settings_text(const MediumResult& m, const MediumArgs& args);
+
+}  // namespace lambert
