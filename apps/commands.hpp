@@ -35,6 +35,7 @@ struct FormFactorsOptions {
   bool by_surface = false;
   std::vector<double> point, normal;  ///< sensor point and normal (3 each) or empty
   std::string precision = "double";   ///< --ff-precision: "double" or "float" (saved values)
+  MediumArgs medium;  ///< participating medium: F then holds its zones after the patches
 };
 /// Registers `formfactors` on the app.
 CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts);
@@ -66,6 +67,7 @@ struct CompareOptions {
   SolveOptions solve;                ///< tolerance etc. shared by every solver
   std::vector<std::string> solvers;  ///< empty = all
   std::string output = "compare";    ///< directory or file prefix
+  MediumArgs medium;                 ///< participating medium (matrix method: zones join F)
 };
 /// Registers `compare` on the app.
 CLI::App* add_compare_command(CLI::App& app, CompareOptions& opts);

@@ -3,12 +3,12 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <algorithm>
 #include <filesystem>
 #include <limits>
 #include <sstream>
@@ -16,6 +16,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/memory.hpp"
+#include "geometry/formfactors/media.hpp"
 #include "io/obj_loader.hpp"
 #include "solvers/radiosity.hpp"
 
@@ -180,14 +181,21 @@ void check_job_memory(std::int64_t patches, const JobPlan& plan) {
   const std::string why = direct ? direct_refusal(n, all_pairs, limit->bytes, limit->source) : "";
   if (!why.empty()) throw UsageError(why);
   const double lu = direct ? direct_memory_bytes(n, all_pairs) : 0.0;
-  if (mesh + ff + lu <= limit->bytes) return;
-  throw UsageError("this job needs about " + format_bytes(mesh + ff + lu) + " (" +
-                   std::to_string(patches) + " patches: mesh " + format_bytes(mesh) +
-                   (plan.ff ? ", form factors " + format_bytes(ff) + " at the all-pairs bound" : "") +
-                   (direct ? ", direct's LU " + format_bytes(lu) : "") +
-                   ") but the limit is " + format_bytes(limit->bytes) + " (" + limit->source +
-                   "): use fewer --patches or a larger --max-edge (--threshold does not lower the "
-                   "peak), or set --max-memory / LAMBERT_MAX_MEMORY (0 = no check)");
+  // The medium's zones, and the copy of the patches' block the extended F makes.
+  const double medium =
+      plan.medium ? medium_peak_bytes(patches, *plan.medium, plan.medium_rays) + ff : 0.0;
+  if (mesh + ff + lu + medium <= limit->bytes) return;
+  throw UsageError(
+      "this job needs about " + format_bytes(mesh + ff + lu + medium) + " (" +
+      std::to_string(patches) + " patches: mesh " + format_bytes(mesh) +
+      (plan.ff ? ", form factors " + format_bytes(ff) + " at the all-pairs bound" : "") +
+      (direct ? ", direct's LU " + format_bytes(lu) : "") +
+      (plan.medium ? ", the medium's zones " + format_bytes(medium) +
+                         " (fewer --voxels or --medium-rays lower it)"
+                   : "") +
+      ") but the limit is " + format_bytes(limit->bytes) + " (" + limit->source +
+      "): use fewer --patches or a larger --max-edge (--threshold does not lower the "
+      "peak), or set --max-memory / LAMBERT_MAX_MEMORY (0 = no check)");
 }
 
 void add_scene_options(CLI::App* cmd, SceneArgs& args) {

@@ -16,6 +16,8 @@
 
 namespace lambert {
 
+struct Medium;
+
 /// Scene file, how to load it and meshing target.
 struct SceneArgs {
   std::string scene;                 ///< OBJ path; empty = built-in Cornell box
@@ -94,6 +96,8 @@ struct JobPlan {
   std::string max_memory;          ///< RunArgs::max_memory
   bool direct = false;  ///< the job solves with `direct`: its factorisation is counted (for a
                         ///< computed F, at the all-pairs bound: a dense LU of N patches)
+  const Medium* medium = nullptr;  ///< a participating medium whose zones join F here
+  int medium_rays = 0;             ///< its rays per unknown (--medium-rays)
 };
 
 /// The memory a job may use, and where that limit comes from ("--max-memory 512M",

@@ -159,11 +159,31 @@ int compare_matrix(const CompareOptions& opts) {
   JobPlan plan = job_plan(opts.run);
   plan.outputs = {{"-o", table}, {"-o", history}, {"-o", svg}, {"-o", png}};
   plan_form_factors(plan, opts.ff, opts.run);
+  const std::shared_ptr<const Medium> medium = make_medium(opts.medium);
+  plan.medium = medium.get();
+  plan.medium_rays = opts.medium.rays;
   const LoadedScene loaded = load_scene(opts.scene, plan);
-  const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);
-  const RadiosityProblem problem = make_problem(loaded.mesh, ff);
-  warn_about_lighting(loaded.mesh, ff.F);
-  check_closed_lossless(loaded.mesh, ff);
+  if (medium) check_medium_scene(loaded.mesh, nullptr);
+  FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run, false, medium.get());
+  // With a medium the solvers compare on the extended system (patches, then zones).
+  Zones zones;
+  if (medium) {
+    zones = make_zones(*medium);
+    if (ff.options.medium_zones == 0) {
+      warn_about_lighting(loaded.mesh, ff.F);
+      check_closed_lossless(loaded.mesh, ff);
+      ff = medium_form_factors(loaded, ff, *medium, zones, opts.medium, opts.run);
+    }
+    log_info("compare: " + std::to_string(loaded.mesh.size()) + " patches + " +
+             std::to_string(zones.size()) + " medium zones");
+  }
+  const RadiosityProblem problem =
+      medium ? make_extended_problem(loaded.mesh, ff.F, zones.albedo, zones.emission, zones.area)
+             : make_problem(loaded.mesh, ff);
+  if (!medium) {
+    warn_about_lighting(loaded.mesh, ff.F);
+    check_closed_lossless(loaded.mesh, ff);
+  }
   std::vector<std::string> names = opts.solvers.empty() ? solver_names() : opts.solvers;
   // Drop repeated names, keeping the first occurrence's order.
   std::vector<std::string> unique_names;
@@ -194,7 +214,8 @@ int compare_matrix(const CompareOptions& opts) {
   for (auto& r : rows)
     if (r.skipped.empty()) r.max_diff = (r.solution.B - reference.B).cwiseAbs().maxCoeff();
 
-  std::printf("%d patches, %lld form factors, tol %g, max-iter %d\n", loaded.mesh.size(),
+  std::printf("%d patches%s, %lld form factors, tol %g, max-iter %d\n", loaded.mesh.size(),
+              medium ? (" + " + std::to_string(zones.size()) + " medium zones").c_str() : "",
               static_cast<long long>(ff.F.nonZeros()), opts.solve.tol, opts.solve.max_iterations);
   std::printf("%-13s %-15s %10s %10s %10s %12s %15s\n", "solver", "status", "iterations",
               "mat-vecs", "time (s)", "residual", "max |B-ref|");
@@ -294,6 +315,13 @@ void write_surfaces_csv(const std::string& path, const std::vector<SurfaceRadios
 // from the form-factor options on the --patches mesh, solved by direct, or gauss-seidel at
 // a tight tolerance when direct does not fit), compared per surface (the meshes differ).
 int compare_hierarchical(const CompareOptions& opts) {
+  // The matrix reference's options are accepted here, but a medium has no hierarchical side.
+  for (const std::string& o : medium_option_names())
+    if (const CLI::Option* given = opts.medium.command->get_option_no_throw(o);
+        given != nullptr && given->count() > 0)
+      throw UsageError(o +
+                       " is not available with --method hierarchical (a participating "
+                       "medium is solved by the matrix method only)");
   const std::string base = output_prefix(opts.output, "compare");
   const std::string table = base + "_table.csv", surfaces_csv = base + "_surfaces.csv";
   JobPlan plan = job_plan(opts.run);
@@ -380,6 +408,7 @@ CLI::App* add_compare_command(CLI::App& app, CompareOptions& opts) {
       ->check(output_prefix_check())
       ->capture_default_str();
   add_run_options(cmd, opts.run);
+  add_medium_options(cmd, opts.medium);
   return cmd;
 }
 

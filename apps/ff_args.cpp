@@ -6,6 +6,7 @@
 #include "core/log.hpp"
 #include "core/progress.hpp"
 #include "geometry/formfactors/analysis.hpp"
+#include "geometry/medium.hpp"
 #include "io/ff_file.hpp"
 
 namespace lambert {
@@ -156,8 +157,30 @@ std::string reciprocity_summary(const FormFactors& ff) {
 
 }  // namespace
 
+namespace {
+
+// A loaded F that holds a participating medium's zones must be used with that medium: the
+// zones' albedo and emission come from the medium options, their exchange factors from the
+// file. Its extinction hash (medium.hpp) names the medium it was computed for.
+void check_loaded_medium(const FormFactors& ff, const Medium* medium, const std::string& path) {
+  const FormFactorOptions& o = ff.options;
+  if (o.medium_zones == 0) return;
+  if (medium == nullptr)
+    throw UsageError(path + ": holds the exchange factors of a participating medium (" +
+                     std::to_string(o.medium_zones) +
+                     " zones): give the medium it was computed with (--medium-box with "
+                     "--sigma-a/--sigma-s, or --medium-grid)");
+  if (extinction_hash(*medium) != o.medium_extinction)
+    throw SceneError(path + ": computed for another participating medium (" +
+                     std::to_string(o.medium_zones) +
+                     " zones; its box, voxels or extinction sigma_a + sigma_s differ from the "
+                     "medium given): give the same medium, or a form-factor file without one");
+}
+
+}  // namespace
+
 FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& args,
-                                const RunArgs& run, bool with_stderr) {
+                                const RunArgs& run, bool with_stderr, const Medium* medium) {
   if (!args.ff_file.empty()) {
     FormFactorFileInfo info;
     FormFactors ff =
@@ -173,6 +196,7 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
       log_warn(args.ff_file + ": extended form factors without their specular bookkeeping "
                "(a Matrix Market file): the energy balance counts light carried on by mirrors "
                "and glass once more, as negative escaped power (save F as .bin to keep it)");
+    check_loaded_medium(ff, medium, args.ff_file);
     log_info("form factors: loaded " + args.ff_file + " (" + std::to_string(ff.F.nonZeros()) +
              " entries, " + ff_settings_text(ff.options, "") + ")");
     return ff;

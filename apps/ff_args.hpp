@@ -11,6 +11,8 @@
 
 namespace lambert {
 
+struct Medium;
+
 /// --estimator, --samples, --rays, --threshold, --hemicube-res, --reciprocity,
 /// --symmetrize, --ff.
 struct FormFactorArgs {
@@ -57,9 +59,12 @@ std::vector<std::string> unused_count_options(const FormFactorArgs& args,
 /// Computes F for the scene, or loads --ff (refusing a file made for another mesh), and
 /// logs a one-line summary on stderr. A loaded F's `options` are the settings stored in the
 /// file (threads and progress from `run`); when the file records none, `options.estimator`
-/// is empty (reports then show the settings as unknown) and a warning is logged.
+/// is empty (reports then show the settings as unknown) and a warning is logged. A loaded F
+/// holding a participating medium's zones (`options.medium_zones` > 0) needs `medium`
+/// (UsageError without one) with the extinction it was computed for (SceneError otherwise).
 FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& args,
-                                const RunArgs& run, bool with_stderr = false);
+                                const RunArgs& run, bool with_stderr = false,
+                                const Medium* medium = nullptr);
 
 /// Warns once per cause (analysis.hpp's find_lighting_problems) when F makes the result
 /// silently B = E: nothing sees anything, or an emitter sees nothing. (A scene without an

@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
+#include "core/timer.hpp"
 #include "geometry/formfactors/analysis.hpp"
 #include "io/ff_file.hpp"
 #include "io/json.hpp"
@@ -114,6 +115,52 @@ Json point_json(const PointFactors& pf) {
 
 Eigen::Vector3d parse_vec(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
 
+// The medium's zones appended to F (media.hpp). Returns the report section and prints how
+// the patches' power divides between the surfaces and the medium.
+Json extend_with_zones(const LoadedScene& s, const Medium& medium, const MediumArgs& args,
+                       const RunArgs& run, FormFactors& ff) {
+  const Timer timer;
+  const Zones zones = make_zones(medium);
+  FormFactors extended = medium_form_factors(s, ff, medium, zones, args, run);
+  const double seconds = timer.seconds();
+  ff = std::move(extended);
+  const std::int32_t n = s.mesh.size(), m = zones.size();
+  // Per patch row: the part its power sends into the medium (the zone columns).
+  double into_min = n > 0 ? 1e300 : 0.0, into_max = 0.0, into_mean = 0.0;
+  for (std::int32_t i = 0; i < n; ++i) {
+    double into = 0.0;
+    for (SparseF::InnerIterator it(ff.F, i); it; ++it)
+      if (it.col() >= n) into += it.value();
+    into_min = std::min(into_min, into), into_max = std::max(into_max, into);
+    into_mean += into / n;
+  }
+  double zone_min = m > 0 ? 1e300 : 0.0, zone_max = 0.0;
+  for (std::int32_t z = 0; z < m; ++z) {
+    const double sum = row_sum(ff.F, n + z);
+    zone_min = std::min(zone_min, sum), zone_max = std::max(zone_max, sum);
+  }
+  const Eigen::Vector3i& res = medium.resolution;
+  std::printf("medium %s, %dx%dx%d voxels, %d zones: %lld entries in %s\n", medium.source.c_str(),
+              res.x(), res.y(), res.z(), m, static_cast<long long>(ff.F.nonZeros()),
+              format_duration(seconds).c_str());
+  std::printf(
+      "patch rows into the medium: min %.6f  mean %.6f  max %.6f; zone row sums: min "
+      "%.6f  max %.6f\n",
+      into_min, into_mean, into_max, zone_min, zone_max);
+  return {
+      {"source", medium.source},
+      {"bounds",
+       {medium.lo.x(), medium.lo.y(), medium.lo.z(), medium.hi.x(), medium.hi.y(), medium.hi.z()}},
+      {"resolution", {res.x(), res.y(), res.z()}},
+      {"zones", m},
+      {"rays_per_unknown", args.rays},
+      {"transmittance_samples", args.transmittance_samples},
+      {"entries", ff.F.nonZeros()},
+      {"seconds", seconds},
+      {"patch_rows_into_medium", {{"min", into_min}, {"mean", into_mean}, {"max", into_max}}},
+      {"zone_row_sums", {{"min", zone_min}, {"max", zone_max}}}};
+}
+
 }  // namespace
 
 CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts) {
@@ -145,6 +192,7 @@ CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts) {
   pt->needs(nm);
   nm->needs(pt);
   pt->excludes(by);
+  add_medium_options(cmd, opts.medium);
   return cmd;
 }
 
@@ -157,8 +205,15 @@ int run_formfactors(const FormFactorsOptions& opts) {
       !opts.report.empty() || opts.output.empty()
           ? opts.report
           : fs::path(opts.output).replace_extension(".report.json").string();
+  const std::shared_ptr<const Medium> medium = make_medium(opts.medium);
+  if (medium && (opts.by_surface || !opts.point.empty() || opts.with_stderr))
+    throw UsageError(
+        "--by-surface, --point and --stderr do not combine with a participating medium yet: "
+        "save F (-o F.bin or F.mtx) and read the zone columns");
   JobPlan plan = job_plan(opts.run);
   plan.outputs = {{"-o", opts.output}};
+  plan.medium = medium.get();
+  plan.medium_rays = opts.medium.rays;
   if (opts.point.empty()) {
     plan.outputs.push_back({"--report", report});
     plan_form_factors(plan, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
@@ -184,12 +239,19 @@ int run_formfactors(const FormFactorsOptions& opts) {
     }
     return 0;
   }
-  const FormFactors ff = obtain_form_factors(scene, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
+  if (medium) check_medium_scene(scene.mesh, nullptr);
+  FormFactors ff =
+      obtain_form_factors(scene, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
   warn_about_lighting(scene.mesh, ff.F);
   check_closed_lossless(scene.mesh, ff, false);
+  // Diagnostics of the patches' F; with a medium they describe the surfaces' exchange before
+  // the medium attenuates it.
   const FormFactorDiagnostics d = diagnose(scene.mesh, ff.F);
   print_diagnostics(scene, ff, d);
+  Json report_json = diagnostics_json(scene, ff, d, "");
+  if (medium) report_json["medium"] = extend_with_zones(scene, *medium, opts.medium, opts.run, ff);
   const std::string settings = settings_string(ff.options, scene);
+  report_json["settings"] = settings;
   const std::string ext = fs::path(opts.output).extension().string();
   const ValuePrecision precision =
       opts.precision == "float" ? ValuePrecision::Float : ValuePrecision::Double;
@@ -201,7 +263,7 @@ int run_formfactors(const FormFactorsOptions& opts) {
     write_ff_binary(opts.output, ff, {mesh_hash(scene.mesh), settings}, precision);
   }
   log_info("wrote " + opts.output);
-  write_json_file(report, diagnostics_json(scene, ff, d, settings));
+  write_json_file(report, report_json);
   log_info("wrote " + report);
   return 0;
 }

@@ -104,11 +104,6 @@ std::shared_ptr<const Medium> make_medium(const MediumArgs& args) {
   if (!((hi - lo).minCoeff() > 0.0))
     throw UsageError("--medium-box: empty or inverted box (need X0 < X1, Y0 < Y1, Z0 < Z1)");
   const Eigen::Vector3d sa = rgb_or_zero(args.sigma_a), ss = rgb_or_zero(args.sigma_s);
-  const Eigen::Vector3d st = sa + ss;
-  if (st.maxCoeff() - st.minCoeff() > 1e-12 * st.maxCoeff())
-    throw UsageError(
-        "--sigma-a + --sigma-s (the extinction) must be the same in every channel; "
-        "colour goes in the albedo sigma-s / (sigma-a + sigma-s) and the emission");
   auto m = std::make_shared<Medium>(
       homogeneous_medium(lo, hi, medium_resolution(lo, hi, args.voxels, args.voxel_size), sa, ss,
                          rgb_or_zero(args.emission)));
@@ -116,7 +111,7 @@ std::shared_ptr<const Medium> make_medium(const MediumArgs& args) {
   src << "box " << lo.x() << ',' << lo.y() << ',' << lo.z() << ',' << hi.x() << ',' << hi.y() << ','
       << hi.z();
   m->source = src.str();
-  validate_medium(*m, "--medium-box");
+  validate_medium(*m, "--medium-box with --sigma-a/--sigma-s");
   return m;
 }
 
@@ -133,6 +128,17 @@ void check_medium_scene(const PatchMesh& mesh, const ShadeArgs* shade) {
   check_vertex_interp(*shade, false, "a participating medium");
 }
 
+FormFactors medium_form_factors(const LoadedScene& scene, const FormFactors& surface,
+                                const Medium& medium, const Zones& zones, const MediumArgs& args,
+                                const RunArgs& run) {
+  MediumFactorOptions mo;
+  mo.rays = args.rays;
+  mo.transmittance_samples = args.transmittance_samples;
+  mo.seed = run.seed;
+  mo.threads = run.threads;
+  return extend_with_medium(scene.mesh, medium, zones, surface, mo, scene_bvh(scene, run.threads));
+}
+
 MediumResult solve_scene_with_medium(const LoadedScene& scene, const FormFactors& surface,
                                      std::shared_ptr<const Medium> medium, const MediumArgs& args,
                                      const SolveOptions& solver, const RunArgs& run,
@@ -142,19 +148,22 @@ MediumResult solve_scene_with_medium(const LoadedScene& scene, const FormFactors
   const Medium& m = *out.medium;
   const PatchMesh& mesh = scene.mesh;
   const std::int32_t n = mesh.size();
-  warn_about_lighting(mesh, surface.F);
-  check_closed_lossless(mesh, surface);
   const Timer timer;
   out.zones = make_zones(m);
   const Zones& zones = out.zones;
-  MediumFactorOptions mo;
-  mo.rays = args.rays;
-  mo.transmittance_samples = args.transmittance_samples;
-  mo.seed = run.seed;
-  mo.threads = run.threads;
-  const FormFactors F =
-      extend_with_medium(mesh, m, zones, surface, mo, scene_bvh(scene, run.threads));
+  // A loaded F may hold the zones already (obtain_form_factors checked it is this medium's).
+  FormFactors extended;
+  if (surface.options.medium_zones == 0) {
+    warn_about_lighting(mesh, surface.F);
+    check_closed_lossless(mesh, surface);
+    extended = medium_form_factors(scene, surface, m, zones, args, run);
+  }
+  const FormFactors& F = surface.options.medium_zones == 0 ? extended : surface;
+  LAMBERT_CHECK(F.F.rows() == n + zones.size(), "extended F does not match the zones");
   out.seconds = timer.seconds();
+  out.loaded = surface.options.medium_zones > 0;
+  out.rays = F.options.medium_rays;
+  out.transmittance_samples = F.options.transmittance_samples;
   out.stats = F.stats;
   out.entries = F.F.nonZeros();
   log_info("medium: " + std::to_string(zones.size()) + " zones, " + std::to_string(out.entries) +
@@ -198,14 +207,15 @@ MediumResult solve_scene_with_medium(const LoadedScene& scene, const FormFactors
   return out;
 }
 
-Json medium_json(const MediumResult& m, const MediumArgs& args) {
+Json medium_json(const MediumResult& m) {
   const Medium& md = *m.medium;
   Json j = {{"source", md.source},
             {"bounds", {md.lo.x(), md.lo.y(), md.lo.z(), md.hi.x(), md.hi.y(), md.hi.z()}},
             {"resolution", {md.resolution.x(), md.resolution.y(), md.resolution.z()}},
             {"zones", m.zones.size()},
-            {"rays_per_unknown", args.rays},
-            {"transmittance_samples", args.transmittance_samples},
+            {"rays_per_unknown", m.rays},
+            {"transmittance_samples", m.transmittance_samples},
+            {"loaded", m.loaded},
             {"entries", m.entries},
             {"seconds", m.seconds}};
   j["absorbed_surfaces"] = {m.absorbed_surfaces[0], m.absorbed_surfaces[1], m.absorbed_surfaces[2]};
@@ -213,12 +223,12 @@ Json medium_json(const MediumResult& m, const MediumArgs& args) {
   return j;
 }
 
-std::string medium_settings_text(const MediumResult& m, const MediumArgs& args) {
+std::string medium_settings_text(const MediumResult& m) {
   const Medium& md = *m.medium;
   std::ostringstream s;
   s << "medium=\"" << md.source << "\" voxels=" << md.resolution.x() << 'x' << md.resolution.y()
-    << 'x' << md.resolution.z() << " medium_rays=" << args.rays
-    << " transmittance_samples=" << args.transmittance_samples;
+    << 'x' << md.resolution.z() << " medium_rays=" << m.rays
+    << " transmittance_samples=" << m.transmittance_samples;
   return s.str();
 }
 

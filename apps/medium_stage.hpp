@@ -55,6 +55,11 @@ std::shared_ptr<const Medium> make_medium(const MediumArgs& args);
 /// without the medium).
 void check_medium_scene(const PatchMesh& mesh, const ShadeArgs* shade);
 
+/// The extended F (patches, then the zones of `medium`) from the patches' `surface` F.
+FormFactors medium_form_factors(const LoadedScene& scene, const FormFactors& surface,
+                                const Medium& medium, const Zones& zones, const MediumArgs& args,
+                                const RunArgs& run);
+
 /// What the extended solve produced.
 struct MediumResult {
   std::shared_ptr<const Medium> medium;
@@ -62,13 +67,16 @@ struct MediumResult {
   FormFactorStats stats;     ///< of the extended F (rays include the surface estimator's)
   std::int64_t entries = 0;  ///< stored entries of the extended F
   double seconds = 0.0;      ///< the medium's exchange factors
+  bool loaded = false;       ///< they came with a loaded F (--ff)
+  int rays = 0, transmittance_samples = 0;  ///< their settings (the file's when loaded)
   /// Per channel: power absorbed by the surfaces and by the medium (W); together they are
   /// the energy balance's `absorbed`.
   std::array<double, 3> absorbed_surfaces{}, absorbed_medium{};
   MediumView view;  ///< the per-voxel radiosity for rendering
 };
 
-/// Extends `surface` (the patches' F) with the medium's zones, solves the extended system
+/// Extends `surface` (the patches' F) with the medium's zones (unless it holds them already:
+/// a loaded extended F, checked by obtain_form_factors), solves the extended system
 /// and fills `r` (B: the patches' rows only; solution: every unknown; indirect: empty, since
 /// exact-direct vertices are refused with a medium) and the returned result.
 MediumResult solve_scene_with_medium(const LoadedScene& scene, const FormFactors& surface,
@@ -76,12 +84,13 @@ MediumResult solve_scene_with_medium(const LoadedScene& scene, const FormFactors
                                      const SolveOptions& solver, const RunArgs& run,
                                      RadiosityResult& r);
 
-/// The report section: {source, bounds, resolution, zones, rays, transmittance_samples,
-/// entries, seconds, absorbed_surfaces [R,G,B], absorbed_medium [R,G,B]}.
-Json medium_json(const MediumResult& m, const MediumArgs& args);
+/// The report section: {source, bounds, resolution, zones, rays_per_unknown,
+/// transmittance_samples, loaded, entries, seconds, absorbed_surfaces [R,G,B],
+/// absorbed_medium [R,G,B]}.
+Json medium_json(const MediumResult& m);
 
 /// One line of key=value text for metadata: "medium=SOURCE voxels=NXxNYxNZ medium_rays=K
 /// transmittance_samples=S".
-std::string medium_settings_text(const MediumResult& m, const MediumArgs& args);
+std::string medium_settings_text(const MediumResult& m);
 
 }  // namespace lambert

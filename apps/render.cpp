@@ -92,6 +92,8 @@ int render_matrix(const RenderOptions& opts) {
   JobPlan plan = render_plan(opts);
   if (opts.radiosity.empty()) {
     plan_form_factors(plan, opts.ff, opts.run);
+    plan.medium = medium.get();
+    plan.medium_rays = opts.medium.rays;
     plan.direct = opts.solver.solver == "direct";
   } else {
     plan.inputs.push_back({"--radiosity", opts.radiosity});
@@ -103,13 +105,12 @@ int render_matrix(const RenderOptions& opts) {
   if (medium) {
     check_medium_scene(loaded.mesh, &opts.shade);
     const Timer timer;
-    const FormFactors F = obtain_form_factors(loaded, opts.ff, opts.run);
+    const FormFactors F = obtain_form_factors(loaded, opts.ff, opts.run, false, medium.get());
     r.ff_seconds = timer.seconds();
     const MediumResult m =
         solve_scene_with_medium(loaded, F, medium, opts.medium, opts.solver, opts.run, r);
     render_and_write(opts, loaded, r.B, nullptr, camera,
-                     matrix_settings(opts, loaded, r) + ' ' + medium_settings_text(m, opts.medium),
-                     &m.view);
+                     matrix_settings(opts, loaded, r) + ' ' + medium_settings_text(m), &m.view);
     return r.solution.status != SolveStatus::Converged ? kExitNotConverged : kExitOk;
   }
   if (!opts.radiosity.empty()) {

@@ -240,10 +240,10 @@ std::string loading_what(const RunOptions& opts, const char* verb) {
 }
 
 // The medium's part of the report and summary.
-void describe_medium(const RunOptions& opts, const MediumResult& medium, MethodOutcome& m) {
+void describe_medium(const MediumResult& medium, MethodOutcome& m) {
   m.medium = &medium.view;
-  m.settings += ' ' + medium_settings_text(medium, opts.medium);
-  m.sections["medium"] = medium_json(medium, opts.medium);
+  m.settings += ' ' + medium_settings_text(medium);
+  m.sections["medium"] = medium_json(medium);
   const Eigen::Vector3i& res = medium.medium->resolution;
   char line[256];
   std::snprintf(line, sizeof line,
@@ -270,6 +270,8 @@ int run_matrix(const RunOptions& opts) {
   JobPlan plan;
   const RunPaths paths = prepare_outputs(opts, plan);
   plan_form_factors(plan, opts.ff, opts.run);
+  plan.medium = medium.get();
+  plan.medium_rays = opts.medium.rays;
   plan.direct = opts.solver.solver == "direct";
   LoadedScene loaded = load_scene(opts.scene, plan);
   const Camera camera = make_camera(loaded.scene, opts.camera);
@@ -311,7 +313,7 @@ int run_matrix(const RunOptions& opts) {
     r.solved = true;
     warn_about_lighting(loaded.mesh, F.F);
   } else {
-    const FormFactors F = obtain_form_factors(loaded, opts.ff, opts.run);
+    const FormFactors F = obtain_form_factors(loaded, opts.ff, opts.run, false, medium.get());
     r.ff_seconds = timer.seconds();
     if (medium) {
       stages.next("medium zones and solving (I - rho F) B = E with " + opts.solver.solver);
@@ -331,7 +333,7 @@ int run_matrix(const RunOptions& opts) {
            << ff_settings_text(r.ff_options, opts.ff.ff_file) << " solver=" << opts.solver.solver
            << " tol=" << opts.solver.tol;
   m.settings = settings.str();
-  if (medium_result) describe_medium(opts, *medium_result, m);
+  if (medium_result) describe_medium(*medium_result, m);
   Json& ff = m.sections["form_factors"] = ff_settings_json(r.ff_options, opts.ff.ff_file);
   ff["entries"] = r.ff_entries;
   ff["pairs_tested"] = r.ff_stats.pairs_tested;

@@ -60,6 +60,8 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
   JobPlan plan = job_plan(opts.run);
   plan.outputs = {{"-o", opts.output}, {"the summary", summary_path(opts.output)}};
   plan_form_factors(plan, opts.ff, opts.run);
+  plan.medium = medium.get();
+  plan.medium_rays = opts.medium.rays;
   plan.direct = opts.solve.solver == "direct";
   LoadedScene loaded = load_scene(opts.scene, plan);
   const double load_seconds = total.seconds();
@@ -75,7 +77,7 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
   std::int64_t nonzeros = 0;
   if (medium) {
     check_medium_scene(loaded.mesh, nullptr);
-    ff = obtain_form_factors(loaded, opts.ff, opts.run);
+    ff = obtain_form_factors(loaded, opts.ff, opts.run, false, medium.get());
     RadiosityResult r;
     medium_result = solve_scene_with_medium(loaded, ff, medium, opts.medium, so, opts.run, r);
     ff_seconds = ff_timer.seconds() - r.solve_seconds;
@@ -125,7 +127,7 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
               {"solve_seconds", sol.seconds}}},
             {"form_factors", ff_settings_json(ff.options, opts.ff.ff_file)},
             {"form_factor_nonzeros", nonzeros}};
-  if (medium_result) j["medium"] = medium_json(*medium_result, opts.medium);
+  if (medium_result) j["medium"] = medium_json(*medium_result);
   Json& channels = j["channels"] = Json::array();
   for (int c = 0; c < 3; ++c) channels.push_back(channel_json(sol.channels[c], sol.energy[c], c));
   j["surfaces"] = surface_averages_json(surfaces);

@@ -1,6 +1,9 @@
 #include "geometry/medium.hpp"
 
+#include <cstring>
+
 #include "core/error.hpp"
+#include "core/sampling.hpp"
 
 namespace lambert {
 
@@ -63,6 +66,18 @@ void validate_medium(const Medium& m, const std::string& what) {
       throw UsageError(what + ": voxel " + std::to_string(v) +
                        " emits but has sigma_a + sigma_s = 0 (emission needs extinction)");
   }
+}
+
+std::uint64_t extinction_hash(const Medium& m) {
+  std::uint64_t h = mix64(static_cast<std::uint64_t>(m.voxels()));
+  const auto add = [&](double x) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    h = mix64(h ^ bits);
+  };
+  for (int a = 0; a < 3; ++a) add(m.lo[a]), add(m.hi[a]), add(m.resolution[a]);
+  for (std::int32_t v = 0; v < m.voxels(); ++v) add(m.sigma_t(v));
+  return h;
 }
 
 double optical_depth(const Medium& medium, const Eigen::Vector3d& o, const Eigen::Vector3d& d,

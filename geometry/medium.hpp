@@ -75,6 +75,11 @@ Medium homogeneous_medium(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
 /// difference), or a voxel emits without extinction (emission needs σt > 0).
 void validate_medium(const Medium& medium, const std::string& what);
 
+/// A hash of what the exchange factors depend on: the box, the resolution and every voxel's
+/// extinction σt (bit patterns). Albedo and emission are left out: they enter the system as
+/// the zones' ρ and E, not F, so a saved F serves any of them (like a surface's colour).
+std::uint64_t extinction_hash(const Medium& medium);
+
 /// Visits, in order along the ray o + t d (d unit), every voxel the part t ∈ [t0, t1] crosses
 /// with positive length: visit(voxel, t_enter, t_exit). Nothing when the segment misses the
 /// box. Each crossing's parameters come from the voxel planes directly (not accumulated), so

@@ -174,6 +174,30 @@ bool extended_settings(const std::string& settings) {
   return parse_ff_settings(settings, o) && o.extended;
 }
 
+// The number of participating-medium zones the settings say F holds after its patches
+// (media.hpp: they are rows and columns n - zones .. n - 1; a zone extinguishes part of
+// its own rays, so its diagonal may be nonzero), 0 for none.
+std::int64_t medium_zones_of(const std::string& settings) {
+  FormFactorOptions o;
+  return parse_ff_settings(settings, o) ? o.medium_zones : 0;
+}
+
+// The first row whose diagonal entry may be nonzero: every row of extended form factors (a
+// patch sees itself through a mirror), the zone rows of a medium's, else none (n).
+std::int64_t first_self_row(const std::string& settings, std::int64_t n) {
+  return extended_settings(settings) ? 0 : n - medium_zones_of(settings);
+}
+
+// The zones the settings announce, checked against the matrix size n (IoError: a header
+// that does not fit its matrix is corrupt).
+std::int64_t checked_zones(const std::string& settings, std::int64_t n, const std::string& path) {
+  const std::int64_t zones = medium_zones_of(settings);
+  if (zones > n)
+    throw IoError(path + ": corrupt header: " + std::to_string(zones) +
+                  " medium zones in a matrix of " + std::to_string(n) + " rows");
+  return zones;
+}
+
 std::string patch_pair(std::int64_t i, std::int64_t j) {
   return "entry (" + std::to_string(i) + ", " + std::to_string(j) + ")";
 }
@@ -185,12 +209,11 @@ std::string value_text(double v) {
 }
 
 // What is physically wrong with the value of F_ij (or its standard error), or "".
-std::string bad_value(double v, std::int64_t i, std::int64_t j, bool is_stderr,
-                      bool extended) {
+std::string bad_value(double v, std::int64_t i, std::int64_t j, bool is_stderr, bool self_allowed) {
   const char* what = is_stderr ? "standard error" : "value";
   if (!std::isfinite(v)) return std::string(what) + " " + value_text(v) + " is not finite";
   if (v < 0) return std::string(what) + " " + value_text(v) + " is negative";
-  if (!is_stderr && i == j && v != 0 && !extended)
+  if (!is_stderr && i == j && v != 0 && !self_allowed)
     return "nonzero diagonal " + value_text(v) + " (a planar patch sees none of itself)";
   return "";
 }
@@ -228,7 +251,7 @@ void check_row_sums(const FormFactors& ff, const std::string& settings, const st
 // Binary structure and values: row starts from 0 to nnz and monotone, columns in range,
 // strictly increasing within a row, values (and standard errors) finite, non-negative,
 // zero on the diagonal. Linear in nnz.
-void check_binary_entries(const FormFactors& ff, const std::string& path, bool extended) {
+void check_binary_entries(const FormFactors& ff, const std::string& path, std::int64_t self_from) {
   const std::int64_t n = ff.F.rows(), nnz = ff.F.nonZeros();
   const auto* outer = ff.F.outerIndexPtr();
   const auto* col = ff.F.innerIndexPtr();
@@ -250,9 +273,9 @@ void check_binary_entries(const FormFactors& ff, const std::string& path, bool e
       if (k > outer[i] && col[k] <= col[k - 1])
         throw corrupt(patch_pair(i, col[k]) + (col[k] == col[k - 1] ? " repeated" : " unsorted") +
                       " (columns must increase within a row)");
-      std::string why = bad_value(ff.F.valuePtr()[k], i, col[k], false, extended);
+      std::string why = bad_value(ff.F.valuePtr()[k], i, col[k], false, i >= self_from);
       if (why.empty() && with_err)
-        why = bad_value(ff.stderr_F.valuePtr()[k], i, col[k], true, extended);
+        why = bad_value(ff.stderr_F.valuePtr()[k], i, col[k], true, i >= self_from);
       if (!why.empty()) throw SceneError(path + ": " + patch_pair(i, col[k]) + ": " + why);
     }
   }
@@ -320,7 +343,8 @@ FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t
                   std::to_string(file_size));
   std::string settings(len, '\0');
   r.get(settings.data(), len);
-  if (expected_n >= 0) check_identity(path, hash, n, expected_hash, expected_n);
+  const std::int64_t zones = checked_zones(settings, n, path);
+  if (expected_n >= 0) check_identity(path, hash, n - zones, expected_hash, expected_n);
   FormFactors ff;
   ff.F.resize(n, n);
   ff.F.resizeNonZeros(nnz);
@@ -355,7 +379,7 @@ FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t
     if (!(ff.specular_continued[i] >= 0.0) || !std::isfinite(ff.specular_continued[i]))
       throw SceneError(path + ": specular bookkeeping of patch " + std::to_string(i) + " is " +
                        value_text(ff.specular_continued[i]) + " (must be finite and >= 0)");
-  check_binary_entries(ff, path, extended_settings(settings));
+  check_binary_entries(ff, path, first_self_row(settings, n));
   check_row_sums(ff, settings, path, f32 ? kFloatRounding : 0.0);
   if (info) *info = {hash, settings};
   return ff;
@@ -433,7 +457,7 @@ FormFactorFileInfo read_mm_header(LineReader& lines, std::string_view& line, boo
 // One entry line "i j value": exactly three fields, indices in [1, n], value finite, >= 0
 // and 0 on the diagonal.
 MmEntry parse_mm_entry(const LineReader& lines, std::string_view line, std::int64_t n,
-                       bool extended, std::vector<std::string_view>& tok) {
+                       std::int64_t self_from, std::vector<std::string_view>& tok) {
   split_fields(line, tok);
   if (tok.size() != 3)
     throw SceneError(lines.where() + ": expected 'row column value', found " +
@@ -448,7 +472,7 @@ MmEntry parse_mm_entry(const LineReader& lines, std::string_view line, std::int6
   if (i < 1 || i > n || j < 1 || j > n)
     throw SceneError(lines.where() + ": entry (" + std::to_string(i) + ", " + std::to_string(j) +
                      ") out of range [1, " + std::to_string(n) + "]");
-  why = bad_value(v, i, j, false, extended);
+  why = bad_value(v, i, j, false, i - 1 >= self_from);
   if (!why.empty()) throw SceneError(lines.where() + ": " + why);
   return {static_cast<std::int32_t>(i - 1), static_cast<std::int32_t>(j - 1), v, lines.line_number(),
           half_unit_in_last_digit(tok[2])};
@@ -489,7 +513,6 @@ FormFactors read_matrix_market(std::istream& in, const std::string& path,
   std::string_view line;
   bool have_hash = false;
   const FormFactorFileInfo meta = read_mm_header(lines, line, have_hash);
-  const bool extended = extended_settings(meta.settings);
   if (!have_hash && expected_n >= 0)
     throw SceneError(path + ": no lambert mesh hash in the header: cannot check it belongs to "
                             "this scene");
@@ -504,7 +527,10 @@ FormFactors read_matrix_market(std::istream& in, const std::string& path,
     throw IoError(lines.where() + ": truncated: the size line promises " + std::to_string(nnz) +
                   " entries, a file of " + std::to_string(file_size) + " bytes holds at most " +
                   std::to_string((file_size + 1) / kMinEntryBytes));
-  if (expected_n >= 0) check_identity(path, meta.mesh_hash, rows, expected_hash, expected_n);
+  const std::int64_t zones = checked_zones(meta.settings, rows, path);
+  if (expected_n >= 0)
+    check_identity(path, meta.mesh_hash, rows - zones, expected_hash, expected_n);
+  const std::int64_t self_from = first_self_row(meta.settings, rows);
   std::vector<MmEntry> entries;
   entries.reserve(static_cast<size_t>(nnz));
   while (lines.next(line)) {
@@ -512,7 +538,7 @@ FormFactors read_matrix_market(std::istream& in, const std::string& path,
     if (static_cast<std::int64_t>(entries.size()) == nnz)
       throw SceneError(lines.where() + ": extra line after the " + std::to_string(nnz) +
                        " entries the size line announced");
-    entries.push_back(parse_mm_entry(lines, line, rows, extended, tok));
+    entries.push_back(parse_mm_entry(lines, line, rows, self_from, tok));
   }
   if (static_cast<std::int64_t>(entries.size()) != nnz)
     throw IoError(path + ": truncated: " + std::to_string(entries.size()) + " of " +
@@ -560,7 +586,13 @@ std::string format_ff_settings(const FormFactorOptions& o) {
          (o.extended ? " specular_depth=" + std::to_string(o.specular_depth) +
                            " specular_rays=" + std::to_string(o.specular_rays)
                      : "") +
-         (o.estimator == "analytic" ? std::string(" tol=") + tol : std::string());
+         (o.estimator == "analytic" ? std::string(" tol=") + tol : std::string()) +
+         (o.medium_zones > 0
+              ? " medium_zones=" + std::to_string(o.medium_zones) +
+                    " medium_extinction=" + std::to_string(o.medium_extinction) +
+                    " medium_rays=" + std::to_string(o.medium_rays) +
+                    " transmittance_samples=" + std::to_string(o.transmittance_samples)
+              : std::string());
 }
 
 bool parse_ff_settings(const std::string& text, FormFactorOptions& options) {
@@ -598,6 +630,17 @@ bool parse_ff_settings(const std::string& text, FormFactorOptions& options) {
     } else if (key == "specular_rays") {
       if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
       o.specular_rays = static_cast<int>(k);
+    } else if (key == "medium_zones") {
+      if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
+      o.medium_zones = static_cast<std::int32_t>(k);
+    } else if (key == "medium_extinction") {
+      if (!parse_uint(value, o.medium_extinction)) return false;
+    } else if (key == "medium_rays") {
+      if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
+      o.medium_rays = static_cast<int>(k);
+    } else if (key == "transmittance_samples") {
+      if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
+      o.transmittance_samples = static_cast<int>(k);
     } else if (key == "tol") {
       if (!parse_double(value, o.tol) || !(o.tol > 0.0)) return false;
     } else if (key == "symmetrize") {

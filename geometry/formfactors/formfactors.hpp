@@ -52,6 +52,14 @@ struct FormFactorOptions {
   /// Set on the result: F holds the specular paths (the mesh had specular surfaces and
   /// specular_depth > 0).
   bool extended = false;
+  /// Set on the result of extend_with_medium (media.hpp): F also holds the medium's zones,
+  /// rows and columns N..N+medium_zones-1 (0: no medium). The extinction hash
+  /// (medium.hpp: extinction_hash) names the medium the zones came from; medium_rays and
+  /// transmittance_samples are its settings.
+  std::int32_t medium_zones = 0;
+  std::uint64_t medium_extinction = 0;
+  int medium_rays = 0;
+  int transmittance_samples = 0;
   /// Incremental updates (adaptive meshing): when non-empty (one flag per patch), only the
   /// pairs with a flagged patch are estimated (pair estimators: both entries of each such
   /// pair; gather and hemicube: the flagged rows); everything else is left empty, and

@@ -211,6 +211,20 @@ SparseF zone_block(std::vector<Row>& rows, const std::vector<double>& target, co
 
 }  // namespace
 
+double medium_peak_bytes(std::int64_t patches, const Medium& medium, int rays) {
+  std::int64_t m = 0;
+  for (std::int32_t v = 0; v < medium.voxels(); ++v) m += medium.sigma_t(v) > 0.0;
+  const double k = std::max(rays, 1);
+  const double r0 = std::sqrt(k / (4.0 * M_PI)), far = medium.resolution.maxCoeff();
+  const double seen = 4.0 * M_PI / 3.0 * r0 * r0 * r0 + k * std::max(0.0, far - r0);
+  const double row = std::min<double>(static_cast<double>(m), seen);
+  const double entries = static_cast<double>(m) * row + 2.0 * patches * row;
+  // 16 bytes per entry (value and column), assembled, plus the staged rows: they are freed
+  // row by row as the CSR fills, so half of them on average coexist with it.
+  constexpr double kEntryBytes = 16.0;
+  return 1.5 * kEntryBytes * entries;
+}
+
 Zones make_zones(const Medium& medium) {
   Zones z;
   const std::int32_t m = medium.voxels();
@@ -289,6 +303,10 @@ FormFactors extend_with_medium(const PatchMesh& mesh, const Medium& medium, cons
   }
   FormFactors out;
   out.options = surface.options;
+  out.options.medium_zones = m;
+  out.options.medium_extinction = extinction_hash(medium);
+  out.options.medium_rays = o.rays;
+  out.options.transmittance_samples = o.transmittance_samples;
   out.stats = surface.stats;
   const SparseF block = zone_block(zone_rows, share, zones, out.stats, o.threads);
 

@@ -74,6 +74,17 @@ Zones make_zones(const Medium& medium);
 double pair_transmittance(const PatchMesh& mesh, const Medium& medium, std::int32_t a,
                           std::int32_t b, int samples, std::uint64_t seed);
 
+/// An estimate of the peak bytes the medium adds to a computation on `patches` patches with
+/// `rays` = K rays per unknown: the extended F's zone columns and rows and their staged rows
+/// (the patches' block is copied too: the caller adds its size). The K rays of a zone cover
+/// every voxel out to the distance r0 = sqrt(K / 4π) voxels (where 4π r² = K), then about K
+/// voxels per voxel of distance out to R, the box's longest side in voxels: a zone row holds
+/// min(M, 4π r0³ / 3 + K (R − r0)) entries, and a patch row deposits as many (mirrored into
+/// the zone rows). Against medium_bench on the Cornell box at K = 256 (entries estimated /
+/// measured): 8³ 1.9 M / 1.0 M, 16³ 24 M / 9.2 M, 32³ 267 M / 158 M; bytes 551 MiB / 455 MB
+/// RSS at 16³, 6.0 GiB / 6.1 GB at 32³.
+double medium_peak_bytes(std::int64_t patches, const Medium& medium, int rays);
+
 /// The extended (N + M)² F from the surfaces' `surface` F (N x N, reciprocal: a pair
 /// estimator's or an averaged one) and the medium (see above). The result's stats add the
 /// medium's rays; its options are `surface`'s.

@@ -446,6 +446,141 @@ TEST(MediumCli, SavedSurfaceFactorsTakeTheMediumOnTop) {
   EXPECT_EQ(slurp(dir.file("a.csv")), slurp(dir.file("b.csv")));
 }
 
+// The fog of the saved-F tests: 2³ zones of sigma_t 0.0015 / mm.
+std::vector<std::string> saved_fog(const std::string& sigma_a, const std::string& sigma_s) {
+  return {"--medium-box",
+          "0,0,0,556,548.8,559.2",
+          "--sigma-a",
+          sigma_a,
+          "--sigma-s",
+          sigma_s,
+          "--voxels",
+          "2",
+          "--medium-rays",
+          "16",
+          "--transmittance-samples",
+          "4"};
+}
+
+std::vector<std::string> joined(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+TEST(MediumCli, FormFactorsSavesTheZonesAndSolveReusesThem) {
+  // `formfactors` with a medium writes the extended F (patches, then zones); `solve --ff`
+  // with the same medium takes it as it is: the same B as computing everything in `solve`
+  // (same seed; .bin stores doubles, .mtx writes %.17g: both round-trip bit for bit).
+  TempDir dir;
+  const std::vector<std::string> fog = saved_fog("0.0005,0.0005,0.0005", "0.001,0.001,0.001");
+  const std::vector<std::string> mesh = {"--patches", "80", "-q"};
+  ::testing::internal::CaptureStdout();
+  ASSERT_EQ(
+      run(joined(joined({"formfactors", "-o", dir.file("F.bin"), "--samples", "4"}, mesh), fog)),
+      kExitOk);
+  ASSERT_EQ(
+      run(joined(joined({"formfactors", "-o", dir.file("F.mtx"), "--samples", "4"}, mesh), fog)),
+      kExitOk);
+  ASSERT_EQ(run(joined(joined({"solve", "-o", dir.file("a.csv"), "--samples", "4"}, mesh), fog)),
+            kExitOk);
+  ASSERT_EQ(
+      run(joined(joined({"solve", "-o", dir.file("b.csv"), "--ff", dir.file("F.bin")}, mesh), fog)),
+      kExitOk);
+  ASSERT_EQ(
+      run(joined(joined({"solve", "-o", dir.file("c.csv"), "--ff", dir.file("F.mtx")}, mesh), fog)),
+      kExitOk);
+  ::testing::internal::GetCapturedStdout();
+  EXPECT_EQ(slurp(dir.file("a.csv")), slurp(dir.file("b.csv")));
+  EXPECT_EQ(slurp(dir.file("a.csv")), slurp(dir.file("c.csv")));
+  const nlohmann::json report = nlohmann::json::parse(slurp(dir.file("F.report.json")));
+  EXPECT_EQ(report.at("medium").at("zones").get<int>(), 8);
+  EXPECT_NE(report.at("settings").get<std::string>().find("medium_zones=8"), std::string::npos);
+  // The summary says the zones came with the file.
+  const nlohmann::json b = nlohmann::json::parse(slurp(dir.file("b.json")));
+  EXPECT_TRUE(b.at("medium").at("loaded").get<bool>());
+  EXPECT_EQ(b.at("medium").at("rays_per_unknown").get<int>(), 16);
+}
+
+TEST(MediumCli, SavedZonesServeAnyAlbedoOfTheSameExtinction) {
+  // F depends on the extinction only: the saved zones with another albedo (same sigma_t =
+  // 0.0015) give bitwise the B of computing F with that albedo; another extinction is
+  // refused (exit 1), and no medium at all is a usage error (exit 2).
+  TempDir dir;
+  const std::vector<std::string> mesh = {"--patches", "80", "-q"};
+  const std::vector<std::string> grey = saved_fog("0.0005,0.0005,0.0005", "0.001,0.001,0.001");
+  const std::vector<std::string> tinted = saved_fog("0.001,0.0005,0", "0.0005,0.001,0.0015");
+  ::testing::internal::CaptureStdout();
+  ASSERT_EQ(
+      run(joined(joined({"formfactors", "-o", dir.file("F.bin"), "--samples", "4"}, mesh), grey)),
+      kExitOk);
+  ASSERT_EQ(run(joined(joined({"solve", "-o", dir.file("a.csv"), "--samples", "4"}, mesh), tinted)),
+            kExitOk);
+  ASSERT_EQ(run(joined(joined({"solve", "-o", dir.file("b.csv"), "--ff", dir.file("F.bin")}, mesh),
+                       tinted)),
+            kExitOk);
+  ::testing::internal::GetCapturedStdout();
+  EXPECT_EQ(slurp(dir.file("a.csv")), slurp(dir.file("b.csv")));
+  const std::vector<std::string> thicker = saved_fog("0.001,0.001,0.001", "0.001,0.001,0.001");
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(run(joined(joined({"solve", "-o", dir.file("c.csv"), "--ff", dir.file("F.bin")}, mesh),
+                       thicker)),
+            kExitFailure);
+  EXPECT_NE(::testing::internal::GetCapturedStderr().find("another participating medium"),
+            std::string::npos);
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(run(joined({"solve", "-o", dir.file("d.csv"), "--ff", dir.file("F.bin")}, mesh)),
+            kExitUsage);
+  EXPECT_NE(::testing::internal::GetCapturedStderr().find("F.bin: holds the exchange factors"),
+            std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("c.csv")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("d.csv")));
+}
+
+TEST(MediumCli, CompareRunsEverySolverOnTheExtendedSystem) {
+  // The command compares on patches + zones: each solver reaches its stopping rule there
+  // (their agreement with direct within tol ||E|| / (1 - rho_max) on the extended system is
+  // MediumSolvers.EverySolverMatchesDirectOnTheExtendedSystem).
+  TempDir dir;
+  const std::vector<std::string> fog = saved_fog("0.0005,0.0005,0.0005", "0.001,0.001,0.001");
+  ::testing::internal::CaptureStdout();
+  ASSERT_EQ(run(joined({"compare", "-o", dir.file("cmp") + "/", "--patches", "80", "--samples", "4",
+                        "-q", "--tol", "1e-8", "--solvers", "jacobi,gauss-seidel,bicgstab,direct"},
+                       fog)),
+            kExitOk);
+  const std::string text = ::testing::internal::GetCapturedStdout();
+  EXPECT_NE(text.find("+ 8 medium zones"), std::string::npos) << text;
+  const std::string table = slurp(dir.file("cmp/compare_table.csv"));
+  EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 5) << table;  // header + 4 solvers
+  EXPECT_EQ(std::count(table.begin(), table.end(), '\n') - 1, [&] {
+    int converged = 0;
+    for (size_t at = 0; (at = table.find(",converged,", at)) != std::string::npos; ++at)
+      ++converged;
+    return converged;
+  }()) << table;
+  // The hierarchical comparison has no medium.
+  EXPECT_EQ(
+      run(joined({"compare", "-o", dir.file("h") + "/", "--method", "hierarchical", "-q"}, fog)),
+      kExitUsage);
+}
+
+TEST(MediumCli, TheMemoryEstimateCountsTheZones) {
+  // 32³ zones at 256 rays need gigabytes (media.hpp: medium_peak_bytes; 6.1 GB measured on
+  // the Cornell box): under a 200 MiB limit the job is refused before any work, naming the
+  // medium, while the same job without the medium (1.6 k patches, < 60 MiB) fits.
+  TempDir dir;
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(
+      run({"formfactors", "-o", dir.file("F.bin"), "-q", "--max-memory", "200M", "--medium-box",
+           "0,0,0,556,548.8,559.2", "--sigma-a", "0.001,0.001,0.001", "--voxels", "32"}),
+      kExitUsage);
+  EXPECT_NE(::testing::internal::GetCapturedStderr().find("the medium's zones"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("F.bin")));
+  // --by-surface has no zone columns yet: refused rather than silently dropping the medium.
+  EXPECT_EQ(run({"formfactors", "-o", dir.file("s.json"), "--by-surface", "-q", "--medium-box",
+                 "0,0,0,556,548.8,559.2", "--sigma-a", "0.001,0.001,0.001"}),
+            kExitUsage);
+}
+
 TEST(MediumCli, HeterogeneousGridFileIsRead) {
   TempDir dir;
   std::string grid = "# two voxels along x\nbounds 0 0 0 556 548.8 559.2\nresolution 2 1 1\n";

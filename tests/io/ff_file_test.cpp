@@ -484,4 +484,39 @@ TEST(FormFactorFile, SpecularBookkeepingWithoutExtendedSettingsIsRefused) {
   EXPECT_EQ(back.specular_continued.size(), f.mesh.size());
 }
 
+TEST(FormFactorFile, MediumZonesFollowThePatchesAndMaySeeThemselves) {
+  // A 3 x 3 F with settings announcing 1 medium zone: 2 patches, then zone 2, whose rays are
+  // partly extinguished in itself (a nonzero diagonal in its row only).
+  testing::TempDir dir;
+  const std::string settings =
+      "estimator=hybrid samples=4 seed=1 threshold=0 medium_zones=1 medium_extinction=77 "
+      "medium_rays=16 transmittance_samples=4";
+  const std::string path =
+      write_csr(dir, {0, 1, 2, 4}, {2, 2, 0, 2}, {.3, .3, .2, .4}, {}, settings);
+  FormFactorFileInfo info;
+  const FormFactors ff = read_form_factors(path, kHash, 2, &info);  // the mesh has 2 patches
+  EXPECT_EQ(ff.F.rows(), 3);
+  FormFactorOptions o;
+  ASSERT_TRUE(parse_ff_settings(info.settings, o));
+  EXPECT_EQ(o.medium_zones, 1);
+  EXPECT_EQ(o.medium_extinction, 77u);
+  EXPECT_EQ(o.medium_rays, 16);
+  EXPECT_EQ(o.transmittance_samples, 4);
+  // The same file is from another mesh for 3 patches, and a patch row still sees none of
+  // itself.
+  EXPECT_TRUE(has(refusal<SceneError>(path, 3), "different scene"));
+  const std::string patch_diag =
+      write_csr(dir, {0, 1, 2, 3}, {0, 2, 2}, {.3, .3, .4}, {}, settings);
+  EXPECT_TRUE(has(refusal<SceneError>(patch_diag, 2), "entry (0, 0): nonzero diagonal"));
+  // More zones than rows is a corrupt header; the settings survive a round trip.
+  const std::string too_many =
+      write_csr(dir, {0, 1, 2, 4}, {2, 2, 0, 2}, {.3, .3, .2, .4}, {},
+                "estimator=hybrid samples=4 seed=1 threshold=0 medium_zones=5");
+  EXPECT_TRUE(has(refusal<IoError>(too_many, 2), "5 medium zones in a matrix of 3 rows"));
+  FormFactorOptions back;
+  ASSERT_TRUE(parse_ff_settings(format_ff_settings(o), back));
+  EXPECT_EQ(back.medium_zones, 1);
+  EXPECT_EQ(back.medium_extinction, 77u);
+}
+
 }  // namespace lambert
