@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "apps/cli.hpp"
@@ -182,15 +183,32 @@ void compare_factors(const PatchMesh& mesh, const SparseF& F, const SparseF& ref
                                  std::abs(it.value()) / (0.5 * (area[i] + area[it.col()])));
 }
 
-std::vector<SurfaceRadiosity> solve_surfaces(const PatchMesh& mesh, const SparseF& F, int threads) {
-  const RadiosityProblem problem = make_problem(mesh, F);
+// The participating medium of a study, when there is one: every F gets its zones.
+struct StudyMedium {
+  std::shared_ptr<const Medium> medium;
+  Zones zones;
+  LoadedScene scene;  // the study's scene and mesh, for medium_form_factors
+};
+
+// F over the patches only: with a medium, its top-left N x N block (the attenuated surface
+// factors); the comparisons per patch pair read that.
+SparseF patch_block(const SparseF& F, std::int32_t n) {
+  if (F.rows() == n) return F;
+  return F.topLeftCorner(n, n);
+}
+
+std::vector<SurfaceRadiosity> solve_surfaces(const PatchMesh& mesh, const SparseF& F, int threads,
+                                             const Zones* zones) {
+  const RadiosityProblem problem =
+      zones ? make_extended_problem(mesh, F, zones->albedo, zones->emission, zones->area)
+            : make_problem(mesh, F);
   SolveOptions so;
   so.tol = kSolveTol;
   so.threads = threads;
   const RadiositySolution sol = solve_radiosity(problem, so);
   if (sol.status != SolveStatus::Converged)
     log_warn(std::string("accuracy: radiosity solve ended with status ") + to_string(sol.status));
-  return surface_averages(mesh, sol.B);
+  return surface_averages(mesh, sol.B.topRows(mesh.size()));
 }
 
 // Relative differences of per-surface B (each channel with B_ref > 0): max and RMS.
@@ -392,6 +410,7 @@ CLI::App* add_accuracy_command(CLI::App& app, AccuracyOptions& opts) {
       ->check(output_prefix_check())
       ->capture_default_str();
   add_run_options(cmd, opts.run);
+  add_medium_options(cmd, opts.medium);
   return cmd;
 }
 
@@ -406,9 +425,32 @@ int run_accuracy(const AccuracyOptions& opts) {
   // reference) beside the run's own.
   plan.ff = FormFactorOptions{};
   plan.ff->with_stderr = true;
+  std::optional<StudyMedium> sm;
+  if (const std::shared_ptr<const Medium> medium = make_medium(opts.medium)) {
+    sm.emplace();
+    sm->medium = medium;
+    plan.medium = medium.get();
+    plan.medium_rays = opts.medium.rays;
+  }
   const Study study = make_study(opts, plan);
   const PatchMesh& mesh = study.mesh;
   const bool analytic = !study.exact.empty() && !study.occluded;
+  // With a medium every F, the reference's too, gets the zones with the same medium settings
+  // and streams: the differences are the surface estimators' as the medium carries them.
+  // The closed forms hold without a medium only.
+  const Zones* zones = nullptr;
+  if (sm) {
+    check_medium_scene(mesh, nullptr);
+    sm->zones = make_zones(*sm->medium);
+    sm->scene.scene = study.scene;
+    sm->scene.mesh = mesh;
+    zones = &sm->zones;
+  }
+  const auto add_medium = [&](FormFactors ff) {
+    if (!sm) return ff;
+    return medium_form_factors(sm->scene, ff, *sm->medium, sm->zones, opts.medium, opts.run);
+  };
+  const bool exact = !study.exact.empty() && !sm;
   std::printf("%s: %zu surfaces, %d patches\n", study.name.c_str(), mesh.surface_names.size(),
               mesh.size());
 
@@ -432,32 +474,44 @@ int run_accuracy(const AccuracyOptions& opts) {
     log_info("accuracy: reference hybrid k=" + std::to_string(o.samples));
     ref = compute_form_factors(mesh, o);
   }
+  SparseF ref_stderr;  // the surface reference's own error (the medium's factors have none)
+  ref_stderr.swap(ref.stderr_F);
+  ref = add_medium(std::move(ref));
+  const SparseF ref_block = patch_block(ref.F, mesh.size());
   AccuracyRow ref_row;
   ref_row.estimator = analytic ? "quadrature" : "hybrid";
   ref_row.setting = "reference";
   ref_row.seconds = ref.stats.seconds;
   ref_row.nnz = ref.F.nonZeros();
-  compare_exact(study, ref, ref_row);
-  ref_row.surfaces = solve_surfaces(mesh, ref.F, opts.run.threads);
-  compare_factors(mesh, ref.F, ref.F, ref_row);
-  if (analytic) {
+  if (exact) compare_exact(study, ref, ref_row);
+  ref_row.surfaces = solve_surfaces(mesh, ref.F, opts.run.threads, zones);
+  compare_factors(mesh, ref_block, ref_block, ref_row);
+  if (sm) {
+    std::printf(
+        "medium %s: %d zones, the same medium factors (--medium-rays %d, "
+        "--transmittance-samples %d) added to every F; the closed forms hold without "
+        "a medium and are not compared\n",
+        sm->medium->source.c_str(), sm->zones.size(), opts.medium.rays,
+        opts.medium.transmittance_samples);
+  }
+  if (analytic && !sm) {
     std::printf("reference: per-patch quadrature of the exact point-to-patch factor; exact "
                 "surface factors (closed form): F(%s->%s) = %.9f\n",
                 mesh.surface_names[study.exact[0].g].c_str(),
                 mesh.surface_names[study.exact[0].h].c_str(), study.exact[0].value);
-  } else {
-    if (study.occluded)
+  } else if (!analytic) {
+    if (study.occluded && !sm)
       std::printf("exact surface factor (partial-shadow kernel): F(%s->%s) = %.12f\n",
                   mesh.surface_names[study.exact[0].g].c_str(),
                   mesh.surface_names[study.exact[0].h].c_str(), study.exact[0].value);
     double max_se = 0.0, sum2 = 0.0;
-    for (std::int64_t k = 0; k < ref.stderr_F.nonZeros(); ++k) {
-      max_se = std::max(max_se, ref.stderr_F.valuePtr()[k]);
-      sum2 += std::pow(ref.stderr_F.valuePtr()[k], 2);
+    for (std::int64_t k = 0; k < ref_stderr.nonZeros(); ++k) {
+      max_se = std::max(max_se, ref_stderr.valuePtr()[k]);
+      sum2 += std::pow(ref_stderr.valuePtr()[k], 2);
     }
     std::printf("reference: hybrid k=%d, its own standard error per entry: max %.3e, RMS %.3e\n",
                 opts.reference_samples, max_se,
-                std::sqrt(sum2 / std::max<std::int64_t>(1, ref.stderr_F.nonZeros())));
+                std::sqrt(sum2 / std::max<std::int64_t>(1, ref_stderr.nonZeros())));
   }
 
   std::vector<AccuracyRow> rows{ref_row};
@@ -473,12 +527,12 @@ int run_accuracy(const AccuracyOptions& opts) {
     row.estimator = spec_name(spec);
     row.setting = spec_setting(spec);
     log_info("accuracy: " + row.estimator + " " + row.setting);
-    const FormFactors ff = compute_form_factors(mesh, o);
+    const FormFactors ff = add_medium(compute_form_factors(mesh, o));
     row.seconds = ff.stats.seconds;
     row.nnz = ff.F.nonZeros();
-    compare_exact(study, ff, row);
-    compare_factors(mesh, ff.F, ref.F, row);
-    row.surfaces = solve_surfaces(mesh, ff.F, opts.run.threads);
+    if (exact) compare_exact(study, ff, row);
+    compare_factors(mesh, patch_block(ff.F, mesh.size()), ref_block, row);
+    row.surfaces = solve_surfaces(mesh, ff.F, opts.run.threads, zones);
     compare_radiosity(ref_row.surfaces, row);
     rows.push_back(std::move(row));
   }
@@ -487,7 +541,7 @@ int run_accuracy(const AccuracyOptions& opts) {
   print_failure_modes(rows);
   write_table_csv(csv, study, rows);
   write_surfaces_csv(surf, rows, ref_row.surfaces);
-  const std::vector<Plot> plots = error_plots(rows, !study.exact.empty());
+  const std::vector<Plot> plots = error_plots(rows, exact);
   write_plots_svg(svg, plots);
   write_plots_png(png, plots);
   std::printf("wrote %s, %s, %s, %s\n", csv.c_str(), surf.c_str(), svg.c_str(), png.c_str());

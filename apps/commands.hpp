@@ -139,6 +139,7 @@ struct AccuracyOptions {
   bool symmetrize = false;       ///< also run each hemicube resolution symmetrized
   int reference_samples = 1024;  ///< hybrid reference for scenes without a closed form
   std::string output = "accuracy";  ///< directory or file prefix
+  MediumArgs medium;  ///< participating medium: every F (and the reference) gets its zones
 };
 /// Registers `accuracy` on the app.
 CLI::App* add_accuracy_command(CLI::App& app, AccuracyOptions& opts);

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -8,8 +9,8 @@
 
 #include "apps/cli.hpp"
 #include "common/run_cli.hpp"
-#include "geometry/analytic.hpp"
 #include "common/temp_dir.hpp"
+#include "geometry/analytic.hpp"
 
 namespace lambert {
 
@@ -110,6 +111,41 @@ TEST(AccuracyCommand, SceneWithoutClosedFormUsesAHybridReference) {
   EXPECT_EQ(column(table[0], table[1], "estimator"), "hybrid");
   EXPECT_EQ(column(table[0], table[1], "setting"), "reference");
   EXPECT_GT(size_of(out + "accuracy_error_vs_time.png"), 0u);
+}
+
+// With a medium every F, the reference's too, has each patch pair's factor multiplied by
+// the same kernel-weighted transmittance T (same pair streams whatever the estimator), so
+// each per-pair error is T times the one without the medium. Between the squares 1 apart
+// every segment runs >= 1 through the box's sigma_t = 0.5, so T <= exp(-0.5): the hemicube's
+// max and RMS |dF| shrink at least that much (rounding: 1e-12 relative).
+TEST(AccuracyCommand, AMediumScalesEveryPairErrorByItsTransmittance) {
+  testing::TempDir dir;
+  const std::vector<std::string> common = {
+      "accuracy", "--case",       "parallel_squares", "--max-edge",     "0.25",
+      "-q",       "--estimators", "hemicube",         "--hemicube-res", "16"};
+  std::vector<std::string> clear = common, fog = common;
+  clear.insert(clear.end(), {"-o", dir.file("clear")});
+  fog.insert(fog.end(), {"-o", dir.file("fog"), "--medium-box", "-1,-1,-1,2,2,2", "--sigma-a",
+                         "0.5,0.5,0.5", "--voxels", "3", "--medium-rays", "16"});
+  ::testing::internal::CaptureStdout();
+  ASSERT_EQ(run(clear), kExitOk);
+  ASSERT_EQ(run(fog), kExitOk);
+  const std::string text = ::testing::internal::GetCapturedStdout();
+  EXPECT_NE(text.find("27 zones"), std::string::npos) << text;
+  const auto a = lines(dir.file("clear") + "_table.csv");
+  const auto b = lines(dir.file("fog") + "_table.csv");
+  ASSERT_EQ(a.size(), 3u);
+  ASSERT_EQ(b.size(), 3u);
+  const double bound = std::exp(-0.5) * (1 + 1e-12);
+  for (const char* col : {"max_abs_err", "rms_abs_err"}) {
+    const double without = std::stod(column(a[0], a[2], col));
+    const double with = std::stod(column(b[0], b[2], col));
+    EXPECT_GT(without, 0.0) << col;
+    EXPECT_LE(with, bound * without) << col;
+    EXPECT_GT(with, 0.0) << col;
+  }
+  // The closed form holds without a medium only: not compared (empty in the CSV).
+  EXPECT_EQ(column(b[0], b[2], "F_exact_abs_err"), "nan");
 }
 
 TEST(AccuracyCommand, SceneAndCaseTogetherIsAUsageError) {
