@@ -25,6 +25,8 @@
 #include <utility>
 #include <vector>
 
+#include "apps/common.hpp"
+#include "apps/medium_stage.hpp"
 #include "apps/problem.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -35,6 +37,7 @@
 #include "geometry/vertex_field.hpp"
 #include "io/exr.hpp"
 #include "io/ff_file.hpp"
+#include "io/json.hpp"
 #include "io/obj_loader.hpp"
 #include "io/tonemap.hpp"
 #include "solvers/radiosity.hpp"
@@ -45,15 +48,15 @@ namespace lambert {
 namespace {
 
 // A meshed scene with its BVH (built on first use, shared by form factors and renders).
+// A LoadedScene, as the CLI's stages take it (apps/medium_stage reads one).
 struct MeshHandle {
-  Scene scene;
-  PatchMesh mesh;
-  mutable std::shared_ptr<const Bvh> bvh;
+  LoadedScene loaded;
+  const Scene& scene = loaded.scene;
+  const PatchMesh& mesh = loaded.mesh;
   mutable std::mutex bvh_mutex;  // calls on one mesh from several Python threads (GIL released)
   const Bvh& get_bvh() const {
     const std::lock_guard<std::mutex> lock(bvh_mutex);
-    if (!bvh) bvh = std::make_shared<const Bvh>(mesh, 0);
-    return *bvh;
+    return scene_bvh(loaded, 0);
   }
 };
 
@@ -252,6 +255,36 @@ py::dict report_dict(const RadiositySolution& sol) {
   return r;
 }
 
+// The medium keywords of lambert.solve (the CLI's --medium-box, --sigma-a, ... by the same
+// names with underscores), as MediumArgs.
+MediumArgs medium_args(const py::dict& d) {
+  MediumArgs a;
+  const auto doubles = [&](const char* key, size_t n, std::vector<double>& out) {
+    if (!d.contains(key) || d[key].is_none()) return;
+    out = d[key].cast<std::vector<double>>();
+    if (out.size() != n)
+      throw UsageError(std::string(key) + " must have " + std::to_string(n) + " components");
+    for (double v : out)
+      if (!std::isfinite(v)) throw UsageError(std::string(key) + " must be finite");
+  };
+  doubles("medium_box", 6, a.box);
+  doubles("sigma_a", 3, a.sigma_a);
+  doubles("sigma_s", 3, a.sigma_s);
+  doubles("medium_emission", 3, a.emission);
+  if (d.contains("medium_grid") && !d["medium_grid"].is_none())
+    a.grid = d["medium_grid"].cast<std::string>();
+  if (d.contains("voxels")) a.voxels = d["voxels"].cast<int>();
+  if (d.contains("voxel_size")) a.voxel_size = d["voxel_size"].cast<double>();
+  if (d.contains("medium_rays")) a.rays = d["medium_rays"].cast<int>();
+  if (d.contains("transmittance_samples"))
+    a.transmittance_samples = d["transmittance_samples"].cast<int>();
+  if (a.voxels < 1 || a.rays < 1 || a.transmittance_samples < 1 || !(a.voxel_size >= 0.0))
+    throw UsageError("voxels, medium_rays and transmittance_samples must be >= 1, voxel_size >= 0");
+  if (!a.active() && (!a.sigma_a.empty() || !a.sigma_s.empty() || !a.emission.empty()))
+    throw UsageError("sigma_a, sigma_s and medium_emission need medium_box (or medium_grid)");
+  return a;
+}
+
 Shading parse_shading(const std::string& s) {
   if (s == "gouraud") return Shading::Gouraud;
   if (s == "flat") return Shading::Flat;
@@ -421,7 +454,7 @@ PYBIND11_MODULE(_lambert, m) {
           throw UsageError("max_edge must be a finite number >= 0");
         if (patches < 0) throw UsageError("patches must be >= 0");
         auto h = std::make_shared<MeshHandle>();
-        h->scene = scene;
+        h->loaded.scene = scene;
         py::gil_scoped_release release;
         MeshOptions mo;
         mo.max_edge = max_edge;
@@ -430,7 +463,9 @@ PYBIND11_MODULE(_lambert, m) {
         // As the CLI's load_scene: the planned edge bound, so the mesh is the CLI's.
         const MeshPlan plan = plan_mesh(h->scene, mo);
         if (!mo.discontinuity) mo.max_edge = plan.max_edge;
-        h->mesh = mesh_scene(h->scene, mo);
+        h->loaded.mesh = mesh_scene(h->scene, mo);
+        h->loaded.max_edge = h->mesh.max_edge;
+        h->loaded.discontinuity = mo.discontinuity;
         return h;
       },
       py::arg("scene"), py::arg("max_edge"), py::arg("patches"), py::arg("discontinuity"));
@@ -525,7 +560,7 @@ PYBIND11_MODULE(_lambert, m) {
       [](const MeshHandle& h, const IndexArray& indptr, const IndexArray& indices,
          const ValueArray& data, const std::string& solver, double tol, int max_iterations,
          double omega, const std::string& preconditioner, int restart, int threads,
-         std::optional<ValueArray> initial) {
+         std::optional<ValueArray> initial, const py::dict& medium_options) {
         const auto names = solver_names();
         if (std::find(names.begin(), names.end(), solver) == names.end()) {
           std::string list;
@@ -544,6 +579,29 @@ PYBIND11_MODULE(_lambert, m) {
         o.restart = restart;
         o.threads = threads;
         if (initial) o.initial_guess = matrix_n3(*initial, h.mesh.size(), "initial_guess");
+        const MediumArgs margs = medium_args(medium_options);
+        if (margs.active()) {  // the extended solve of apps/medium_stage, as `lambert solve`
+          if (initial) throw UsageError("initial_guess does not combine with a medium");
+          const std::shared_ptr<const Medium> medium = make_medium(margs);
+          check_medium_scene(h.mesh, nullptr);
+          RunArgs run;
+          run.threads = threads;
+          run.seed =
+              medium_options.contains("seed") ? py::cast<std::uint64_t>(medium_options["seed"]) : 1;
+          run.quiet = true;
+          FormFactors surface;
+          surface.F = F;
+          RadiosityResult r;
+          MediumResult mr;
+          {
+            py::gil_scoped_release release;
+            h.get_bvh();
+            mr = solve_scene_with_medium(h.loaded, surface, medium, margs, o, run, r);
+          }
+          py::dict report = report_dict(r.solution);
+          report["medium"] = py::module_::import("json").attr("loads")(json_text(medium_json(mr)));
+          return py::make_tuple(adopt_matrix(r.B), report);
+        }
         RadiositySolution sol;
         {
           py::gil_scoped_release release;
@@ -555,7 +613,7 @@ PYBIND11_MODULE(_lambert, m) {
       },
       py::arg("mesh"), py::arg("indptr"), py::arg("indices"), py::arg("data"), py::arg("solver"),
       py::arg("tol"), py::arg("max_iterations"), py::arg("omega"), py::arg("preconditioner"),
-      py::arg("restart"), py::arg("threads"), py::arg("initial_guess"));
+      py::arg("restart"), py::arg("threads"), py::arg("initial_guess"), py::arg("medium"));
 
   py::class_<VertexField, std::shared_ptr<VertexField>>(m, "VertexField")
       .def("__len__", &VertexField::size)

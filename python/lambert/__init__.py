@@ -104,18 +104,31 @@ def load_form_factors(path, mesh, stderr=False):
     return _wrap_ff(_lambert.load_form_factors(str(path), mesh), mesh, stderr)
 
 
+_MEDIUM_KEYS = ("medium_box", "sigma_a", "sigma_s", "medium_emission", "medium_grid", "voxels",
+                "voxel_size", "medium_rays", "transmittance_samples", "seed")
+
+
 def solve(mesh, F, solver="gauss-seidel", tol=1e-8, max_iterations=10000, omega=1.5,
-          preconditioner="diagonal", restart=30, threads=1, initial_guess=None):
+          preconditioner="diagonal", restart=30, threads=1, initial_guess=None, **medium):
     """Solves (I - rho F) B = E per channel. Returns (B, report): B an (N, 3) array, report a
     dict with status, iterations, residual (worst channel), seconds, and per channel
     `channels` (residual_history, time_history, ...) and `energy` (emitted, absorbed,
-    escaped, relative_imbalance)."""
+    escaped, relative_imbalance).
+
+    A participating medium (the CLI's solve --medium-box ...): medium_box=(x0, y0, z0, x1, y1,
+    z1) with sigma_a, sigma_s, medium_emission (R, G, B), voxels or voxel_size, or
+    medium_grid=FILE; medium_rays, transmittance_samples and seed steer its exchange factors.
+    F is then the surfaces' F; B holds the patches' rows and report["medium"] the medium's
+    part (zones, absorbed_medium per channel, ...)."""
     _check_mesh(mesh)
+    unknown = set(medium) - set(_MEDIUM_KEYS)
+    if unknown:
+        raise TypeError(f"solve() got unexpected keyword arguments {sorted(unknown)}")
     indptr, indices, data = _csr_arrays(F, mesh, "F")
     return _lambert.solve(mesh, indptr, indices, data, str(solver), float(tol),
                           _int(max_iterations, "max_iterations"), float(omega),
                           str(preconditioner), _int(restart, "restart"), _int(threads, "threads"),
-                          initial_guess)
+                          initial_guess, medium)
 
 
 def vertex_radiosity(mesh, B, mode="conservative"):

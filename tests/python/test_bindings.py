@@ -200,3 +200,30 @@ def test_wrong_arguments_raise_not_crash(cornell_mesh):
         bad = sp.csr_matrix(([np.nan], ([0], [1])), shape=(n, n))
         lambert.solve(cornell_mesh, bad)
     assert issubclass(lambert.UsageError, ValueError)
+
+
+def test_medium_solve_equals_the_cli(tmp_path, cornell):
+    fog = ["--medium-box", "0,0,0,556,548.8,559.2", "--sigma-a", "0.001,0.001,0.001",
+           "--voxels", 4, "--medium-rays", 64]
+    run_cli("solve", "--patches", 150, "--estimator", "hybrid", "--samples", 4, "--seed", 3,
+            "--tol", 1e-10, "-q", *fog, "-o", tmp_path / "B.csv")
+    mesh = cornell.mesh(patches=150)
+    F = lambert.form_factors(mesh, estimator="hybrid", samples=4, seed=3)
+    B, report = lambert.solve(mesh, F, tol=1e-10, medium_box=(0, 0, 0, 556, 548.8, 559.2),
+                              sigma_a=(1e-3,) * 3, voxels=4, medium_rays=64, seed=3)
+    assert report["status"] == "converged" and report["medium"]["zones"] == 64
+    import csv
+    with open(tmp_path / "B.csv") as f:
+        cli = np.array([[float(r[c]) for c in "RGB"] for r in csv.DictReader(f)])
+    # The CSV holds 17 significant digits: a double read back is the double written.
+    assert B.shape == cli.shape and np.array_equal(B, cli)
+    for c in range(3):  # the medium takes its share of the absorbed power
+        e = report["energy"][c]
+        assert report["medium"]["absorbed_medium"][c] > 0
+        assert math.isclose(report["medium"]["absorbed_medium"][c]
+                            + report["medium"]["absorbed_surfaces"][c], e["absorbed"],
+                            rel_tol=1e-9)
+    with pytest.raises(lambert.UsageError):
+        lambert.solve(mesh, F, sigma_a=(1e-3,) * 3)  # coefficients without a box
+    with pytest.raises(TypeError):
+        lambert.solve(mesh, F, medium_bx=(0, 0, 0, 1, 1, 1))
