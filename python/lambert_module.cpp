@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "apps/common.hpp"
+#include "apps/hierarchical_stage.hpp"
 #include "apps/medium_stage.hpp"
 #include "apps/problem.hpp"
 #include "core/error.hpp"
@@ -614,6 +615,48 @@ PYBIND11_MODULE(_lambert, m) {
       py::arg("mesh"), py::arg("indptr"), py::arg("indices"), py::arg("data"), py::arg("solver"),
       py::arg("tol"), py::arg("max_iterations"), py::arg("omega"), py::arg("preconditioner"),
       py::arg("restart"), py::arg("threads"), py::arg("initial_guess"), py::arg("medium"));
+
+  m.def(
+      "solve_hierarchical",
+      [](const Scene& scene, double epsilon, double min_area, int link_rays, double tol,
+         int max_iterations, int max_passes, std::uint64_t seed, int threads) {
+        if (!(epsilon > 0.0 && epsilon < 1.0)) throw UsageError("epsilon must be in (0, 1)");
+        if (!(min_area >= 0.0) || !std::isfinite(min_area))
+          throw UsageError("min_area must be >= 0");
+        if (!(tol > 0.0 && tol < 1.0)) throw UsageError("tol must be in (0, 1)");
+        if (link_rays < 1 || max_iterations < 1 || max_passes < 1 || threads < 0)
+          throw UsageError("link_rays, max_iterations and max_passes must be >= 1, threads >= 0");
+        HierarchicalOptions o;
+        o.epsilon = epsilon;
+        o.min_area = min_area;
+        o.link_rays = link_rays;
+        o.tol = tol;
+        o.max_iterations = max_iterations;
+        o.max_passes = max_passes;
+        o.seed = seed;
+        o.threads = threads;
+        auto h = std::make_shared<MeshHandle>();
+        HierarchicalRun run;
+        {
+          py::gil_scoped_release release;
+          run = solve_scene_hierarchical(scene, o);
+          h->loaded = std::move(run.loaded);
+        }
+        const py::object loads = py::module_::import("json").attr("loads");
+        py::dict report = loads(json_text(hierarchical_json(run)));
+        py::list energy;
+        for (const HierarchicalEnergy& e : run.stats.energy)
+          energy.append(loads(json_text(hierarchical_energy_json(e))));
+        report["energy"] = energy;
+        std::vector<double> bound(run.error_bound.data(),
+                                  run.error_bound.data() + run.error_bound.size());
+        report["error_bound"] =
+            adopt(std::move(bound), {static_cast<py::ssize_t>(run.error_bound.size())});
+        return py::make_tuple(h, adopt_matrix(run.B), report);
+      },
+      py::arg("scene"), py::arg("epsilon"), py::arg("min_area"), py::arg("link_rays"),
+      py::arg("tol"), py::arg("max_iterations"), py::arg("max_passes"), py::arg("seed"),
+      py::arg("threads"));
 
   py::class_<VertexField, std::shared_ptr<VertexField>>(m, "VertexField")
       .def("__len__", &VertexField::size)

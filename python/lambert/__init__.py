@@ -24,7 +24,8 @@ from ._lambert import Error, InputError, UsageError, Mesh, Scene, VertexField  #
 
 __all__ = [
     "Error", "InputError", "UsageError", "Scene", "Mesh", "VertexField", "load_scene",
-    "form_factors", "save_form_factors", "load_form_factors", "solve", "vertex_radiosity",
+    "form_factors", "save_form_factors", "load_form_factors", "solve", "solve_hierarchical",
+    "vertex_radiosity",
     "write_vertex_exr", "render", "estimators", "solvers", "set_verbosity",
 ]
 
@@ -129,6 +130,21 @@ def solve(mesh, F, solver="gauss-seidel", tol=1e-8, max_iterations=10000, omega=
                           _int(max_iterations, "max_iterations"), float(omega),
                           str(preconditioner), _int(restart, "restart"), _int(threads, "threads"),
                           initial_guess, medium)
+
+
+def solve_hierarchical(scene, epsilon=1e-4, min_area=0.0, link_rays=16, tol=1e-6,
+                       max_iterations=1000, max_passes=10, seed=1, threads=0):
+    """The CLI's --method hierarchical: refines links and elements of `scene` to the power
+    error bound `epsilon` and solves. Returns (leaves, B, report): the leaf Mesh (use it with
+    vertex_radiosity, render, write_vertex_exr), B (leaves, 3), and the report (status,
+    leaves, links, rays, passes, seconds, energy per channel, error_bound per leaf)."""
+    if not isinstance(scene, Scene):
+        raise TypeError(f"expected a lambert.Scene (load_scene(...)), got {type(scene).__name__}")
+    return _lambert.solve_hierarchical(scene, float(epsilon), float(min_area),
+                                       _int(link_rays, "link_rays"), float(tol),
+                                       _int(max_iterations, "max_iterations"),
+                                       _int(max_passes, "max_passes"), _int(seed, "seed"),
+                                       _int(threads, "threads"))
 
 
 def vertex_radiosity(mesh, B, mode="conservative"):

@@ -227,3 +227,19 @@ def test_medium_solve_equals_the_cli(tmp_path, cornell):
         lambert.solve(mesh, F, sigma_a=(1e-3,) * 3)  # coefficients without a box
     with pytest.raises(TypeError):
         lambert.solve(mesh, F, medium_bx=(0, 0, 0, 1, 1, 1))
+
+
+def test_hierarchical_equals_the_cli(tmp_path, cornell):
+    run_cli("solve", "--method", "hierarchical", "--epsilon", 1e-3, "--seed", 2, "-q",
+            "-o", tmp_path / "B.csv")
+    leaves, B, report = lambert.solve_hierarchical(cornell, epsilon=1e-3, seed=2)
+    assert report["status"] == "converged" and len(leaves) == report["leaves"] == len(B)
+    import csv
+    with open(tmp_path / "B.csv") as f:
+        cli = np.array([[float(r[c]) for c in "RGB"] for r in csv.DictReader(f)])
+    assert np.array_equal(B, cli)  # 17 significant digits in the CSV: exact
+    assert max(e["relative_imbalance"] for e in report["energy"]) < 1e-9
+    img = lambert.render(leaves, B, width=16, height=16, antialias=1)  # the leaf mesh renders
+    assert img.max() > 0
+    with pytest.raises(lambert.UsageError):
+        lambert.solve_hierarchical(cornell, epsilon=2.0)
