@@ -243,3 +243,27 @@ def test_hierarchical_equals_the_cli(tmp_path, cornell):
     assert img.max() > 0
     with pytest.raises(lambert.UsageError):
         lambert.solve_hierarchical(cornell, epsilon=2.0)
+
+
+def test_long_calls_release_the_gil(cornell):
+    import threading
+    import time
+    mesh = cornell.mesh(patches=600)
+    ticks, done = [0], threading.Event()
+
+    def tick():
+        while not done.is_set():
+            ticks[0] += 1
+            time.sleep(0.001)
+
+    t = threading.Thread(target=tick)
+    t.start()
+    start = time.perf_counter()
+    lambert.form_factors(mesh, estimator="hybrid", samples=8)
+    seconds = time.perf_counter() - start
+    done.set()
+    t.join()
+    # Holding the GIL for the whole call would leave the ticker at 0 or 1 (it gets the
+    # interpreter only before and after); released, it ticks about once a millisecond
+    # (a 20th of that on a loaded machine still passes).
+    assert seconds < 0.05 or ticks[0] >= 50 * seconds, (ticks[0], seconds)
