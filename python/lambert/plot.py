@@ -46,6 +46,19 @@ def _pyplot():
     return plt
 
 
+def _finish(ax, legend):
+    ax.grid(True, which="both", alpha=0.3)
+    if legend:
+        ax.legend(fontsize="small")
+
+
+def _save(plt, fig, output):
+    fig.tight_layout()
+    fig.savefig(output)
+    plt.close(fig)
+    return output
+
+
 def compare_history(prefix):
     """{channel: {solver: (iterations, seconds, residuals)}} from <prefix>_history.csv."""
     out = OrderedDict((c, OrderedDict()) for c in CHANNELS)
@@ -78,13 +91,8 @@ def plot_compare(path, output=None, fmt="png", channels=CHANNELS):
         row[1].set(title=f"residual vs time (channel {c})", xlabel="seconds",
                    ylabel="||E - K B|| / ||E||")
         for ax in row:
-            ax.grid(True, which="both", alpha=0.3)
-            ax.legend(fontsize="small")
-    fig.tight_layout()
-    output = output or f"{prefix}_convergence.{fmt}"
-    fig.savefig(output)
-    plt.close(fig)
-    return output
+            _finish(ax, True)
+    return _save(plt, fig, output or f"{prefix}_convergence.{fmt}")
 
 
 def plot_accuracy(path, output=None, fmt="png"):
@@ -115,14 +123,8 @@ def plot_accuracy(path, output=None, fmt="png"):
                 ax.annotate(s, (x, y), fontsize="x-small", xytext=(3, 3),
                             textcoords="offset points")
         ax.set(title=title, xlabel="form-factor time (s)", ylabel=ylabel)
-        ax.grid(True, which="both", alpha=0.3)
-        if series:
-            ax.legend(fontsize="small")
-    fig.tight_layout()
-    output = output or f"{prefix}_error_vs_time.{fmt}"
-    fig.savefig(output)
-    plt.close(fig)
-    return output
+        _finish(ax, bool(series))
+    return _save(plt, fig, output or f"{prefix}_error_vs_time.{fmt}")
 
 
 def main(argv=None):
