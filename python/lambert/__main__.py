@@ -1,4 +1,4 @@
-"""`python3 -m lambert` prints the module's version of the API and where it was loaded."""
+"""`python3 -m lambert` prints where the module was loaded from and its estimator and solver names."""
 import lambert
 
 print(f"lambert from {lambert.__file__}; estimators {lambert.estimators()}, "
