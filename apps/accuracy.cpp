@@ -418,9 +418,9 @@ int run_accuracy(const AccuracyOptions& opts) {
   apply_run_options(opts.run);
   const std::string base_path = output_prefix(opts.output, "accuracy");
   const std::string csv = base_path + "_table.csv", surf = base_path + "_surfaces.csv";
-  const std::string svg = base_path + "_error_vs_time.svg", png = base_path + "_error_vs_time.png";
+  const std::string svg = base_path + "_error_vs_time.svg";
   JobPlan plan = job_plan(opts.run);
-  plan.outputs = {{"-o", csv}, {"-o", surf}, {"-o", svg}, {"-o", png}};
+  plan.outputs = {{"-o", csv}, {"-o", surf}, {"-o", svg}};
   // The largest F held at a time: an all-pairs estimate with standard errors (the hybrid
   // reference) beside the run's own.
   plan.ff = FormFactorOptions{};
@@ -543,8 +543,8 @@ int run_accuracy(const AccuracyOptions& opts) {
   write_surfaces_csv(surf, rows, ref_row.surfaces);
   const std::vector<Plot> plots = error_plots(rows, exact);
   write_plots_svg(svg, plots);
-  write_plots_png(png, plots);
-  std::printf("wrote %s, %s, %s, %s\n", csv.c_str(), surf.c_str(), svg.c_str(), png.c_str());
+  std::printf("wrote %s, %s, %s (PNG: python3 -m lambert.plot accuracy %s)\n", csv.c_str(),
+              surf.c_str(), svg.c_str(), opts.output.c_str());
   return kExitOk;
 }
 

@@ -155,9 +155,9 @@ std::vector<Plot> convergence_plots(const std::vector<CompareRow>& rows, int c, 
 int compare_matrix(const CompareOptions& opts) {
   const std::string base = output_prefix(opts.output, "compare");
   const std::string table = base + "_table.csv", history = base + "_history.csv";
-  const std::string svg = base + "_convergence.svg", png = base + "_convergence.png";
+  const std::string svg = base + "_convergence.svg";
   JobPlan plan = job_plan(opts.run);
-  plan.outputs = {{"-o", table}, {"-o", history}, {"-o", svg}, {"-o", png}};
+  plan.outputs = {{"-o", table}, {"-o", history}, {"-o", svg}};
   plan_form_factors(plan, opts.ff, opts.run);
   const std::shared_ptr<const Medium> medium = make_medium(opts.medium);
   plan.medium = medium.get();
@@ -235,8 +235,8 @@ int compare_matrix(const CompareOptions& opts) {
   write_history_csv(history, rows);
   const auto plots = convergence_plots(rows, plot_channel(problem), opts.solve.tol);
   write_plots_svg(svg, plots);
-  write_plots_png(png, plots);
-  std::printf("wrote %s, %s, %s, %s\n", table.c_str(), history.c_str(), svg.c_str(), png.c_str());
+  std::printf("wrote %s, %s, %s (PNG: python3 -m lambert.plot compare %s)\n", table.c_str(),
+              history.c_str(), svg.c_str(), opts.output.c_str());
   if (!all_converged) {
     log_warn("some solvers did not converge within --max-iter; results were written anyway");
     return kExitNotConverged;

@@ -21,7 +21,7 @@
 // error = c t^p fitted (log-log least squares) to the gather runs.
 //
 // Usage: estimator_accuracy_bench [--patches 10000] [--ref-rays 65536] [--samples 4,8,16]
-//                                 [--rays 256,512,...,32768] [-j N] [--plot out.png]
+//                                 [--rays 256,512,...,32768] [-j N] [--plot out.svg]
 // Wall times on a shared machine: quote them as measured.
 
 #include <algorithm>
@@ -169,7 +169,7 @@ void write_plot(const std::string& path, const std::vector<Run>& runs, const Err
     plot.series.push_back({"reference's own error", {t_min, t_max}, {n, n}});
     panels.push_back(plot);
   }
-  write_plots_png(path, panels);
+  write_plots_svg(path, panels);
 }
 
 }  // namespace

@@ -37,7 +37,7 @@
 // Usage: hierarchical_bench [--sections family,cornell,furnace] [--sizes 1000,10000,100000,1000000]
 //   [--epsilon E] [--link-rays K] [--family-matrix-patches N] [--family-rays K]
 //   [--epsilons 1e-2,1e-3,1e-4,3e-5,1e-5] [--patches 100,300,1000,3000] [--ref-patches N]
-//   [--samples S] [--seed S] [-j N] [--plot cornell.png]
+//   [--samples S] [--seed S] [-j N] [--plot cornell.svg]
 // The machine is shared: compare ratios, and rerun for medians.
 
 #include <sys/resource.h>
@@ -86,7 +86,7 @@ struct Settings {
   int samples = 4;
   std::uint64_t seed = 1;
   int threads = 0;
-  std::string plot;  ///< --plot PNG: the Cornell section's error against time
+  std::string plot;  ///< --plot SVG: the Cornell section's error against time
 };
 
 // ---- per-surface comparison ----
@@ -482,7 +482,7 @@ void write_cornell_plot(const std::string& path, const std::vector<Point>& matri
   }
   plot.series.push_back({"RenderPark (1.6 s, 1.5 %)", {1.6}, {kTargetError}});
   plot.series.push_back({"reference's own error", {t_min, t_max}, {ref.own.worst, ref.own.worst}});
-  write_plots_png(path, {plot});
+  write_plots_svg(path, {plot});
   std::printf("wrote %s\n", path.c_str());
 }
 
@@ -601,7 +601,7 @@ int main(int argc, char** argv) {
                  "usage: hierarchical_bench [--sections family,cornell,furnace] [--sizes N,N,...] "
                  "[--epsilon E] [--link-rays K] [--family-matrix-patches N] [--family-rays K] "
                  "[--epsilons E,E,...] [--patches N,N,...] [--ref-patches N] [--samples S] "
-                 "[--seed S] [-j N] [--plot PNG]\n");
+                 "[--seed S] [-j N] [--plot SVG]\n");
     return 2;
   }
   s.threads = resolve_threads(s.threads);

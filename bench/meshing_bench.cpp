@@ -8,19 +8,19 @@
 // |B_i - B(x)| over the floor of the patch constants, and line, the largest |B_h(x) - B(x)|
 // of the Gouraud field at 400 points on the line y = 1.75 across umbra and penumbra, with
 // the vertex values `run` uses (exact direct light on discontinuity meshes, conservative
-// otherwise) and, in the last column, with conservative ones for every method. Adaptive runs start from the uniform mesh of a quarter
-// of the target and refine (apps/adapt_stage) until the target.
+// otherwise) and, in the last column, with conservative ones for every method. Adaptive runs start
+// from the uniform mesh of a quarter of the target and refine (apps/adapt_stage) until the target.
 //
 // Cornell box (built-in): per-surface average radiosity against a reference (uniform,
 // --ref-patches, gather 4096 rays) for uniform and discontinuity meshing (hybrid, 32
 // samples per pair) at the same targets (discontinuity makes more patches: its lines force
 // them): the worst relative per-surface difference over surfaces and channels, and the time.
 //
-// Log-log slopes of error against patches are printed per method; --plot FILE.png writes
+// Log-log slopes of error against patches are printed per method; --plot FILE.svg writes
 // error versus patches (both errors, log-log).
 //
 // Usage: meshing_bench [--targets 300,1000,3000] [--samples 64] [--ref-patches 48000]
-//   [--sections shadow,cornell] [--plot meshing.png]
+//   [--sections shadow,cornell] [--plot meshing.svg]
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -222,7 +222,7 @@ int main(int argc, char** argv) {
       l1.series.push_back(a);
       line.series.push_back(b);
     }
-    write_plots_png(plot, {l1, line});
+    write_plots_svg(plot, {l1, line});
     std::printf("wrote %s\n", plot.c_str());
   }
   return 0;

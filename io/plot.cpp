@@ -5,13 +5,10 @@
 #include <cstdio>
 #include <limits>
 #include <sstream>
-#include <string_view>
 #include <tuple>
 #include <utility>
 
 #include "core/atomic_file.hpp"
-#include "io/bitmap_font.hpp"
-#include "io/png.hpp"
 
 namespace lambert {
 namespace {
@@ -128,118 +125,9 @@ std::string tick_label(double v, bool log) {
   return buf;
 }
 
-// SVG legend position: top-right of the plot area (the PNG picks the emptiest corner).
+// Legend position: top-right of the plot area.
 int legend_x(const Frame& f) { return f.ox + kPanelW - kRight - 150; }
 int legend_y(int k) { return kTop + 8 + k * kLegendRow; }
-
-constexpr std::array<std::uint8_t, 3> kBlack{0, 0, 0}, kGrid{224, 224, 224},
-    kLegendEdge{176, 176, 176}, kWhite{255, 255, 255};
-
-// RGB raster with thick anti-alias-free lines.
-struct Raster : RgbImage {
-  using RgbImage::RgbImage;
-  void dot(int x, int y, std::array<std::uint8_t, 3> c, int r) {
-    for (int dy = -r; dy <= r; ++dy)
-      for (int dx = -r; dx <= r; ++dx) set(x + dx, y + dy, c);
-  }
-  void line(double x0, double y0, double x1, double y1, std::array<std::uint8_t, 3> c, int r) {
-    const int n = static_cast<int>(std::ceil(std::max(std::abs(x1 - x0), std::abs(y1 - y0)))) + 1;
-    for (int k = 0; k <= n; ++k) {
-      const double t = static_cast<double>(k) / n;
-      dot(static_cast<int>(std::lround(x0 + t * (x1 - x0))),
-          static_cast<int>(std::lround(y0 + t * (y1 - y0))), c, r);
-    }
-  }
-  void outline(double x0, double y0, double x1, double y1, std::array<std::uint8_t, 3> c) {
-    line(x0, y0, x1, y0, c, 0);
-    line(x0, y1, x1, y1, c, 0);
-    line(x0, y0, x0, y1, c, 0);
-    line(x1, y0, x1, y1, c, 0);
-  }
-  void fill(int x0, int y0, int x1, int y1, std::array<std::uint8_t, 3> c) {
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) set(x, y, c);
-  }
-  // Pixels in [x0, x1] x [y0, y1] that are neither background nor grid: what a box there hides.
-  long ink(int x0, int y0, int x1, int y1) const {
-    long n = 0;
-    for (int y = std::max(y0, 0); y <= std::min(y1, height - 1); ++y)
-      for (int x = std::max(x0, 0); x <= std::min(x1, width - 1); ++x) {
-        const std::uint8_t* p = &rgb[3 * (static_cast<size_t>(y) * width + x)];
-        const std::array<std::uint8_t, 3> c{p[0], p[1], p[2]};
-        n += c != kWhite && c != kGrid;
-      }
-    return n;
-  }
-};
-
-enum class Anchor { kStart, kMiddle, kEnd };  // as SVG's text-anchor
-
-// Draws text in the bitmap font with the middle of its capitals on row y and its left edge,
-// centre or right edge (per anchor) on column x.
-void put_text(Raster& img, double x, double y, std::string_view text, Anchor anchor) {
-  const int w = text_width(text, 1);
-  const int left = static_cast<int>(std::lround(anchor == Anchor::kStart    ? x
-                                                : anchor == Anchor::kMiddle ? x - w / 2.0
-                                                                            : x - w));
-  const int top = static_cast<int>(std::lround(y)) - kGlyphCapHeight / 2;
-  draw_text(img, left, top, text, kBlack, 1);
-}
-
-// Draws text in a bold cut of the bitmap font (each glyph twice, one pixel apart, and one
-// more blank column between glyphs), centred on column x with its capitals' middle on row y.
-void put_bold_text(Raster& img, double x, double y, std::string_view text) {
-  constexpr int kAdvance = kGlyphAdvance + 1;
-  const int w = static_cast<int>(text.size()) * kAdvance - 1;
-  const int left = static_cast<int>(std::lround(x - w / 2.0));
-  const int top = static_cast<int>(std::lround(y)) - kGlyphCapHeight / 2;
-  for (size_t k = 0; k < text.size(); ++k)
-    for (int dx : {0, 1})
-      draw_text(img, left + static_cast<int>(k) * kAdvance + dx, top, text.substr(k, 1), kBlack, 1);
-}
-
-// Pixel bounds of a panel's plot area, and the panel's x offset in the image.
-struct Area {
-  double l, r, t, b;
-  int ox;
-};
-
-// The panel's title (bold, above the plot area), x-axis title (below the tick labels) and
-// y-axis title (turned, along the panel's left edge): where the SVG puts them.
-void draw_titles(Raster& img, const Plot& plot, const Area& a) {
-  put_bold_text(img, (a.l + a.r) / 2, 18, plot.title);
-  put_text(img, (a.l + a.r) / 2, a.b + 34, plot.x_label, Anchor::kMiddle);
-  const int y = static_cast<int>(std::lround((a.t + a.b) / 2 + text_width(plot.y_label, 1) / 2.0));
-  draw_text_up(img, a.ox + 16 - kGlyphCapHeight / 2, y, plot.y_label, kBlack, 1);
-}
-
-// The legend: a white box holding, per series, a swatch of its colour and its name. Drawn
-// after the curves, in the corner of the plot area where it hides the fewest curve pixels
-// (top-right, the SVG's place, on a tie).
-void draw_legend(Raster& img, const Plot& plot, const Area& a) {
-  if (plot.series.empty()) return;
-  constexpr int kPad = 6, kSwatch = 24;
-  int text_w = 0;
-  for (const auto& s : plot.series) text_w = std::max(text_w, text_width(s.name, 1));
-  const int w = 3 * kPad + kSwatch + text_w;
-  // Rows kLegendRow apart, the first and last 10 px from the box's edges.
-  const int h = static_cast<int>(plot.series.size()) * kLegendRow + 4;
-  const int left = static_cast<int>(a.l) + kPad, right = static_cast<int>(a.r) - kPad - w;
-  const int top = static_cast<int>(a.t) + kPad, bottom = static_cast<int>(a.b) - kPad - h;
-  int x0 = right, y0 = top;
-  long hidden = img.ink(x0, y0, x0 + w, y0 + h);
-  for (auto [x, y] : {std::pair{left, top}, {right, bottom}, {left, bottom}}) {
-    const long n = img.ink(x, y, x + w, y + h);
-    if (n < hidden) x0 = x, y0 = y, hidden = n;
-  }
-  img.fill(x0, y0, x0 + w, y0 + h, kWhite);
-  img.outline(x0, y0, x0 + w, y0 + h, kLegendEdge);
-  for (size_t k = 0; k < plot.series.size(); ++k) {
-    const int y = y0 + 10 + static_cast<int>(k) * kLegendRow;
-    img.line(x0 + kPad + 2, y, x0 + kPad + kSwatch - 2, y, plot_color(k), 2);  // 5 px thick
-    put_text(img, x0 + 2 * kPad + kSwatch, y, plot.series[k].name, Anchor::kStart);
-  }
-}
 
 // Calls seg(x0, y0, x1, y1) for every drawable segment of a series (pixel coordinates).
 template <typename Seg>
@@ -320,37 +208,6 @@ std::string plots_svg(const std::vector<Plot>& panels) {
 void write_plots_svg(const std::string& path, const std::vector<Plot>& panels) {
   const std::string svg = plots_svg(panels);
   write_stream_atomically(path, [&](std::ostream& out) { out << svg; });
-}
-
-void write_plots_png(const std::string& path, const std::vector<Plot>& panels) {
-  Raster img(kPanelW * static_cast<int>(std::max<size_t>(1, panels.size())), kPanelH);
-  for (size_t p = 0; p < panels.size(); ++p) {
-    const Plot& plot = panels[p];
-    const Frame f = make_frame(plot, static_cast<int>(p) * kPanelW);
-    const Area a{f.left(), f.right(), kTop, kPanelH - kBottom, f.ox};
-    for (double v : ticks(f.y0, f.y1, f.log_y)) {
-      img.line(a.l, f.py(v), a.r, f.py(v), kGrid, 0);
-      img.line(a.l - 5, f.py(v), a.l, f.py(v), kBlack, 0);
-      put_text(img, a.l - 8, f.py(v), tick_label(v, f.log_y), Anchor::kEnd);
-    }
-    for (double v : ticks(f.x0, f.x1, f.log_x)) {
-      img.line(f.px(v), a.t, f.px(v), a.b, kGrid, 0);
-      img.line(f.px(v), a.b, f.px(v), a.b + 5, kBlack, 0);
-      put_text(img, f.px(v), a.b + 13, tick_label(v, f.log_x), Anchor::kMiddle);
-    }
-    img.outline(a.l, a.t, a.r, a.b, kBlack);
-    for (size_t k = 0; k < plot.series.size(); ++k) {
-      const auto c = plot_color(k);
-      for_segments(f, plot.series[k], [&](double x0, double y0, double x1, double y1) {
-        img.line(x0, y0, x1, y1, c, 1);
-        if (plot.markers)
-          img.dot(static_cast<int>(std::lround(x1)), static_cast<int>(std::lround(y1)), c, 3);
-      });
-    }
-    draw_legend(img, plot, a);
-    draw_titles(img, plot, a);
-  }
-  write_png(path, img.width, img.height, img.rgb);
 }
 
 }  // namespace lambert

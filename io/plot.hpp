@@ -1,7 +1,7 @@
 #pragma once
 // Line plots (e.g. solver convergence: residual vs iteration and vs time) written as SVG
-// (axes, ticks, labels, legend) and as PNG (the same plot rasterised, its text drawn in a small
-// built-in bitmap font).
+// (axes, ticks, labels, legend). PNG figures come from the CSVs through matplotlib
+// (`python3 -m lambert.plot`, python/lambert/plot.py).
 
 #include <array>
 #include <cstdint>
@@ -29,7 +29,7 @@ struct Plot {
   std::vector<PlotSeries> series;
 };
 
-/// Colour (sRGB 8-bit) of series k; the same palette in SVG and PNG.
+/// Colour (sRGB 8-bit) of series k (Tableau 10, as matplotlib's default cycle).
 std::array<std::uint8_t, 3> plot_color(std::size_t k);
 
 /// The panels side by side as an SVG document (each panel 560 x 420 px).
@@ -37,10 +37,5 @@ std::string plots_svg(const std::vector<Plot>& panels);
 
 /// Writes plots_svg atomically. Throws IoError.
 void write_plots_svg(const std::string& path, const std::vector<Plot>& panels);
-
-/// Writes the panels side by side as an RGB PNG with the same layout and text as the SVG
-/// (curves, axes, grid, tick labels, titles, a legend box naming each colour), atomically.
-/// Throws IoError.
-void write_plots_png(const std::string& path, const std::vector<Plot>& panels);
 
 }  // namespace lambert

@@ -6,7 +6,8 @@ cd "$(dirname "$0")/.."
 preset="${1:-release}"
 
 packages=(build-essential cmake pkg-config libembree-dev libeigen3-dev libopenexr-dev
-          libgtest-dev libcli11-dev zlib1g-dev nlohmann-json3-dev libcgal-dev)
+          libgtest-dev libcli11-dev zlib1g-dev nlohmann-json3-dev libcgal-dev
+          pybind11-dev python3-dev python3-numpy python3-scipy python3-matplotlib python3-pytest)
 # The fuzz preset builds with clang and links libFuzzer (from libclang-rt).
 [[ "$preset" == fuzz ]] && packages+=(clang libclang-rt-14-dev)
 missing=()

@@ -20,13 +20,6 @@ std::string read_all(const std::string& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-// A big-endian 32-bit field of a PNG header.
-std::uint32_t be32(const std::string& s, size_t at) {
-  std::uint32_t v = 0;
-  for (size_t k = 0; k < 4; ++k) v = v << 8 | static_cast<unsigned char>(s[at + k]);
-  return v;
-}
-
 Plot residual_plot(const std::string& title, const std::string& name) {
   Plot p;
   p.title = title;
@@ -47,43 +40,21 @@ int inked(const RgbImage& img) {
 
 constexpr std::array<std::uint8_t, 3> kInk{0, 0, 0};
 
-TEST(PlotPng, HasSignatureAndPanelSize) {
+// The SVG is the CLI's one plot format (PNGs come from `python3 -m lambert.plot`): panels
+// side by side, 560 px each, every title and legend name in the text.
+TEST(PlotSvg, PanelsTitlesAndLegendNames) {
   testing::TempDir dir;
-  const std::string path = dir.file("plot.png");
-  write_plots_png(path, {residual_plot("a", "jacobi"), residual_plot("b", "jacobi")});
-  const std::string png = read_all(path);
-  ASSERT_GE(png.size(), 33u) << "missing or truncated: " << path;
-  EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
-  EXPECT_EQ(png.substr(12, 4), "IHDR");
-  EXPECT_EQ(be32(png, 16), 2u * 560u);  // two 560 x 420 panels side by side
-  EXPECT_EQ(be32(png, 20), 420u);
-  EXPECT_EQ(png[24], 8);  // bit depth
-  EXPECT_EQ(png[25], 2);  // colour type: RGB
-
-  std::vector<Plot> loglog = {residual_plot("a", "mc"), residual_plot("b", "mc"),
-                              residual_plot("c", "mc")};
-  for (Plot& p : loglog) p.log_x = p.markers = true;
-  write_plots_png(path, loglog);
-  const std::string three = read_all(path);
-  ASSERT_GE(three.size(), 33u);
-  EXPECT_EQ(be32(three, 16), 3u * 560u);
-  EXPECT_EQ(be32(three, 20), 420u);
+  const std::string path = dir.file("plot.svg");
+  write_plots_svg(path, {residual_plot("residual", "jacobi"), residual_plot("by time", "gmres")});
+  const std::string svg = read_all(path);
+  EXPECT_NE(svg.find("width=\"1120\" height=\"420\""), std::string::npos);
+  for (const char* text : {"residual", "by time", "jacobi", "gmres", "direct"})
+    EXPECT_NE(svg.find(text), std::string::npos) << text;
+  EXPECT_EQ(svg,
+            plots_svg({residual_plot("residual", "jacobi"), residual_plot("by time", "gmres")}));
 }
 
-// The text is part of the raster: plots that differ only in a legend name or a title give
-// different PNGs (before the bitmap font they were byte-identical).
-TEST(PlotPng, LegendNamesAndTitlesAreDrawn) {
-  testing::TempDir dir;
-  const auto png_of = [&](const Plot& p) {
-    write_plots_png(dir.file("p.png"), {p});
-    return read_all(dir.file("p.png"));
-  };
-  const std::string base = png_of(residual_plot("residual", "jacobi"));
-  EXPECT_NE(base, png_of(residual_plot("residual", "gmres")));
-  EXPECT_NE(base, png_of(residual_plot("residual vs time", "jacobi")));
-  EXPECT_EQ(base, png_of(residual_plot("residual", "jacobi")));  // and deterministic
-}
-
+// The bitmap font stays for image legends (the thermal colour bar); its own tests follow.
 TEST(BitmapFont, LetterAInksPixelsSpaceInksNone) {
   RgbImage a(16, 16), space(16, 16);
   draw_text(a, 2, 2, "A", kInk, 1);

@@ -1,0 +1,212 @@
+"""lambert: radiosity and form factors from Python.
+
+    import lambert
+    scene = lambert.load_scene()                 # the built-in Cornell box
+    mesh = scene.mesh(patches=500)
+    F = lambert.form_factors(mesh, estimator="hybrid", samples=32, seed=1)
+    B, report = lambert.solve(mesh, F, solver="gauss-seidel", tol=1e-8)
+
+Errors: lambert.InputError (a bad scene or F file: SceneError/IoError, the file named in the
+message), lambert.UsageError (a bad argument; also a ValueError), both lambert.Error.
+Wrong array shapes raise UsageError, wrong types TypeError.
+
+Arrays: Mesh arrays are read-only views into the C++ mesh (no copy; `patch_corners` is a
+copy). Results (F's data, B, images) are handed over without a copy; scipy converts F's
+64-bit indices to 32-bit (a copy of the index arrays) when they fit. Arrays passed in (F, B)
+are copied into lambert's types.
+"""
+
+import numpy as _np
+import scipy.sparse as _sparse
+
+from . import _lambert
+from ._lambert import Error, InputError, UsageError, Mesh, Scene, VertexField  # noqa: F401
+
+__all__ = [
+    "Error", "InputError", "UsageError", "Scene", "Mesh", "VertexField", "load_scene",
+    "form_factors", "save_form_factors", "load_form_factors", "solve", "solve_hierarchical",
+    "vertex_radiosity",
+    "write_vertex_exr", "render", "estimators", "solvers", "set_verbosity",
+]
+
+estimators = _lambert.estimators
+solvers = _lambert.solvers
+set_verbosity = _lambert.set_verbosity
+
+
+def load_scene(path=None, strict=False, emit=None):
+    """Loads an OBJ scene (None: the built-in Cornell box). `emit` maps a surface or material
+    glob to an emission (R, G, B), as the CLI's --emit. Raises InputError for a bad file."""
+    if path is None:
+        path = _lambert.builtin_cornell_box_path()
+    rules = [(str(k), [float(x) for x in v]) for k, v in (emit or {}).items()]
+    return _lambert.load_scene(str(path), bool(strict), rules)
+
+
+def _mesh(self, max_edge=None, patches=None, discontinuity=False):
+    """Meshes the scene: patch edges at most `max_edge` (scene units) or about `patches`
+    patches (max_edge wins when both are given); neither: one patch per face (triangulated
+    above 4 corners). The same mesh as the CLI's --max-edge/--patches."""
+    return _lambert.mesh_scene(self, float(max_edge or 0.0), int(patches or 0), bool(discontinuity))
+
+
+Scene.mesh = _mesh
+
+
+def _csr(arrays, n):
+    data, indices, indptr = arrays
+    return _sparse.csr_matrix((data, indices, indptr), shape=(n, n), copy=False)
+
+
+def _wrap_ff(result, mesh, stderr):
+    n = len(mesh)
+    F = _csr(result["F"], n)
+    F.lambert_settings = result["settings"]
+    F.lambert_stats = result.get("stats")
+    if not stderr:
+        return F
+    S = None if result["stderr"] is None else _csr(result["stderr"], n)
+    return F, S
+
+
+def form_factors(mesh, estimator="auto", samples=None, rays=None, seed=1, threads=0,
+                 threshold=0.0, reciprocity="auto", tol=None, hemicube_resolution=128,
+                 stderr=False):
+    """F (scipy.sparse.csr_matrix, N x N) of the mesh; with stderr=True (F, standard errors).
+    The settings mean what the CLI's options of the same names mean; the same settings give
+    the CLI's F bit for bit. F.lambert_settings holds the settings text a saved F carries,
+    F.lambert_stats what the computation did."""
+    _check_mesh(mesh)
+    result = _lambert.form_factors(mesh, str(estimator), _opt_int(samples, "samples"),
+                                   _opt_int(rays, "rays"), _int(seed, "seed"),
+                                   _int(threads, "threads"), float(threshold), str(reciprocity),
+                                   None if tol is None else float(tol),
+                                   _int(hemicube_resolution, "hemicube_resolution"), bool(stderr))
+    return _wrap_ff(result, mesh, stderr)
+
+
+def save_form_factors(path, mesh, F, stderr=None, precision="double"):
+    """Saves F as the CLI does: Matrix Market for a .mtx path, else lambert's binary format
+    (with the standard errors when given), tied to the mesh."""
+    _check_mesh(mesh)
+    indptr, indices, data = _csr_arrays(F, mesh, "F")
+    err = None
+    if stderr is not None:
+        s_indptr, s_indices, s_data = _csr_arrays(stderr, mesh, "stderr")
+        err = (s_data, s_indices, s_indptr)
+    settings = getattr(F, "lambert_settings", "")
+    _lambert.save_form_factors(str(path), mesh, indptr, indices, data, err, settings, str(precision))
+
+
+def load_form_factors(path, mesh, stderr=False):
+    """Reads an F saved by the CLI or save_form_factors (binary or Matrix Market); refuses
+    (InputError) one made for another mesh. With stderr=True (F, standard errors or None)."""
+    _check_mesh(mesh)
+    return _wrap_ff(_lambert.load_form_factors(str(path), mesh), mesh, stderr)
+
+
+_MEDIUM_KEYS = ("medium_box", "sigma_a", "sigma_s", "medium_emission", "medium_grid", "voxels",
+                "voxel_size", "medium_rays", "transmittance_samples", "seed")
+
+
+def solve(mesh, F, solver="gauss-seidel", tol=1e-8, max_iterations=10000, omega=1.5,
+          preconditioner="diagonal", restart=30, threads=1, initial_guess=None, **medium):
+    """Solves (I - rho F) B = E per channel. Returns (B, report): B an (N, 3) array, report a
+    dict with status, iterations, residual (worst channel), seconds, and per channel
+    `channels` (residual_history, time_history, ...) and `energy` (emitted, absorbed,
+    escaped, relative_imbalance).
+
+    A participating medium (the CLI's solve --medium-box ...): medium_box=(x0, y0, z0, x1, y1,
+    z1) with sigma_a, sigma_s, medium_emission (R, G, B), voxels or voxel_size, or
+    medium_grid=FILE; medium_rays, transmittance_samples and seed steer its exchange factors.
+    F is then the surfaces' F; B holds the patches' rows and report["medium"] the medium's
+    part (zones, absorbed_medium per channel, ...)."""
+    _check_mesh(mesh)
+    unknown = set(medium) - set(_MEDIUM_KEYS)
+    if unknown:
+        raise TypeError(f"solve() got unexpected keyword arguments {sorted(unknown)}")
+    indptr, indices, data = _csr_arrays(F, mesh, "F")
+    return _lambert.solve(mesh, indptr, indices, data, str(solver), float(tol),
+                          _int(max_iterations, "max_iterations"), float(omega),
+                          str(preconditioner), _int(restart, "restart"), _int(threads, "threads"),
+                          initial_guess, medium)
+
+
+def solve_hierarchical(scene, epsilon=1e-4, min_area=0.0, link_rays=16, tol=1e-6,
+                       max_iterations=1000, max_passes=10, seed=1, threads=0):
+    """The CLI's --method hierarchical: refines links and elements of `scene` to the power
+    error bound `epsilon` and solves. Returns (leaves, B, report): the leaf Mesh (use it with
+    vertex_radiosity, render, write_vertex_exr), B (leaves, 3), and the report (status,
+    leaves, links, rays, passes, seconds, energy per channel, error_bound per leaf)."""
+    if not isinstance(scene, Scene):
+        raise TypeError(f"expected a lambert.Scene (load_scene(...)), got {type(scene).__name__}")
+    return _lambert.solve_hierarchical(scene, float(epsilon), float(min_area),
+                                       _int(link_rays, "link_rays"), float(tol),
+                                       _int(max_iterations, "max_iterations"),
+                                       _int(max_passes, "max_passes"), _int(seed, "seed"),
+                                       _int(threads, "threads"))
+
+
+def vertex_radiosity(mesh, B, mode="conservative"):
+    """B (N, 3) interpolated to the shading vertices ("conservative" or "area"): a
+    VertexField with positions, normals, surface_ids, patch_corners (views) and values."""
+    _check_mesh(mesh)
+    return _lambert.vertex_radiosity(mesh, B, str(mode))
+
+
+def write_vertex_exr(path, mesh, B, mode="conservative", settings=""):
+    """Writes the vertex EXR of the CLI's run/solve (-o B.exr) from B (N, 3)."""
+    field = B if isinstance(B, VertexField) else vertex_radiosity(mesh, B, mode)
+    _lambert.write_vertex_exr(str(path), mesh, field, str(settings))
+
+
+def render(mesh, B, eye=None, look_at=None, up=None, fov=None, width=None, height=None,
+           shading="gouraud", antialias=2, seed=1, threads=0, exr=None, png=None, ev=None):
+    """Renders B (N, 3) with the scene's camera (or the given eye/look_at/up/fov/size):
+    returns the linear radiance image, float32 (height, width, 3); also writes it as an EXR
+    and/or a tone-mapped PNG (exposure `ev` stops, automatic when None) when paths are given."""
+    _check_mesh(mesh)
+    vec = lambda v, name: None if v is None else [float(x) for x in _vec3(v, name)]  # noqa: E731
+    return _lambert.render(mesh, B, vec(eye, "eye"), vec(look_at, "look_at"), vec(up, "up"),
+                           None if fov is None else float(fov), _opt_int(width, "width"),
+                           _opt_int(height, "height"), str(shading), _int(antialias, "antialias"),
+                           _int(seed, "seed"), _int(threads, "threads"), str(exr or ""),
+                           str(png or ""), None if ev is None else float(ev))
+
+
+# --- argument checks: wrong types raise TypeError, wrong shapes UsageError -------------------
+
+def _check_mesh(mesh):
+    if not isinstance(mesh, Mesh):
+        raise TypeError(f"expected a lambert.Mesh (scene.mesh(...)), got {type(mesh).__name__}")
+
+
+def _int(v, name):
+    if isinstance(v, bool) or not isinstance(v, (int, _np.integer)):
+        raise TypeError(f"{name} must be an integer, got {type(v).__name__}")
+    return int(v)
+
+
+def _opt_int(v, name):
+    return None if v is None else _int(v, name)
+
+
+def _vec3(v, name):
+    a = _np.asarray(v, dtype=float)
+    if a.shape != (3,):
+        raise UsageError(f"{name} must have 3 components, got shape {a.shape}")
+    return a
+
+
+def _csr_arrays(F, mesh, name):
+    if not _sparse.issparse(F):
+        raise TypeError(f"{name} must be a scipy.sparse matrix, got {type(F).__name__}")
+    n = len(mesh)
+    if F.shape != (n, n):
+        raise UsageError(f"{name} has shape {F.shape}, the mesh has {n} patches")
+    F = F.tocsr()
+    if not F.has_canonical_format:
+        F = F.copy()
+        F.sum_duplicates()
+    return (F.indptr.astype(_np.int64, copy=False), F.indices.astype(_np.int64, copy=False),
+            F.data.astype(_np.float64, copy=False))

@@ -1,0 +1,766 @@
+// The compiled part of `import lambert` (pybind11): scenes, meshes, form factors, solvers,
+// vertex fields, rendering and the F files, over the library layers (core, geometry,
+// solvers, io) and the radiosity problem of apps/problem. The pure-Python package
+// (python/lambert/__init__.py) wraps these into the public API: scipy.sparse matrices are
+// built there from the (data, indices, indptr) arrays handed out here.
+//
+// Arrays: mesh arrays are read-only views into the C++ mesh (zero-copy, strided over the
+// patch structs where the values live in them), results moved out of C++ (F's CSR arrays,
+// B, images) are owned by a capsule (zero-copy); arrays passed in are copied into the
+// library's types. Long calls release the GIL.
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "apps/common.hpp"
+#include "apps/hierarchical_stage.hpp"
+#include "apps/medium_stage.hpp"
+#include "apps/problem.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "geometry/bvh.hpp"
+#include "geometry/formfactors/formfactors.hpp"
+#include "geometry/mesh.hpp"
+#include "geometry/render.hpp"
+#include "geometry/vertex_field.hpp"
+#include "io/exr.hpp"
+#include "io/ff_file.hpp"
+#include "io/json.hpp"
+#include "io/obj_loader.hpp"
+#include "io/tonemap.hpp"
+#include "solvers/radiosity.hpp"
+
+namespace py = pybind11;
+
+namespace lambert {
+namespace {
+
+// A meshed scene with its BVH (built on first use, shared by form factors and renders).
+// A LoadedScene, as the CLI's stages take it (apps/medium_stage reads one).
+struct MeshHandle {
+  LoadedScene loaded;
+  const Scene& scene = loaded.scene;
+  const PatchMesh& mesh = loaded.mesh;
+  mutable std::mutex bvh_mutex;  // calls on one mesh from several Python threads (GIL released)
+  const Bvh& get_bvh() const {
+    const std::lock_guard<std::mutex> lock(bvh_mutex);
+    return scene_bvh(loaded, 0);
+  }
+};
+
+// A read-only numpy view of `count` rows of `cols` values of type T starting at `first`,
+// rows `row_stride` bytes apart; `owner` keeps the memory alive.
+template <typename T>
+py::array view(const T* first, py::ssize_t count, py::ssize_t cols, py::ssize_t row_stride,
+               py::handle owner) {
+  std::vector<py::ssize_t> shape{count}, strides{row_stride};
+  if (cols > 0) shape.push_back(cols), strides.push_back(sizeof(T));
+  py::array a(py::dtype::of<T>(), shape, strides, first, owner);
+  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return a;
+}
+
+// The offset of a member inside a Patch (Patch holds Eigen members, so offsetof does not
+// apply to it).
+template <typename M>
+py::ssize_t patch_offset(const Patch& p, const M& member) {
+  return reinterpret_cast<const char*>(&member) - reinterpret_cast<const char*>(&p);
+}
+
+// Moves `v` to the heap and returns a numpy array over it, owned by a capsule.
+template <typename T>
+py::array_t<T> adopt(std::vector<T>&& v, std::vector<py::ssize_t> shape) {
+  auto* heap = new std::vector<T>(std::move(v));
+  py::capsule owner(heap, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  return py::array_t<T>(shape, heap->data(), owner);
+}
+
+py::array_t<double> adopt_matrix(const Eigen::MatrixX3d& m) {  // N x 3, row-major copy
+  std::vector<double> v(static_cast<size_t>(m.rows()) * 3);
+  for (Eigen::Index i = 0; i < m.rows(); ++i)
+    for (int c = 0; c < 3; ++c) v[3 * i + c] = m(i, c);
+  return adopt(std::move(v), {m.rows(), 3});
+}
+
+// An (N, 3) float64 array-like as an Eigen matrix; UsageError naming `what` otherwise.
+Eigen::MatrixX3d matrix_n3(const py::array_t<double, py::array::c_style | py::array::forcecast>& a,
+                           std::int64_t n, const std::string& what) {
+  if (a.ndim() != 2 || a.shape(1) != 3 || a.shape(0) != n) {
+    std::ostringstream ss;
+    ss << what << " must have shape (" << n << ", 3), got (";
+    for (py::ssize_t d = 0; d < a.ndim(); ++d) ss << (d ? ", " : "") << a.shape(d);
+    ss << (a.ndim() == 1 ? ",)" : ")");
+    throw UsageError(ss.str());
+  }
+  Eigen::MatrixX3d m(n, 3);
+  const double* p = a.data();
+  for (std::int64_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(p[3 * i + c]))
+        throw UsageError(what + " holds a non-finite value at row " + std::to_string(i));
+      m(i, c) = p[3 * i + c];
+    }
+  return m;
+}
+
+using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+using ValueArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// A CSR matrix from its arrays, checked entry by entry (UsageError on any inconsistency).
+SparseRowMatrix csr_from_arrays(std::int64_t n, const IndexArray& indptr, const IndexArray& indices,
+                                const ValueArray& data, const std::string& what) {
+  if (indptr.ndim() != 1 || indices.ndim() != 1 || data.ndim() != 1)
+    throw UsageError(what + ": indptr, indices and data must be one-dimensional");
+  if (indptr.shape(0) != n + 1)
+    throw UsageError(what + ": indptr has " + std::to_string(indptr.shape(0)) + " entries, " +
+                     std::to_string(n + 1) + " expected for " + std::to_string(n) + " rows");
+  const std::int64_t nnz = indices.shape(0);
+  if (data.shape(0) != nnz) throw UsageError(what + ": indices and data differ in length");
+  const std::int64_t* p = indptr.data();
+  const std::int64_t* c = indices.data();
+  const double* v = data.data();
+  if (p[0] != 0 || p[n] != nnz) throw UsageError(what + ": indptr must run from 0 to nnz");
+  SparseRowMatrix F(n, n);
+  F.reserve(Eigen::Matrix<std::int64_t, Eigen::Dynamic, 1>::Map(p, n + 1).tail(n) -
+            Eigen::Matrix<std::int64_t, Eigen::Dynamic, 1>::Map(p, n + 1).head(n));
+  for (std::int64_t i = 0; i < n; ++i) {
+    if (p[i + 1] < p[i]) throw UsageError(what + ": indptr decreases at row " + std::to_string(i));
+    for (std::int64_t k = p[i]; k < p[i + 1]; ++k) {
+      if (c[k] < 0 || c[k] >= n || (k > p[i] && c[k] <= c[k - 1]))
+        throw UsageError(what + ": row " + std::to_string(i) +
+                         " has a column index out of range or out of order");
+      if (!std::isfinite(v[k]))
+        throw UsageError(what + ": entry (" + std::to_string(i) + ", " + std::to_string(c[k]) +
+                         ") is not finite");
+      F.insert(i, c[k]) = v[k];
+    }
+  }
+  F.makeCompressed();
+  return F;
+}
+
+// (data, indices, indptr) of a compressed CSR matrix moved to the heap, zero-copy.
+py::tuple csr_arrays(SparseRowMatrix&& F) {
+  F.makeCompressed();
+  auto* heap = new SparseRowMatrix();
+  heap->swap(F);  // Eigen 3.4's SparseMatrix has no move
+  py::capsule owner(heap, [](void* p) { delete static_cast<SparseRowMatrix*>(p); });
+  const py::ssize_t n = heap->rows(), nnz = heap->nonZeros();
+  return py::make_tuple(py::array_t<double>(nnz, heap->valuePtr(), owner),
+                        py::array_t<std::int64_t>(nnz, heap->innerIndexPtr(), owner),
+                        py::array_t<std::int64_t>(n + 1, heap->outerIndexPtr(), owner));
+}
+
+py::dict options_dict(const FormFactorOptions& o) {
+  py::dict d;
+  d["estimator"] = o.estimator;
+  d["samples"] = o.samples;
+  d["rays"] = o.rays;
+  d["seed"] = o.seed;
+  d["threshold"] = o.threshold;
+  d["hemicube_resolution"] = o.hemicube_resolution;
+  d["tol"] = o.tol;
+  d["reciprocity"] = o.reciprocity;
+  d["extended"] = o.extended;
+  return d;
+}
+
+// The settings text stored with a saved F, as the CLI's formfactors command writes it.
+std::string settings_text(const FormFactorOptions& o, const MeshHandle& m) {
+  std::ostringstream ss;
+  ss << format_ff_settings(o) << " patches=" << m.mesh.size() << " max_edge=" << m.mesh.max_edge;
+  return ss.str();
+}
+
+py::dict ff_result(FormFactors&& ff, const MeshHandle& m) {
+  py::dict out;
+  out["settings"] = settings_text(ff.options, m);
+  out["options"] = options_dict(ff.options);
+  py::dict stats;
+  stats["pairs_tested"] = ff.stats.pairs_tested;
+  stats["pairs_culled"] = ff.stats.pairs_culled;
+  stats["pairs_unverified"] = ff.stats.pairs_unverified;
+  stats["rays"] = ff.stats.rays;
+  stats["seconds"] = ff.stats.seconds;
+  out["stats"] = stats;
+  const bool has_stderr = ff.stderr_F.rows() == ff.F.rows() && ff.F.rows() > 0;
+  out["F"] = csr_arrays(std::move(ff.F));
+  out["stderr"] = has_stderr ? py::object(csr_arrays(std::move(ff.stderr_F))) : py::none();
+  if (ff.specular_continued.size() > 0)
+    out["specular_continued"] =
+        py::array_t<double>(ff.specular_continued.size(), ff.specular_continued.data());
+  return out;
+}
+
+Eigen::Vector3d vec3(const std::vector<double>& v, const char* what) {
+  if (v.size() != 3) throw UsageError(std::string(what) + " must have 3 components");
+  return {v[0], v[1], v[2]};
+}
+
+double face_area(const Scene& s, const Face& f) {  // Newell's formula (planar polygon)
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  for (size_t k = 0; k < f.vertices.size(); ++k)
+    n += s.vertices[f.vertices[k]].cross(s.vertices[f.vertices[(k + 1) % f.vertices.size()]]);
+  return 0.5 * n.norm();
+}
+
+py::dict report_dict(const RadiositySolution& sol) {
+  py::dict r;
+  r["status"] = std::string(to_string(sol.status));
+  r["seconds"] = sol.seconds;
+  py::list channels, energy;
+  int iterations = 0;
+  double residual = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const ChannelReport& ch = sol.channels[c];
+    py::dict d;
+    d["status"] = std::string(to_string(ch.status));
+    d["iterations"] = ch.iterations;
+    d["matvecs"] = ch.matvecs;
+    d["residual"] = ch.residual;
+    d["residual_history"] = ch.residual_history;
+    d["time_history"] = ch.time_history;
+    d["history_iteration"] = ch.history_iteration;
+    d["seconds"] = ch.seconds;
+    d["note"] = ch.note;
+    channels.append(d);
+    iterations = std::max(iterations, ch.iterations);
+    residual = std::max(residual, ch.residual);
+    const EnergyBalance& e = sol.energy[c];
+    py::dict b;
+    b["emitted"] = e.emitted;
+    b["absorbed"] = e.absorbed;
+    b["escaped"] = e.escaped;
+    b["relative_imbalance"] = e.relative_imbalance;
+    b["residual_part"] = e.residual_part;
+    b["non_reciprocity_part"] = e.non_reciprocity_part;
+    energy.append(b);
+  }
+  r["iterations"] = iterations;
+  r["residual"] = residual;
+  r["channels"] = channels;
+  r["energy"] = energy;
+  return r;
+}
+
+// The medium keywords of lambert.solve (the CLI's --medium-box, --sigma-a, ... by the same
+// names with underscores), as MediumArgs.
+MediumArgs medium_args(const py::dict& d) {
+  MediumArgs a;
+  const auto doubles = [&](const char* key, size_t n, std::vector<double>& out) {
+    if (!d.contains(key) || d[key].is_none()) return;
+    out = d[key].cast<std::vector<double>>();
+    if (out.size() != n)
+      throw UsageError(std::string(key) + " must have " + std::to_string(n) + " components");
+    for (double v : out)
+      if (!std::isfinite(v)) throw UsageError(std::string(key) + " must be finite");
+  };
+  doubles("medium_box", 6, a.box);
+  doubles("sigma_a", 3, a.sigma_a);
+  doubles("sigma_s", 3, a.sigma_s);
+  doubles("medium_emission", 3, a.emission);
+  if (d.contains("medium_grid") && !d["medium_grid"].is_none())
+    a.grid = d["medium_grid"].cast<std::string>();
+  if (d.contains("voxels")) a.voxels = d["voxels"].cast<int>();
+  if (d.contains("voxel_size")) a.voxel_size = d["voxel_size"].cast<double>();
+  if (d.contains("medium_rays")) a.rays = d["medium_rays"].cast<int>();
+  if (d.contains("transmittance_samples"))
+    a.transmittance_samples = d["transmittance_samples"].cast<int>();
+  if (a.voxels < 1 || a.rays < 1 || a.transmittance_samples < 1 || !(a.voxel_size >= 0.0))
+    throw UsageError("voxels, medium_rays and transmittance_samples must be >= 1, voxel_size >= 0");
+  if (!a.active() && (!a.sigma_a.empty() || !a.sigma_s.empty() || !a.emission.empty()))
+    throw UsageError("sigma_a, sigma_s and medium_emission need medium_box (or medium_grid)");
+  return a;
+}
+
+Shading parse_shading(const std::string& s) {
+  if (s == "gouraud") return Shading::Gouraud;
+  if (s == "flat") return Shading::Flat;
+  throw UsageError("shading must be \"gouraud\" or \"flat\", got \"" + s + "\"");
+}
+
+}  // namespace
+}  // namespace lambert
+
+using namespace lambert;
+
+PYBIND11_MODULE(_lambert, m) {
+  m.doc() = "lambert's compiled core; use the `lambert` package.";
+  set_log_level(LogLevel::Normal);
+
+  // Never destroyed: the translator may run until the interpreter's last call.
+  static PyObject* error = PyErr_NewException("lambert.Error", nullptr, nullptr);
+  static PyObject* input_error = PyErr_NewException("lambert.InputError", error, nullptr);
+  static PyObject* usage_error = PyErr_NewException(
+      "lambert.UsageError", py::make_tuple(py::handle(error), py::handle(PyExc_ValueError)).ptr(),
+      nullptr);
+  m.attr("Error") = py::handle(error);
+  m.attr("InputError") = py::handle(input_error);
+  m.attr("UsageError") = py::handle(usage_error);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const UsageError& e) {
+      PyErr_SetString(usage_error, e.what());
+    } catch (const SceneError& e) {
+      PyErr_SetString(input_error, e.what());
+    } catch (const IoError& e) {
+      PyErr_SetString(input_error, e.what());
+    } catch (const Error& e) {
+      PyErr_SetString(error, e.what());
+    } catch (const InternalError& e) {
+      PyErr_SetString(PyExc_RuntimeError,
+                      (std::string("lambert internal error: ") + e.what()).c_str());
+    }
+  });
+
+  m.def("set_verbosity", [](int level) {
+    if (level < 0 || level > 2) throw UsageError("verbosity is 0 (quiet), 1 or 2");
+    set_log_level(static_cast<LogLevel>(level));
+  });
+  m.def("estimators", &form_factor_estimator_choices);
+  m.def("solvers", &solver_names);
+  m.def("builtin_cornell_box_path", &builtin_cornell_box_path);
+
+  py::class_<Scene, std::shared_ptr<Scene>>(m, "Scene")
+      .def_readonly("source", &Scene::source)
+      .def_property_readonly("surfaces",
+                             [](const Scene& s) {
+                               std::vector<std::string> names;
+                               for (const auto& x : s.surfaces) names.push_back(x.name);
+                               return names;
+                             })
+      .def_property_readonly("surface_materials",
+                             [](const Scene& s) {
+                               std::vector<std::string> names;
+                               for (const auto& x : s.surfaces)
+                                 names.push_back(s.materials[x.material].name);
+                               return names;
+                             })
+      .def_property_readonly(
+          "materials",
+          [](const Scene& s) {
+            py::list out;
+            for (const auto& mat : s.materials) {
+              py::dict d;
+              d["name"] = mat.name;
+              d["rho"] = std::vector<double>{mat.rho.x(), mat.rho.y(), mat.rho.z()};
+              d["emission"] =
+                  std::vector<double>{mat.emission.x(), mat.emission.y(), mat.emission.z()};
+              d["specular"] = mat.specular.any();
+              out.append(d);
+            }
+            return out;
+          })
+      .def_property_readonly("areas",
+                             [](const Scene& s) {
+                               std::vector<double> a(s.surfaces.size(), 0.0);
+                               for (const Face& f : s.faces) a[f.surface] += face_area(s, f);
+                               return a;
+                             })
+      .def_property_readonly("total_area", &Scene::total_area)
+      .def_property_readonly("faces", [](const Scene& s) { return s.faces.size(); })
+      .def_property_readonly("bounds",
+                             [](const Scene& s) {
+                               const auto [lo, hi] = s.bounds();
+                               return py::make_tuple(std::vector<double>{lo.x(), lo.y(), lo.z()},
+                                                     std::vector<double>{hi.x(), hi.y(), hi.z()});
+                             })
+      .def("__repr__", [](const Scene& s) {
+        return "<lambert.Scene " + s.source + ": " + std::to_string(s.surfaces.size()) +
+               " surfaces, " + std::to_string(s.faces.size()) + " faces>";
+      });
+
+  m.def(
+      "load_scene",
+      [](const std::string& path, bool strict,
+         std::vector<std::pair<std::string, std::vector<double>>> emit) {
+        LoadOptions o;
+        o.strict = strict;
+        for (const auto& [pattern, e] : emit) o.emit.push_back({pattern, vec3(e, "an emit value")});
+        py::gil_scoped_release release;
+        return std::make_shared<Scene>(load_obj(path, nullptr, o));
+      },
+      py::arg("path"), py::arg("strict") = false,
+      py::arg("emit") = std::vector<std::pair<std::string, std::vector<double>>>{});
+
+  py::class_<MeshHandle, std::shared_ptr<MeshHandle>> mesh_class(m, "Mesh");
+  mesh_class.def_property_readonly("size", [](const MeshHandle& h) { return h.mesh.size(); })
+      .def("__len__", [](const MeshHandle& h) { return h.mesh.size(); })
+      .def_property_readonly("max_edge", [](const MeshHandle& h) { return h.mesh.max_edge; })
+      .def_property_readonly("hash", [](const MeshHandle& h) { return mesh_hash(h.mesh); })
+      .def_property_readonly("surface_names",
+                             [](const MeshHandle& h) { return h.mesh.surface_names; })
+      .def_property_readonly("vertices",
+                             [](py::object self) {
+                               const auto& mesh = self.cast<const MeshHandle&>().mesh;
+                               return view(
+                                   mesh.vertices.empty() ? nullptr : mesh.vertices[0].data(),
+                                   static_cast<py::ssize_t>(mesh.vertices.size()), 3,
+                                   sizeof(Eigen::Vector3d), self);
+                             })
+      .def_property_readonly("patch_corners",
+                             [](const MeshHandle& h) {  // copy: -1 pads triangles
+                               std::vector<std::int32_t> v;
+                               v.reserve(4 * h.mesh.patches.size());
+                               for (const Patch& p : h.mesh.patches)
+                                 for (int k = 0; k < 4; ++k)
+                                   v.push_back(k < p.vertex_count ? p.vertices[k] : -1);
+                               return adopt(std::move(v), {h.mesh.size(), 4});
+                             })
+      .def_property_readonly("scene",
+                             [](const MeshHandle& h) { return std::make_shared<Scene>(h.scene); });
+
+  // Per-patch views: strided over the Patch structs (zero-copy, read-only).
+  const auto patch_view = [](auto member, py::ssize_t cols) {
+    return [member, cols](py::object self) {
+      const PatchMesh& mesh = self.cast<const MeshHandle&>().mesh;
+      static const Patch probe;
+      using T = std::remove_cv_t<std::remove_reference_t<decltype(probe.*member)>>;
+      const py::ssize_t n = mesh.size();
+      if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
+        const double* first = n ? (mesh.patches[0].*member).data() : nullptr;
+        return view(first, n, cols, sizeof(Patch), self);
+      } else {
+        const T* first = n ? &(mesh.patches[0].*member) : nullptr;
+        return view(first, n, 0, sizeof(Patch), self);
+      }
+    };
+  };
+  mesh_class.def_property_readonly("areas", patch_view(&Patch::area, 0))
+      .def_property_readonly("normals", patch_view(&Patch::normal, 3))
+      .def_property_readonly("centroids", patch_view(&Patch::centroid, 3))
+      .def_property_readonly("rho", patch_view(&Patch::rho, 3))
+      .def_property_readonly("emission", patch_view(&Patch::emission, 3))
+      .def_property_readonly("surface_ids", patch_view(&Patch::surface, 0))
+      .def_property_readonly("vertex_counts", patch_view(&Patch::vertex_count, 0));
+
+  m.def(
+      "mesh_scene",
+      [](const Scene& scene, double max_edge, std::int64_t patches, bool discontinuity) {
+        if (!(max_edge >= 0.0) || !std::isfinite(max_edge))
+          throw UsageError("max_edge must be a finite number >= 0");
+        if (patches < 0) throw UsageError("patches must be >= 0");
+        auto h = std::make_shared<MeshHandle>();
+        h->loaded.scene = scene;
+        py::gil_scoped_release release;
+        MeshOptions mo;
+        mo.max_edge = max_edge;
+        mo.target_patches = patches;
+        mo.discontinuity = discontinuity;
+        // As the CLI's load_scene: the planned edge bound, so the mesh is the CLI's.
+        const MeshPlan plan = plan_mesh(h->scene, mo);
+        if (!mo.discontinuity) mo.max_edge = plan.max_edge;
+        h->loaded.mesh = mesh_scene(h->scene, mo);
+        h->loaded.max_edge = h->mesh.max_edge;
+        h->loaded.discontinuity = mo.discontinuity;
+        return h;
+      },
+      py::arg("scene"), py::arg("max_edge"), py::arg("patches"), py::arg("discontinuity"));
+
+  m.def(
+      "form_factors",
+      [](const MeshHandle& h, const std::string& estimator, std::optional<int> samples,
+         std::optional<int> rays, std::uint64_t seed, int threads, double threshold,
+         const std::string& reciprocity, std::optional<double> tol, int hemicube_resolution,
+         bool with_stderr) {
+        FormFactorOptions o;
+        o.estimator = estimator;
+        const auto valid = form_factor_estimator_choices();
+        if (std::find(valid.begin(), valid.end(), estimator) == valid.end())
+          throw UsageError("unknown estimator \"" + estimator + "\"");
+        if (estimator != "auto") {
+          const std::string used = estimator_count_option(estimator);
+          if (samples && used != "samples" && estimator != "hemicube")
+            throw UsageError("samples does not apply to estimator " + estimator);
+          if (rays && used != "rays")
+            throw UsageError("rays does not apply to estimator " + estimator);
+        }
+        if (samples) o.samples = *samples;
+        if (rays) o.rays = *rays;
+        if (tol) o.tol = *tol, o.tol_given = true;
+        if (o.samples < 1 || o.rays < 1) throw UsageError("samples and rays must be >= 1");
+        if (threads < 0) throw UsageError("threads must be >= 0 (0 = all cores)");
+        o.seed = seed;
+        o.threads = threads;
+        o.threshold = threshold;
+        o.reciprocity = reciprocity;
+        o.hemicube_resolution = hemicube_resolution;
+        o.with_stderr = with_stderr;
+        o.progress = false;
+        FormFactors ff;
+        {
+          py::gil_scoped_release release;
+          ff = compute_form_factors(h.mesh, o, &h.get_bvh());
+        }
+        return ff_result(std::move(ff), h);
+      },
+      py::arg("mesh"), py::arg("estimator"), py::arg("samples"), py::arg("rays"), py::arg("seed"),
+      py::arg("threads"), py::arg("threshold"), py::arg("reciprocity"), py::arg("tol"),
+      py::arg("hemicube_resolution"), py::arg("stderr"));
+
+  m.def(
+      "save_form_factors",
+      [](const std::string& path, const MeshHandle& h, const IndexArray& indptr,
+         const IndexArray& indices, const ValueArray& data, std::optional<py::tuple> err,
+         const std::string& settings, const std::string& precision) {
+        if (precision != "double" && precision != "float")
+          throw UsageError("precision must be \"double\" or \"float\"");
+        FormFactors ff;
+        ff.F = csr_from_arrays(h.mesh.size(), indptr, indices, data, "F");
+        if (err)
+          ff.stderr_F =
+              csr_from_arrays(h.mesh.size(), (*err)[2].cast<IndexArray>(),
+                              (*err)[1].cast<IndexArray>(), (*err)[0].cast<ValueArray>(), "stderr");
+        const ValuePrecision p =
+            precision == "float" ? ValuePrecision::Float : ValuePrecision::Double;
+        const FormFactorFileInfo info{mesh_hash(h.mesh), settings};
+        py::gil_scoped_release release;
+        const std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
+        if (ext == ".mtx") {
+          if (ff.stderr_F.size() > 0)
+            throw UsageError(path + ": standard errors are saved in the binary format only (.bin)");
+          write_matrix_market(path, ff.F, info, p);
+        } else {
+          write_ff_binary(path, ff, info, p);
+        }
+      },
+      py::arg("path"), py::arg("mesh"), py::arg("indptr"), py::arg("indices"), py::arg("data"),
+      py::arg("stderr"), py::arg("settings"), py::arg("precision"));
+
+  m.def(
+      "load_form_factors",
+      [](const std::string& path, const MeshHandle& h) {
+        FormFactors ff;
+        FormFactorFileInfo info;
+        {
+          py::gil_scoped_release release;
+          ff = read_form_factors(path, mesh_hash(h.mesh), h.mesh.size(), &info);
+        }
+        py::dict out = ff_result(std::move(ff), h);
+        out["settings"] = info.settings;
+        return out;
+      },
+      py::arg("path"), py::arg("mesh"));
+
+  m.def(
+      "solve",
+      [](const MeshHandle& h, const IndexArray& indptr, const IndexArray& indices,
+         const ValueArray& data, const std::string& solver, double tol, int max_iterations,
+         double omega, const std::string& preconditioner, int restart, int threads,
+         std::optional<ValueArray> initial, const py::dict& medium_options) {
+        const auto names = solver_names();
+        if (std::find(names.begin(), names.end(), solver) == names.end()) {
+          std::string list;
+          for (const auto& s : names) list += (list.empty() ? "" : ", ") + s;
+          throw UsageError("unknown solver \"" + solver + "\" (one of " + list + ")");
+        }
+        if (!(tol > 0.0 && tol < 1.0)) throw UsageError("tol must be in (0, 1)");
+        if (max_iterations < 1) throw UsageError("max_iterations must be >= 1");
+        const SparseRowMatrix F = csr_from_arrays(h.mesh.size(), indptr, indices, data, "F");
+        SolveOptions o;
+        o.solver = solver;
+        o.tol = tol;
+        o.max_iterations = max_iterations;
+        o.omega = omega;
+        o.preconditioner = preconditioner;
+        o.restart = restart;
+        o.threads = threads;
+        if (initial) o.initial_guess = matrix_n3(*initial, h.mesh.size(), "initial_guess");
+        const MediumArgs margs = medium_args(medium_options);
+        if (margs.active()) {  // the extended solve of apps/medium_stage, as `lambert solve`
+          if (initial) throw UsageError("initial_guess does not combine with a medium");
+          const std::shared_ptr<const Medium> medium = make_medium(margs);
+          check_medium_scene(h.mesh, nullptr);
+          RunArgs run;
+          run.threads = threads;
+          run.seed =
+              medium_options.contains("seed") ? py::cast<std::uint64_t>(medium_options["seed"]) : 1;
+          run.quiet = true;
+          FormFactors surface;
+          surface.F = F;
+          RadiosityResult r;
+          MediumResult mr;
+          {
+            py::gil_scoped_release release;
+            h.get_bvh();
+            mr = solve_scene_with_medium(h.loaded, surface, medium, margs, o, run, r);
+          }
+          py::dict report = report_dict(r.solution);
+          report["medium"] = py::module_::import("json").attr("loads")(json_text(medium_json(mr)));
+          return py::make_tuple(adopt_matrix(r.B), report);
+        }
+        RadiositySolution sol;
+        {
+          py::gil_scoped_release release;
+          const RadiosityProblem problem = make_problem(h.mesh, F);
+          validate_problem(problem);
+          sol = solve_radiosity(problem, o);
+        }
+        return py::make_tuple(adopt_matrix(sol.B), report_dict(sol));
+      },
+      py::arg("mesh"), py::arg("indptr"), py::arg("indices"), py::arg("data"), py::arg("solver"),
+      py::arg("tol"), py::arg("max_iterations"), py::arg("omega"), py::arg("preconditioner"),
+      py::arg("restart"), py::arg("threads"), py::arg("initial_guess"), py::arg("medium"));
+
+  m.def(
+      "solve_hierarchical",
+      [](const Scene& scene, double epsilon, double min_area, int link_rays, double tol,
+         int max_iterations, int max_passes, std::uint64_t seed, int threads) {
+        if (!(epsilon > 0.0 && epsilon < 1.0)) throw UsageError("epsilon must be in (0, 1)");
+        if (!(min_area >= 0.0) || !std::isfinite(min_area))
+          throw UsageError("min_area must be >= 0");
+        if (!(tol > 0.0 && tol < 1.0)) throw UsageError("tol must be in (0, 1)");
+        if (link_rays < 1 || max_iterations < 1 || max_passes < 1 || threads < 0)
+          throw UsageError("link_rays, max_iterations and max_passes must be >= 1, threads >= 0");
+        HierarchicalOptions o;
+        o.epsilon = epsilon;
+        o.min_area = min_area;
+        o.link_rays = link_rays;
+        o.tol = tol;
+        o.max_iterations = max_iterations;
+        o.max_passes = max_passes;
+        o.seed = seed;
+        o.threads = threads;
+        auto h = std::make_shared<MeshHandle>();
+        HierarchicalRun run;
+        {
+          py::gil_scoped_release release;
+          run = solve_scene_hierarchical(scene, o);
+          h->loaded = std::move(run.loaded);
+        }
+        const py::object loads = py::module_::import("json").attr("loads");
+        py::dict report = loads(json_text(hierarchical_json(run)));
+        py::list energy;
+        for (const HierarchicalEnergy& e : run.stats.energy)
+          energy.append(loads(json_text(hierarchical_energy_json(e))));
+        report["energy"] = energy;
+        std::vector<double> bound(run.error_bound.data(),
+                                  run.error_bound.data() + run.error_bound.size());
+        report["error_bound"] =
+            adopt(std::move(bound), {static_cast<py::ssize_t>(run.error_bound.size())});
+        return py::make_tuple(h, adopt_matrix(run.B), report);
+      },
+      py::arg("scene"), py::arg("epsilon"), py::arg("min_area"), py::arg("link_rays"),
+      py::arg("tol"), py::arg("max_iterations"), py::arg("max_passes"), py::arg("seed"),
+      py::arg("threads"));
+
+  py::class_<VertexField, std::shared_ptr<VertexField>>(m, "VertexField")
+      .def("__len__", &VertexField::size)
+      .def_property_readonly("positions",
+                             [](py::object self) {
+                               const auto& f = self.cast<const VertexField&>();
+                               return view(f.positions.empty() ? nullptr : f.positions[0].data(),
+                                           f.size(), 3, sizeof(Eigen::Vector3d), self);
+                             })
+      .def_property_readonly("normals",
+                             [](py::object self) {
+                               const auto& f = self.cast<const VertexField&>();
+                               return view(f.normals.empty() ? nullptr : f.normals[0].data(),
+                                           f.size(), 3, sizeof(Eigen::Vector3d), self);
+                             })
+      .def_property_readonly("surface_ids",
+                             [](py::object self) {
+                               const auto& f = self.cast<const VertexField&>();
+                               return view(f.surface.data(), f.size(), 0, sizeof(std::int32_t),
+                                           self);
+                             })
+      .def_property_readonly("patch_corners",
+                             [](py::object self) {
+                               const auto& f = self.cast<const VertexField&>();
+                               return view(
+                                   f.patch_corners.empty() ? nullptr : f.patch_corners[0].data(),
+                                   static_cast<py::ssize_t>(f.patch_corners.size()), 4,
+                                   4 * sizeof(std::int32_t), self);
+                             })
+      .def_property_readonly("values", [](const VertexField& f) { return adopt_matrix(f.values); });
+
+  m.def(
+      "vertex_radiosity",
+      [](const MeshHandle& h, const ValueArray& B, const std::string& mode) {
+        const Eigen::MatrixX3d b = matrix_n3(B, h.mesh.size(), "B");
+        const VertexInterpolation im = parse_vertex_interpolation(mode);
+        py::gil_scoped_release release;
+        return std::make_shared<VertexField>(interpolate_to_vertices(h.mesh, b, im));
+      },
+      py::arg("mesh"), py::arg("B"), py::arg("mode"));
+
+  m.def(
+      "write_vertex_exr",
+      [](const std::string& path, const MeshHandle& h, const VertexField& field,
+         const std::string& settings) {
+        ExrInfo info;
+        info.units = "radiosity B (units of the scene's emission E)";
+        info.settings = settings;
+        info.surface_names = h.mesh.surface_names;
+        py::gil_scoped_release release;
+        write_vertex_exr(path, field, info);
+      },
+      py::arg("path"), py::arg("mesh"), py::arg("field"), py::arg("settings"));
+
+  m.def(
+      "render",
+      [](const MeshHandle& h, const ValueArray& B, std::optional<std::vector<double>> eye,
+         std::optional<std::vector<double>> look_at, std::optional<std::vector<double>> up,
+         std::optional<double> fov, std::optional<int> width, std::optional<int> height,
+         const std::string& shading, int antialias, std::uint64_t seed, int threads,
+         const std::string& exr, const std::string& png, std::optional<double> ev) {
+        const Eigen::MatrixX3d b = matrix_n3(B, h.mesh.size(), "B");
+        Camera cam = h.scene.camera;
+        if (!cam.defined) {
+          const auto [lo, hi] = h.scene.bounds();
+          cam = framing_camera(lo, hi);
+        }
+        if (eye) cam.eye = vec3(*eye, "eye");
+        if (look_at) cam.look_at = vec3(*look_at, "look_at");
+        if (up) cam.up = vec3(*up, "up");
+        if (fov) {
+          if (!(*fov >= 0.1 && *fov <= 179.0))
+            throw UsageError("fov must be in [0.1, 179] degrees");
+          cam.vfov_degrees = *fov;
+        }
+        if (width) cam.width = *width;
+        if (height) cam.height = *height;
+        if (cam.width < 1 || cam.height < 1 || cam.width > 16384 || cam.height > 16384)
+          throw UsageError("width and height must be in [1, 16384]");
+        if (const std::string why = camera_problem(cam); !why.empty())
+          throw UsageError("camera: " + why);
+        if (antialias < 1 || antialias > 16) throw UsageError("antialias must be in [1, 16]");
+        RenderSettings rs;
+        rs.shading = parse_shading(shading);
+        rs.antialias = antialias;
+        rs.seed = seed;
+        rs.threads = threads;
+        rs.progress = false;
+        Image img;
+        {
+          py::gil_scoped_release release;
+          const VertexField field = interpolate_to_vertices(h.mesh, b);
+          img = render(h.mesh, h.get_bvh(), cam, b, field, rs);
+          if (!exr.empty()) {
+            ExrInfo info;
+            info.units = "radiance B/pi (W m^-2 sr^-1 in the scene's units)";
+            write_image_exr(exr, img, info);
+          }
+          if (!png.empty()) write_png_preview(png, img, ev ? *ev : auto_exposure(img));
+        }
+        const int w = img.width, hh = img.height;
+        return adopt(std::move(img.rgb), {hh, w, 3});
+      },
+      py::arg("mesh"), py::arg("B"), py::arg("eye"), py::arg("look_at"), py::arg("up"),
+      py::arg("fov"), py::arg("width"), py::arg("height"), py::arg("shading"), py::arg("antialias"),
+      py::arg("seed"), py::arg("threads"), py::arg("exr"), py::arg("png"), py::arg("ev"));
+}

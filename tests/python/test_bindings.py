@@ -1,0 +1,269 @@
+"""The Python API against the CLI and against closed forms."""
+import math
+import os
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import lambert
+from conftest import run_cli, write_obj
+
+
+def test_scene_and_mesh_arrays(cornell, cornell_mesh):
+    assert "floor" in " ".join(cornell.surfaces).lower() or len(cornell.surfaces) >= 5
+    assert len(cornell.areas) == len(cornell.surfaces)
+    m = cornell_mesh
+    n = len(m)
+    assert m.areas.shape == (n,) and m.normals.shape == (n, 3) and m.rho.shape == (n, 3)
+    assert m.emission.shape == (n, 3) and m.centroids.shape == (n, 3)
+    assert m.patch_corners.shape == (n, 4) and m.surface_ids.shape == (n,)
+    # The patches tile the surfaces exactly (mesh.cpp: area exact).
+    assert math.isclose(m.areas.sum(), sum(cornell.areas), rel_tol=1e-12)
+    assert np.allclose(np.linalg.norm(m.normals, axis=1), 1.0)
+    assert (m.emission.max(axis=1) > 0).any()
+    assert m.patch_corners.max() < len(m.vertices)
+
+
+def test_mesh_arrays_are_read_only_views(cornell_mesh):
+    areas = cornell_mesh.areas
+    assert not areas.flags.writeable and not areas.flags.owndata
+    with pytest.raises(ValueError):
+        areas[0] = 1.0
+    # Two reads of the same member share the mesh's memory: no copy was made.
+    assert np.shares_memory(cornell_mesh.rho, cornell_mesh.rho)
+
+
+@pytest.mark.parametrize("estimator,count", [("hybrid", ["--samples", "8"]),
+                                             ("gather", ["--rays", "256"])])
+def test_form_factors_equal_the_cli_bitwise(tmp_path, cornell, estimator, count):
+    mesh = cornell.mesh(patches=300)
+    kwargs = {"samples": 8} if estimator == "hybrid" else {"rays": 256}
+    F = lambert.form_factors(mesh, estimator=estimator, seed=7, threads=2, **kwargs)
+    assert isinstance(F, sp.csr_matrix) and F.shape == (len(mesh), len(mesh))
+    assert not F.data.flags.owndata  # handed over from C++ without a copy
+    cli = tmp_path / "F.bin"
+    run_cli("formfactors", "--patches", 300, "--estimator", estimator, *count, "--seed", 7,
+            "-j", 1, "-q", "-o", cli)
+    G = lambert.load_form_factors(cli, mesh)
+    # Bitwise: the same sparsity and the same doubles (not merely close).
+    assert np.array_equal(F.indptr, G.indptr) and np.array_equal(F.indices, G.indices)
+    assert F.data.tobytes() == G.data.tobytes()
+    # Saved from Python, the file is the CLI's byte for byte (same settings text).
+    mine = tmp_path / "mine.bin"
+    lambert.save_form_factors(mine, mesh, F)
+    assert mine.read_bytes() == cli.read_bytes()
+
+
+def test_save_load_round_trip_with_stderr(tmp_path, cornell_mesh):
+    F, S = lambert.form_factors(cornell_mesh, estimator="mc", samples=4, stderr=True)
+    assert S is not None and S.shape == F.shape
+    lambert.save_form_factors(tmp_path / "F.bin", cornell_mesh, F, stderr=S)
+    G, T = lambert.load_form_factors(tmp_path / "F.bin", cornell_mesh, stderr=True)
+    assert (G != F).nnz == 0 and (T != S).nnz == 0
+    lambert.save_form_factors(tmp_path / "F.mtx", cornell_mesh, F)
+    assert (lambert.load_form_factors(tmp_path / "F.mtx", cornell_mesh) != F).nnz == 0
+
+
+def cube_faces():
+    """The unit cube's six faces wound about their inward normals."""
+    faces = {}
+    for a in range(3):
+        u, v = (a + 1) % 3, (a + 2) % 3
+        for s in (0, 1):
+            p = []
+            for du, dv in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                c = [0.0, 0.0, 0.0]
+                c[a], c[u], c[v] = float(s), float(du), float(dv)
+                p.append(tuple(c))
+            faces[f"f{a}{s}"] = [p if s == 0 else p[::-1]]
+    return faces
+
+
+def test_furnace_gives_e_over_one_minus_rho(tmp_path):
+    rho, e = 0.5, 1.0
+    faces = cube_faces()
+    path = write_obj(tmp_path / "cube.obj", faces, {k: ((rho,) * 3, (e,) * 3) for k in faces})
+    mesh = lambert.load_scene(path).mesh(max_edge=0.5)
+    n = len(mesh)
+    tol_f, tol = 1e-9, 1e-10
+    F = lambert.form_factors(mesh, estimator="analytic", tol=tol_f)
+    B, report = lambert.solve(mesh, F, solver="gauss-seidel", tol=tol)
+    assert report["status"] == "converged"
+    # Bound: ||K^-1||_inf <= 1/(1 - rho) = 2 turns the stopping rule ||E - K B|| <= tol ||E||
+    # into |B - B*| <= 2 tol ||E||_2 = 2 tol sqrt(n); each row of F is off by at most n tol_f,
+    # which moves B* by at most 2 rho (n tol_f) max B = 2 n tol_f.
+    bound = 2 * tol * math.sqrt(n) * e + 2 * n * tol_f
+    assert np.abs(B - e / (1 - rho)).max() <= bound
+    for ch in report["energy"]:
+        assert ch["escaped"] <= 2 * n * tol_f * ch["emitted"]
+
+
+def parallel_squares_factor(x, y):
+    """F between parallel, directly opposed rectangles of sides x, y at unit distance."""
+    a, b = 1 + x * x, 1 + y * y
+    return 2 / (math.pi * x * y) * (
+        math.log(math.sqrt(a * b / (a + b - 1))) + x * math.sqrt(b) * math.atan(x / math.sqrt(b))
+        + y * math.sqrt(a) * math.atan(y / math.sqrt(a)) - x * math.atan(x) - y * math.atan(y))
+
+
+def test_parallel_squares_within_four_standard_errors(tmp_path):
+    bottom = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]
+    top = [(0, 0, 1), (0, 1, 1), (1, 1, 1), (1, 0, 1)]
+    path = write_obj(tmp_path / "squares.obj", {"bottom": [bottom], "top": [top]})
+    mesh = lambert.load_scene(path).mesh(max_edge=0.25)
+    F, S = lambert.form_factors(mesh, estimator="mc", samples=64, seed=3, stderr=True)
+    ids, A = mesh.surface_ids, mesh.areas
+    b, t = ids == mesh.surface_names.index("bottom"), ids == mesh.surface_names.index("top")
+    Ab = A[b].sum()
+    F_bt = (A[b][:, None] * F[b][:, t].toarray()).sum() / Ab
+    # The entries' estimates are independent (one stream per pair), so the surface factor's
+    # standard error is the root sum of squares of the area-weighted entry errors.
+    se = math.sqrt(((A[b][:, None] * S[b][:, t].toarray()) ** 2).sum()) / Ab
+    exact = parallel_squares_factor(1.0, 1.0)  # 0.19982
+    assert se > 0
+    assert abs(F_bt - exact) <= 4 * se, (F_bt, exact, se)
+
+
+def test_two_solvers_agree_and_report(cornell_mesh):
+    F = lambert.form_factors(cornell_mesh, estimator="hybrid", samples=8)
+    B1, r1 = lambert.solve(cornell_mesh, F, solver="gauss-seidel", tol=1e-10)
+    B2, r2 = lambert.solve(cornell_mesh, F, solver="cg", tol=1e-10)
+    assert B1.shape == (len(cornell_mesh), 3) and r1["status"] == r2["status"] == "converged"
+    assert len(r1["channels"]) == 3 and r1["channels"][0]["residual_history"]
+    assert r1["residual"] <= 1e-10
+    # Both meet ||E - K B|| <= 1e-10 ||E||; K^-1 <= 1/(1 - rho_max) (rho_max = 0.78 the light).
+    assert np.abs(B1 - B2).max() <= 2 * 1e-10 * np.linalg.norm(cornell_mesh.emission) / (1 - 0.78)
+    assert (B1 >= cornell_mesh.emission - 1e-12).all()
+
+
+def test_vertex_field_render_and_files(tmp_path, cornell_mesh):
+    F = lambert.form_factors(cornell_mesh, estimator="hybrid", samples=4)
+    B, _ = lambert.solve(cornell_mesh, F)
+    field = lambert.vertex_radiosity(cornell_mesh, B)
+    assert field.values.shape == (len(field), 3) and field.positions.shape == (len(field), 3)
+    lambert.write_vertex_exr(tmp_path / "v.exr", cornell_mesh, B)
+    assert (tmp_path / "v.exr").stat().st_size > 0
+    img = lambert.render(cornell_mesh, B, width=32, height=24, antialias=1,
+                         exr=tmp_path / "r.exr", png=tmp_path / "r.png")
+    assert img.shape == (24, 32, 3) and img.dtype == np.float32 and img.max() > 0
+    assert (tmp_path / "r.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_bad_files_raise_input_error_naming_the_file(tmp_path, cornell_mesh):
+    missing = tmp_path / "missing.obj"
+    with pytest.raises(lambert.InputError, match="missing.obj"):
+        lambert.load_scene(missing)
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n")
+    with pytest.raises(lambert.InputError, match="bad.obj"):
+        lambert.load_scene(bad)
+    # An F made for another mesh is refused, naming the file.
+    other = lambert.load_scene().mesh(patches=50)
+    lambert.save_form_factors(tmp_path / "other.bin", other,
+                              lambert.form_factors(other, estimator="hybrid", samples=2))
+    with pytest.raises(lambert.InputError, match="other.bin"):
+        lambert.load_form_factors(tmp_path / "other.bin", cornell_mesh)
+    garbage = tmp_path / "garbage.bin"
+    garbage.write_bytes(b"\x00" * 64)
+    with pytest.raises(lambert.InputError, match="garbage.bin"):
+        lambert.load_form_factors(garbage, cornell_mesh)
+    assert issubclass(lambert.InputError, lambert.Error)
+
+
+def test_wrong_arguments_raise_not_crash(cornell_mesh):
+    n = len(cornell_mesh)
+    F = sp.identity(n, format="csr") * 0.0
+    with pytest.raises(lambert.UsageError):
+        lambert.form_factors(cornell_mesh, estimator="nope")
+    with pytest.raises(lambert.UsageError):
+        lambert.form_factors(cornell_mesh, estimator="gather", samples=4)
+    with pytest.raises(TypeError):
+        lambert.form_factors("not a mesh")
+    with pytest.raises(TypeError):
+        lambert.form_factors(cornell_mesh, samples=1.5)
+    with pytest.raises(TypeError):
+        lambert.solve(cornell_mesh, np.zeros((n, n)))
+    with pytest.raises(lambert.UsageError, match="shape"):
+        lambert.solve(cornell_mesh, sp.identity(n + 1, format="csr"))
+    with pytest.raises(lambert.UsageError):
+        lambert.solve(cornell_mesh, F, solver="nope")
+    with pytest.raises(lambert.UsageError, match="shape"):
+        lambert.vertex_radiosity(cornell_mesh, np.zeros((n, 2)))
+    with pytest.raises(lambert.UsageError, match="shape"):
+        lambert.render(cornell_mesh, np.zeros(n))
+    with pytest.raises((TypeError, lambert.UsageError)):
+        lambert.vertex_radiosity(cornell_mesh, "abc")
+    with pytest.raises(lambert.UsageError):
+        lambert.render(cornell_mesh, np.zeros((n, 3)), eye=(1, 2))
+    with pytest.raises(lambert.UsageError, match="not finite"):
+        bad = sp.csr_matrix(([np.nan], ([0], [1])), shape=(n, n))
+        lambert.solve(cornell_mesh, bad)
+    assert issubclass(lambert.UsageError, ValueError)
+
+
+def test_medium_solve_equals_the_cli(tmp_path, cornell):
+    fog = ["--medium-box", "0,0,0,556,548.8,559.2", "--sigma-a", "0.001,0.001,0.001",
+           "--voxels", 4, "--medium-rays", 64]
+    run_cli("solve", "--patches", 150, "--estimator", "hybrid", "--samples", 4, "--seed", 3,
+            "--tol", 1e-10, "-q", *fog, "-o", tmp_path / "B.csv")
+    mesh = cornell.mesh(patches=150)
+    F = lambert.form_factors(mesh, estimator="hybrid", samples=4, seed=3)
+    B, report = lambert.solve(mesh, F, tol=1e-10, medium_box=(0, 0, 0, 556, 548.8, 559.2),
+                              sigma_a=(1e-3,) * 3, voxels=4, medium_rays=64, seed=3)
+    assert report["status"] == "converged" and report["medium"]["zones"] == 64
+    import csv
+    with open(tmp_path / "B.csv") as f:
+        cli = np.array([[float(r[c]) for c in "RGB"] for r in csv.DictReader(f)])
+    # The CSV holds 17 significant digits: a double read back is the double written.
+    assert B.shape == cli.shape and np.array_equal(B, cli)
+    for c in range(3):  # the medium takes its share of the absorbed power
+        e = report["energy"][c]
+        assert report["medium"]["absorbed_medium"][c] > 0
+        assert math.isclose(report["medium"]["absorbed_medium"][c]
+                            + report["medium"]["absorbed_surfaces"][c], e["absorbed"],
+                            rel_tol=1e-9)
+    with pytest.raises(lambert.UsageError):
+        lambert.solve(mesh, F, sigma_a=(1e-3,) * 3)  # coefficients without a box
+    with pytest.raises(TypeError):
+        lambert.solve(mesh, F, medium_bx=(0, 0, 0, 1, 1, 1))
+
+
+def test_hierarchical_equals_the_cli(tmp_path, cornell):
+    run_cli("solve", "--method", "hierarchical", "--epsilon", 1e-3, "--seed", 2, "-q",
+            "-o", tmp_path / "B.csv")
+    leaves, B, report = lambert.solve_hierarchical(cornell, epsilon=1e-3, seed=2)
+    assert report["status"] == "converged" and len(leaves) == report["leaves"] == len(B)
+    import csv
+    with open(tmp_path / "B.csv") as f:
+        cli = np.array([[float(r[c]) for c in "RGB"] for r in csv.DictReader(f)])
+    assert np.array_equal(B, cli)  # 17 significant digits in the CSV: exact
+    assert max(e["relative_imbalance"] for e in report["energy"]) < 1e-9
+    img = lambert.render(leaves, B, width=16, height=16, antialias=1)  # the leaf mesh renders
+    assert img.max() > 0
+    with pytest.raises(lambert.UsageError):
+        lambert.solve_hierarchical(cornell, epsilon=2.0)
+
+
+def test_long_calls_release_the_gil(cornell):
+    import threading
+    import time
+    mesh = cornell.mesh(patches=600)
+    ticks, done = [0], threading.Event()
+
+    def tick():
+        while not done.is_set():
+            ticks[0] += 1
+            time.sleep(0.001)
+
+    t = threading.Thread(target=tick)
+    t.start()
+    start = time.perf_counter()
+    lambert.form_factors(mesh, estimator="hybrid", samples=8)
+    seconds = time.perf_counter() - start
+    done.set()
+    t.join()
+    # Holding the GIL for the whole call would leave the ticker at 0 or 1 (it gets the
+    # interpreter only before and after); released, it ticks about once a millisecond
+    # (a 20th of that on a loaded machine still passes).
+    assert seconds < 0.05 or ticks[0] >= 50 * seconds, (ticks[0], seconds)
