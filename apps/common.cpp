@@ -3,12 +3,12 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <algorithm>
 #include <filesystem>
 #include <limits>
 #include <sstream>
@@ -17,6 +17,7 @@
 #include "core/log.hpp"
 #include "core/memory.hpp"
 #include "io/obj_loader.hpp"
+#include "io/stl_loader.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
@@ -191,7 +192,9 @@ void check_job_memory(std::int64_t patches, const JobPlan& plan) {
 }
 
 void add_scene_options(CLI::App* cmd, SceneArgs& args) {
-  cmd->add_option("scene", args.scene, "OBJ scene file (default: the built-in Cornell box)");
+  cmd->add_option(
+      "scene", args.scene,
+      "OBJ or STL scene file, told apart by content (default: the built-in Cornell box)");
   cmd->add_flag("--strict", args.load.strict,
                 "Refuse missing or undefined materials and Kd = 1 instead of defaulting with a warning");
   cmd->add_option_function<std::string>(
@@ -296,7 +299,8 @@ Scene load_scene_file(const SceneArgs& args) {
     if (!why.empty()) throw UsageError("--emit: " + why);
     options.emit.push_back(rule);
   }
-  return load_obj(args.scene.empty() ? builtin_cornell_box_path() : args.scene, nullptr, options);
+  return load_scene_path(args.scene.empty() ? builtin_cornell_box_path() : args.scene, nullptr,
+                         options);
 }
 
 Scene load_checked_scene(const SceneArgs& args, const JobPlan& plan) {

@@ -64,6 +64,12 @@ Scene load_obj(const std::string& path, LoadReport* report = nullptr,
 Scene load_obj_stream(std::istream& obj, const std::string& name, const MtlOpener& open_mtl,
                       LoadReport* report = nullptr, const LoadOptions& options = {});
 
+/// `--emit`: each rule sets E on the material of every surface it matches by surface or
+/// material name (a material also used by surfaces the rule does not match is copied first,
+/// as `material@surface`). Throws UsageError for a rule matching nothing in `name`. Shared by
+/// the OBJ and STL loaders.
+void apply_emit(const std::vector<EmitRule>& rules, const std::string& name, Scene& scene);
+
 /// Path of the built-in Cornell box scene.
 std::string builtin_cornell_box_path();
 
