@@ -79,6 +79,7 @@ CLI::App* add_heat_command(CLI::App& app, HeatOptions& opts) {
   auto* cmd = app.add_subcommand(
       "heat", "Gray-diffuse radiative heat exchange: temperatures, net fluxes and powers");
   opts.scene.default_patches = 2000;
+  opts.scene.load.warn_without_emitter = false;  // heat's sources are temperatures
   add_scene_options(cmd, opts.scene);
   add_ff_options(cmd, opts.ff);
   add_solve_options(cmd, opts.solve, true);

@@ -660,7 +660,7 @@ Scene load_obj_stream(std::istream& in, const std::string& name, const MtlOpener
   report_coincident(scene, name, diag, report);
   apply_emit(options.emit, name, scene);
   for (const auto& s : scene.surfaces) report.has_emitter = report.has_emitter || scene.materials[s.material].emits();
-  if (!report.has_emitter)
+  if (!report.has_emitter && options.warn_without_emitter)
     diag.warn(name + ": no emitter (no material with Ke > 0): the radiosity is zero; add one with "
               "--emit SURFACE_OR_MATERIAL=R,G,B (lambert info lists the names)");
   scene.camera = framing_camera(lo, hi);

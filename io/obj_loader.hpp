@@ -29,6 +29,9 @@ struct LoadOptions {
   /// Each face whose corners all have colours (`v x y z r g b`) gets their mean as its
   /// reflectance (Face::rho) instead of its material's Kd.
   bool vertex_colors_as_reflectance = false;
+  /// Warn when nothing emits (radiosity would be zero); off for `lambert heat`, whose
+  /// sources are temperatures from its surfaces file.
+  bool warn_without_emitter = true;
 };
 
 /// What the loader had to repair, default or skip (each also logged as a warning).
