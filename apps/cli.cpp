@@ -32,6 +32,8 @@ int run_cli(int argc, const char* const* argv) {
   FormFactorsOptions formfactors;
   commands.emplace_back(add_formfactors_command(app, formfactors),
                         [&] { return run_formfactors(formfactors); });
+  HeatOptions heat;
+  commands.emplace_back(add_heat_command(app, heat), [&] { return run_heat(heat); });
   AccuracyOptions accuracy;
   commands.emplace_back(add_accuracy_command(app, accuracy), [&] { return run_accuracy(accuracy); });
 

@@ -6,6 +6,7 @@
 #include "apps/adapt_stage.hpp"
 #include "apps/common.hpp"
 #include "apps/ff_args.hpp"
+#include "apps/heat_outputs.hpp"
 #include "apps/medium_stage.hpp"
 #include "apps/method.hpp"
 #include "apps/render_stages.hpp"
@@ -145,5 +146,22 @@ struct AccuracyOptions {
 CLI::App* add_accuracy_command(CLI::App& app, AccuracyOptions& opts);
 /// Runs the estimators, compares F and B with the reference; table, CSVs and plot.
 int run_accuracy(const AccuracyOptions& opts);
+
+/// Options of `lambert heat`.
+struct HeatOptions {
+  SceneArgs scene;
+  RunArgs run;
+  FormFactorArgs ff;
+  SolveOptions solve;
+  std::string surfaces;              ///< --surfaces FILE.json (io/heat_surfaces.hpp)
+  double ambient_temperature = 0.0;  ///< --ambient-temperature (K)
+  std::string length_unit = "m";     ///< --length-unit: m, cm, mm or in
+  std::string output = "heat";       ///< -o: prefix (or DIR/) of the CSVs and the JSON
+  HeatImageArgs images;              ///< --vertex-exr, --ply, --image and the camera
+};
+/// Registers `heat` on the app.
+CLI::App* add_heat_command(CLI::App& app, HeatOptions& opts);
+/// Gray-diffuse radiative exchange: T, J, q, Q per patch and surface; 3 if not converged.
+int run_heat(const HeatOptions& opts);
 
 }  // namespace lambert

@@ -18,6 +18,7 @@
 #include "core/memory.hpp"
 #include "geometry/formfactors/media.hpp"
 #include "io/obj_loader.hpp"
+#include "io/stl_loader.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
@@ -199,7 +200,9 @@ void check_job_memory(std::int64_t patches, const JobPlan& plan) {
 }
 
 void add_scene_options(CLI::App* cmd, SceneArgs& args) {
-  cmd->add_option("scene", args.scene, "OBJ scene file (default: the built-in Cornell box)");
+  cmd->add_option(
+      "scene", args.scene,
+      "OBJ or STL scene file, told apart by content (default: the built-in Cornell box)");
   cmd->add_flag("--strict", args.load.strict,
                 "Refuse missing or undefined materials and Kd = 1 instead of defaulting with a warning");
   cmd->add_option_function<std::string>(
@@ -304,7 +307,8 @@ Scene load_scene_file(const SceneArgs& args) {
     if (!why.empty()) throw UsageError("--emit: " + why);
     options.emit.push_back(rule);
   }
-  return load_obj(args.scene.empty() ? builtin_cornell_box_path() : args.scene, nullptr, options);
+  return load_scene_path(args.scene.empty() ? builtin_cornell_box_path() : args.scene, nullptr,
+                         options);
 }
 
 Scene load_checked_scene(const SceneArgs& args, const JobPlan& plan) {

@@ -157,4 +157,10 @@ PlaneFrame plane_frame(const std::vector<Eigen::Vector3d>& poly) {
   return f;
 }
 
+bool is_degenerate_polygon(const std::vector<Eigen::Vector3d>& poly) {
+  if (poly.size() < 3) return true;
+  const double extent = polygon_extent(poly);
+  return polygon_area(poly) <= kDegenerateRelArea * extent * extent;
+}
+
 }  // namespace lambert

@@ -24,6 +24,15 @@ double polygon_area(const std::vector<Eigen::Vector3d>& poly);
 /// vertex mean); 0 for triangles.
 double planarity_deviation(const std::vector<Eigen::Vector3d>& poly);
 
+/// A polygon whose area is below this fraction of its squared extent (bounding-box diagonal)
+/// is degenerate: its normal is not defined to better than ~1e-5 relative in double precision
+/// (the cross product of near-parallel edges loses that many digits), so it cannot be a patch.
+/// The one rule of every scene loader (OBJ, STL).
+constexpr double kDegenerateRelArea = 1e-10;
+
+/// True when the polygon has zero area by kDegenerateRelArea (or fewer than 3 corners).
+bool is_degenerate_polygon(const std::vector<Eigen::Vector3d>& poly);
+
 /// Largest distance between two vertices (O(n^2)).
 double polygon_diameter(const std::vector<Eigen::Vector3d>& poly);
 

@@ -19,10 +19,17 @@
 namespace lambert {
 namespace {
 
-// Vertex channels in the order the layout lists them.
+// Vertex channels in the order the layout lists them (the first three: the value channels,
+// named by ExrInfo::value_channels).
 const char* const kVertexChannels[] = {"R",   "G",   "B",   "P.x", "P.y",
                                        "P.z", "N.x", "N.y", "N.z", "surface"};
 constexpr int kVertexChannelCount = 10;
+
+std::vector<std::string> vertex_channels(const std::array<std::string, 3>& values) {
+  std::vector<std::string> names(kVertexChannels, kVertexChannels + kVertexChannelCount);
+  std::copy(values.begin(), values.end(), names.begin());
+  return names;
+}
 
 const char* const kVertexLayoutText =
     "vertex k at pixel (k mod width, k div width); width = min(vertexCount, 1024); "
@@ -109,13 +116,13 @@ void write_vertex_exr(const std::string& path, const VertexField& field, const E
   const int height = static_cast<int>((n + width - 1) / width);
   const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
   Planes planes;
-  std::vector<std::string> order(kVertexChannels, kVertexChannels + kVertexChannelCount);
+  const std::vector<std::string> order = vertex_channels(info.value_channels);
   for (const auto& name : order) planes[name].assign(count, 0.0f);
   auto& surface = planes["surface"];
   std::fill(surface.begin(), surface.end(), -1.0f);
   for (std::int64_t k = 0; k < n; ++k) {
     for (int c = 0; c < 3; ++c) {
-      planes[kVertexChannels[c]][k] = static_cast<float>(field.values(k, c));
+      planes[order[c]][k] = static_cast<float>(field.values(k, c));
       planes[kVertexChannels[3 + c]][k] = static_cast<float>(field.positions[k][c]);
       planes[kVertexChannels[6 + c]][k] = static_cast<float>(field.normals[k][c]);
     }
@@ -129,8 +136,9 @@ void write_vertex_exr(const std::string& path, const VertexField& field, const E
   write_planes(path, width, height, planes, order, header);
 }
 
-VertexExr read_vertex_exr(const std::string& path) {
-  std::vector<std::string> names(kVertexChannels, kVertexChannels + kVertexChannelCount);
+VertexExr read_vertex_exr(const std::string& path,
+                          const std::array<std::string, 3>& value_channels) {
+  const std::vector<std::string> names = vertex_channels(value_channels);
   VertexExr out;
   Planes planes;
   const Imf::Header header = read_planes(path, names, names, out.width, out.height, planes);
@@ -152,7 +160,7 @@ VertexExr read_vertex_exr(const std::string& path) {
   out.surface.resize(n);
   for (std::int64_t k = 0; k < n; ++k) {
     for (int c = 0; c < 3; ++c) {
-      out.radiosity(k, c) = planes[kVertexChannels[c]][k];
+      out.radiosity(k, c) = planes[names[c]][k];
       out.positions[k][c] = planes[kVertexChannels[3 + c]][k];
       out.normals[k][c] = planes[kVertexChannels[6 + c]][k];
     }

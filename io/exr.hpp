@@ -10,6 +10,7 @@
 // (int), vertexLayout, units, settings, software (strings), surfaceNames (string vector,
 // indexed by surface). ZIP compression, scanlines, increasing Y.
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -27,6 +28,9 @@ struct ExrInfo {
   std::string units;                       ///< what the pixel values mean and their units
   std::string settings;                    ///< the settings that produced the data (one line)
   std::vector<std::string> surface_names;  ///< vertex EXR: surface index -> name
+  /// Vertex EXR: names of the three value channels (radiosity R, G, B; `lambert heat`:
+  /// temperature, heat_flux, radiosity).
+  std::array<std::string, 3> value_channels{"R", "G", "B"};
 };
 
 /// The content of a vertex EXR as read back.
@@ -34,7 +38,7 @@ struct VertexExr {
   int width = 0;
   int height = 0;
   std::int64_t vertex_count = 0;  ///< the vertexCount attribute
-  Eigen::MatrixX3d radiosity;     ///< vertex_count x 3 (R, G, B)
+  Eigen::MatrixX3d radiosity;     ///< vertex_count x 3 (the value channels, R, G, B by default)
   std::vector<Eigen::Vector3d> positions;
   std::vector<Eigen::Vector3d> normals;
   std::vector<std::int32_t> surface;
@@ -46,9 +50,10 @@ struct VertexExr {
 /// Throws IoError on failure.
 void write_vertex_exr(const std::string& path, const VertexField& field, const ExrInfo& info);
 
-/// Reads a vertex EXR written by write_vertex_exr. Throws IoError if unreadable or if a
-/// channel or attribute is missing.
-VertexExr read_vertex_exr(const std::string& path);
+/// Reads a vertex EXR written by write_vertex_exr, its values from `value_channels`. Throws
+/// IoError if unreadable or if a channel or attribute is missing.
+VertexExr read_vertex_exr(const std::string& path,
+                          const std::array<std::string, 3>& value_channels = {"R", "G", "B"});
 
 /// Writes a linear HDR image: FLOAT channels R, G, B (radiance) and A (coverage), with the
 /// units and settings attributes, atomically. Throws IoError.

@@ -28,11 +28,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A face whose area is below this fraction of its squared extent (bounding-box diagonal)
-// is degenerate: its normal is not defined to better than ~1e-5 relative in double
-// precision (the cross product of near-parallel edges loses that many digits), so it
-// cannot be a patch.
-constexpr double kDegenerateRelArea = 1e-10;
 // Vertices farther than this fraction of the polygon extent from its mean plane make it
 // non-planar. Measured geometry is rarely better than 1e-4 relative (the Cornell box's red
 // wall is off by 0.8 mm in 559 mm = 1.4e-3); below it, form factors change by < 1e-4.
@@ -344,7 +339,7 @@ std::map<std::int32_t, std::set<std::int32_t>> build_faces(const ObjData& obj,
     const std::vector<Eigen::Vector3d> poly = collapse_corners(scene.vertices, face, of.vertices);
     const std::set<std::int32_t> distinct(face.vertices.begin(), face.vertices.end());
     const double extent = polygon_extent(poly);
-    if (distinct.size() < 3 || polygon_area(poly) <= kDegenerateRelArea * extent * extent) {
+    if (distinct.size() < 3 || is_degenerate_polygon(poly)) {
       ++report.degenerate_faces_dropped;
       log_debug(where(name, of.line) + ": zero-area face dropped");
       continue;
@@ -595,9 +590,8 @@ void report_coincident(const Scene& scene, const std::string& name, Diagnostics&
   }
 }
 
-// --emit: a rule sets E on the material of every surface it matches by surface or material
-// name; a material also used by surfaces the rule does not match is copied first, as
-// `material@surface`.
+}  // namespace
+
 void apply_emit(const std::vector<EmitRule>& rules, const std::string& name, Scene& scene) {
   auto matches = [](const std::string& pattern, const std::string& s) {
     return fnmatch(pattern.c_str(), s.c_str(), 0) == 0;
@@ -631,8 +625,6 @@ void apply_emit(const std::vector<EmitRule>& rules, const std::string& name, Sce
     }
   }
 }
-
-}  // namespace
 
 std::string builtin_cornell_box_path() {
   if (const char* dir = std::getenv("LAMBERT_DATA_DIR"))
@@ -668,7 +660,7 @@ Scene load_obj_stream(std::istream& in, const std::string& name, const MtlOpener
   report_coincident(scene, name, diag, report);
   apply_emit(options.emit, name, scene);
   for (const auto& s : scene.surfaces) report.has_emitter = report.has_emitter || scene.materials[s.material].emits();
-  if (!report.has_emitter)
+  if (!report.has_emitter && options.warn_without_emitter)
     diag.warn(name + ": no emitter (no material with Ke > 0): the radiosity is zero; add one with "
               "--emit SURFACE_OR_MATERIAL=R,G,B (lambert info lists the names)");
   scene.camera = framing_camera(lo, hi);

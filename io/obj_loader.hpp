@@ -29,6 +29,9 @@ struct LoadOptions {
   /// Each face whose corners all have colours (`v x y z r g b`) gets their mean as its
   /// reflectance (Face::rho) instead of its material's Kd.
   bool vertex_colors_as_reflectance = false;
+  /// Warn when nothing emits (radiosity would be zero); off for `lambert heat`, whose
+  /// sources are temperatures from its surfaces file.
+  bool warn_without_emitter = true;
 };
 
 /// What the loader had to repair, default or skip (each also logged as a warning).
@@ -63,6 +66,12 @@ Scene load_obj(const std::string& path, LoadReport* report = nullptr,
 /// camera sidecar (the camera frames the scene). For tests and fuzzing.
 Scene load_obj_stream(std::istream& obj, const std::string& name, const MtlOpener& open_mtl,
                       LoadReport* report = nullptr, const LoadOptions& options = {});
+
+/// `--emit`: each rule sets E on the material of every surface it matches by surface or
+/// material name (a material also used by surfaces the rule does not match is copied first,
+/// as `material@surface`). Throws UsageError for a rule matching nothing in `name`. Shared by
+/// the OBJ and STL loaders.
+void apply_emit(const std::vector<EmitRule>& rules, const std::string& name, Scene& scene);
 
 /// Path of the built-in Cornell box scene.
 std::string builtin_cornell_box_path();

@@ -10,36 +10,31 @@
 
 namespace lambert {
 
-void write_ply(const std::string& path, const PatchMesh& mesh, const VertexField& field, double ev,
-               const std::string& comment) {
-  LAMBERT_CHECK(
-      field.patch_corners.size() == mesh.patches.size() && field.values.rows() == field.size(),
-      "ply: vertex field does not match the mesh");
+void write_ply_values(const std::string& path, const PatchMesh& mesh, const VertexField& field,
+                      const PlyValues& values) {
+  LAMBERT_CHECK(field.patch_corners.size() == mesh.patches.size() &&
+                    field.values.rows() == field.size() &&
+                    values.colours.size() == static_cast<size_t>(field.size()),
+                "ply: vertex field does not match the mesh");
   write_stream_atomically(path, [&](std::ostream& out) {
     out << "ply\nformat ascii 1.0\n";
     out << "comment written by lambert " << LAMBERT_VERSION << "\n";
-    char buf[256];
-    std::snprintf(buf, sizeof buf,
-                  "comment colours: sRGB OETF of clip(2^EV * B/pi), EV = %.6f (scale %.9g)", ev,
-                  std::exp2(ev));
-    out << buf << "\n";
-    out << "comment radiosity_r/g/b: linear radiosity B, units of the scene's emission E\n";
-    if (!comment.empty()) out << "comment " << comment << "\n";
+    for (const auto& c : values.comments) out << "comment " << c << "\n";
     out << "element vertex " << field.size() << "\n";
     for (const char* p : {"x", "y", "z", "nx", "ny", "nz"}) out << "property float " << p << "\n";
     for (const char* p : {"red", "green", "blue"}) out << "property uchar " << p << "\n";
-    for (const char* p : {"radiosity_r", "radiosity_g", "radiosity_b"})
-      out << "property float " << p << "\n";
+    for (const auto& p : values.names) out << "property float " << p << "\n";
     out << "element face " << mesh.size() << "\n";
     out << "property list uchar int vertex_indices\nend_header\n";
+    char buf[256];
     for (std::int32_t k = 0; k < field.size(); ++k) {
-      const Eigen::Vector3d B = field.values.row(k).transpose();
-      const auto rgb = to_srgb8(B / M_PI, ev);
+      const Eigen::Vector3d v = field.values.row(k).transpose();
+      const auto& rgb = values.colours[k];
       const auto& p = field.positions[k];
       const auto& n = field.normals[k];
       std::snprintf(buf, sizeof buf, "%.9g %.9g %.9g %.6g %.6g %.6g %d %d %d %.9g %.9g %.9g\n",
-                    p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), rgb[0], rgb[1], rgb[2], B[0], B[1],
-                    B[2]);
+                    p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), rgb[0], rgb[1], rgb[2], v[0], v[1],
+                    v[2]);
       out << buf;
     }
     for (std::int32_t i = 0; i < mesh.size(); ++i) {
@@ -49,6 +44,21 @@ void write_ply(const std::string& path, const PatchMesh& mesh, const VertexField
       out << '\n';
     }
   });
+}
+
+void write_ply(const std::string& path, const PatchMesh& mesh, const VertexField& field, double ev,
+               const std::string& comment) {
+  PlyValues values;
+  values.names = {"radiosity_r", "radiosity_g", "radiosity_b"};
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "colours: sRGB OETF of clip(2^EV * B/pi), EV = %.6f (scale %.9g)",
+                ev, std::exp2(ev));
+  values.comments = {buf, "radiosity_r/g/b: linear radiosity B, units of the scene's emission E"};
+  if (!comment.empty()) values.comments.push_back(comment);
+  values.colours.reserve(field.size());
+  for (std::int32_t k = 0; k < field.size(); ++k)
+    values.colours.push_back(to_srgb8(field.values.row(k).transpose() / M_PI, ev));
+  write_ply_values(path, mesh, field, values);
 }
 
 }  // namespace lambert

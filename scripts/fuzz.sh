@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-30}"
 shift || true
 targets=("$@")
-((${#targets[@]})) || targets=(obj_fuzz ff_fuzz csv_fuzz camera_fuzz medium_fuzz)
+((${#targets[@]})) || targets=(obj_fuzz ff_fuzz csv_fuzz camera_fuzz medium_fuzz stl_fuzz)
 
 scripts/setup.sh fuzz >/dev/null
 mkdir -p build-fuzz/crashes

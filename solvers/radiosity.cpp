@@ -121,8 +121,10 @@ void validate_problem(const RadiosityProblem& p) {
       // lossless patches, which the caller rules out (analysis.hpp, find_closed_lossless).
       if (!(p.rho(i, c) >= 0.0 && p.rho(i, c) <= 1.0))
         throw UsageError("patch " + std::to_string(i) + ": rho must be in [0, 1]");
-      if (!(p.emission(i, c) >= 0.0) || !std::isfinite(p.emission(i, c)))
-        throw UsageError("patch " + std::to_string(i) + ": emission must be finite and >= 0");
+      if (!std::isfinite(p.emission(i, c)) || (!p.signed_emission && !(p.emission(i, c) >= 0.0)))
+        throw UsageError("patch " + std::to_string(i) +
+                         std::string(p.signed_emission ? ": emission must be finite"
+                                                       : ": emission must be finite and >= 0"));
     }
   }
 }

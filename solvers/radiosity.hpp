@@ -33,6 +33,9 @@ struct RadiosityProblem {
   /// that arrived and was carried on specularly (counted again further on); empty = none.
   /// The energy balance needs it: row sum − continued is what ends somewhere.
   Eigen::VectorXd continued;
+  /// E may be negative (thermal exchange: a known net flux q < 0 removes heat, thermal.hpp);
+  /// otherwise validate_problem refuses E < 0 (light is never negative).
+  bool signed_emission = false;
 };
 
 /// Solver settings; one stopping rule for all: ||E - K B||_2 / ||E||_2 <= tol.

@@ -1,0 +1,175 @@
+// `lambert heat`: gray-diffuse radiative exchange (solvers/thermal.hpp) on a meshed scene with
+// per-surface conditions from a JSON file (io/heat_surfaces.hpp); CSV, JSON, vertex EXR, PLY
+// and a colour-mapped image.
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <map>
+
+#include "apps/cli.hpp"
+#include "apps/commands.hpp"
+#include "apps/heat_outputs.hpp"
+#include "apps/solve_args.hpp"
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/timer.hpp"
+#include "geometry/formfactors/analysis.hpp"
+#include "io/heat_surfaces.hpp"
+#include "io/json.hpp"
+#include "solvers/thermal.hpp"
+
+namespace lambert {
+namespace {
+
+// Metres per scene unit (--length-unit).
+const std::map<std::string, double>& length_units() {
+  static const std::map<std::string, double> kUnits = {
+      {"m", 1.0}, {"cm", 0.01}, {"mm", 0.001}, {"in", 0.0254}};
+  return kUnits;
+}
+
+// The heat problem on the mesh: per patch ε, the boundary kind and value, areas in m².
+ThermalProblem make_heat_problem(const PatchMesh& mesh, const std::vector<SurfaceCondition>& cond,
+                                 const SparseRowMatrix& F, double metres, double ambient) {
+  ThermalProblem p;
+  const std::int32_t n = mesh.size();
+  p.F = std::make_shared<CsrOperator>(F);
+  p.area.resize(n);
+  p.emissivity.resize(n);
+  p.value.resize(n);
+  p.boundary.resize(n);
+  for (std::int32_t i = 0; i < n; ++i) {
+    const SurfaceCondition& c = cond.at(mesh.patches[i].surface);
+    p.area[i] = mesh.patches[i].area * metres * metres;
+    p.emissivity[i] = c.emissivity;
+    p.value[i] = c.value;
+    p.boundary[i] = c.known_temperature ? ThermalBoundary::Temperature : ThermalBoundary::HeatFlux;
+  }
+  p.ambient_temperature = ambient;
+  return p;
+}
+
+// An enclosure of known-flux (or ε = 0) surfaces from which nothing escapes fixes no
+// temperature level: the system is singular. find_closed_lossless finds such closed sets of
+// ρ = 1 patches within F's error; the patches' ρ is set to the thermal one for it.
+void refuse_floating_enclosure(PatchMesh& mesh, const ThermalProblem& p, const FormFactors& ff,
+                               const std::string& surfaces_file) {
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    const double rho = p.boundary[i] == ThermalBoundary::Temperature ? 1.0 - p.emissivity[i] : 1.0;
+    mesh.patches[i].rho = Eigen::Vector3d::Constant(rho);
+    mesh.patches[i].emission.setZero();
+  }
+  const auto closed = find_closed_lossless(mesh, ff);
+  if (closed.empty()) return;
+  std::string names;
+  for (const auto s : closed.front().surfaces)
+    names += (names.empty() ? "'" : ", '") + mesh.surface_names[s] + "'";
+  throw SceneError(surfaces_file + ": surface(s) " + names +
+                   " enclose a space with known heat flux (or emissivity 0) only and nothing "
+                   "escapes it: no temperature fixes the level (the system is singular); give one "
+                   "of them a temperature, or open the scene with --ambient-temperature");
+}
+
+}  // namespace
+
+CLI::App* add_heat_command(CLI::App& app, HeatOptions& opts) {
+  auto* cmd = app.add_subcommand(
+      "heat", "Gray-diffuse radiative heat exchange: temperatures, net fluxes and powers");
+  opts.scene.default_patches = 2000;
+  opts.scene.load.warn_without_emitter = false;  // heat's sources are temperatures
+  add_scene_options(cmd, opts.scene);
+  add_ff_options(cmd, opts.ff);
+  add_solve_options(cmd, opts.solve, true);
+  cmd->add_option("--surfaces", opts.surfaces,
+                  "JSON file: surface name (or \"*\") -> {\"emissivity\": E, \"temperature\": T} "
+                  "or {\"emissivity\": E, \"heat_flux\": Q}")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--ambient-temperature", opts.ambient_temperature,
+                  "Temperature (K) of the black environment that receives what escapes an "
+                  "open scene (default 0: escaping radiation is lost)")
+      ->check(finite_number(0.0, std::numeric_limits<double>::infinity()));
+  std::vector<std::string> units;
+  for (const auto& [name, m] : length_units()) units.push_back(name);
+  cmd->add_option("--length-unit", opts.length_unit, "Unit of the scene's coordinates")
+      ->check(CLI::IsMember(units))
+      ->capture_default_str();
+  cmd->add_option("-o,--output", opts.output,
+                  "Output prefix: PREFIX_surfaces.csv, PREFIX_patches.csv, PREFIX.json (a "
+                  "folder DIR/ gives DIR/heat_*)")
+      ->check(output_prefix_check())
+      ->capture_default_str();
+  add_heat_output_options(cmd, opts.images);
+  add_run_options(cmd, opts.run);
+  return cmd;
+}
+
+int run_heat(const HeatOptions& opts) {
+  if (opts.solve.ambient)
+    throw UsageError(
+        "--ambient (southwell's display term) does not apply to heat: it would "
+        "change J; --ambient-temperature sets the environment");
+  const Timer total;
+  const std::string prefix = output_prefix(opts.output, "heat");
+  const std::string surfaces_csv = prefix + "_surfaces.csv", patches_csv = prefix + "_patches.csv",
+                    json_path = prefix + ".json";
+  JobPlan plan = job_plan(opts.run);
+  plan.inputs.push_back({"--surfaces", opts.surfaces});
+  plan.outputs = {{"-o", surfaces_csv}, {"-o", patches_csv}, {"-o", json_path}};
+  add_heat_outputs_to_plan(plan, opts.images);
+  plan_form_factors(plan, opts.ff, opts.run);
+  plan.direct = opts.solve.solver == "direct";
+  const SurfaceConditions conditions = read_surface_conditions(opts.surfaces);
+  LoadedScene loaded = load_scene(opts.scene, plan);
+  const std::vector<SurfaceCondition> cond =
+      resolve_surface_conditions(conditions, loaded.mesh.surface_names);
+  const double load_seconds = total.seconds();
+  const double metres = length_units().at(opts.length_unit);
+
+  const Timer ff_timer;
+  const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);
+  const double ff_seconds = ff_timer.seconds();
+  const ThermalProblem problem =
+      make_heat_problem(loaded.mesh, cond, ff.F, metres, opts.ambient_temperature);
+  PatchMesh checked = loaded.mesh;
+  refuse_floating_enclosure(checked, problem, ff, opts.surfaces);
+
+  SolveOptions so = opts.solve;
+  so.threads = opts.run.threads;
+  set_memory_limit(so, opts.run.max_memory);
+  const ThermalSolution sol = solve_thermal(problem, so);
+  std::vector<std::int32_t> surface_of(loaded.mesh.size());
+  for (std::int32_t i = 0; i < loaded.mesh.size(); ++i)
+    surface_of[i] = loaded.mesh.patches[i].surface;
+  const auto surfaces = surface_heat(sol, problem.area, surface_of,
+                                     static_cast<std::int32_t>(loaded.mesh.surface_names.size()));
+  if (sol.undefined_temperatures > 0)
+    log_warn(std::to_string(sol.undefined_temperatures) +
+             " known-flux patch(es) are asked to lose more than they can radiate at 0 K "
+             "(J - (1 - e) H < 0): their temperature is reported as null");
+
+  HeatReport report{&loaded, &problem, &sol, &surfaces, &cond, &ff, &opts, {}};
+  report.timings = {load_seconds, ff_seconds, sol.radiosity.seconds, 0.0};
+  write_heat_surfaces_csv(surfaces_csv, report);
+  write_heat_patches_csv(patches_csv, report);
+  std::vector<std::string> written = {surfaces_csv, patches_csv};
+  const std::vector<std::string> images = write_heat_images(report);
+  written.insert(written.end(), images.begin(), images.end());
+  report.timings.total_seconds = total.seconds();
+  write_json_file(json_path, heat_json(report));
+  written.push_back(json_path);
+
+  print_heat_table(report);
+  for (const auto& f : written) std::printf("wrote %s\n", f.c_str());
+  if (sol.radiosity.status != SolveStatus::Converged) {
+    log_warn("solver " + so.solver + " did not converge (" + to_string(sol.radiosity.status) +
+             "); results were written anyway");
+    return kExitNotConverged;
+  }
+  return kExitOk;
+}
+
+}  // namespace lambert

@@ -1,0 +1,231 @@
+#include "apps/heat_outputs.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "apps/commands.hpp"
+#include "apps/solve_args.hpp"
+#include "core/atomic_file.hpp"
+#include "io/colormap.hpp"
+#include "io/exr.hpp"
+#include "io/ply.hpp"
+
+namespace lambert {
+namespace {
+
+const char* condition_name(const SurfaceCondition& c) {
+  return c.known_temperature ? "temperature" : "heat_flux";
+}
+
+// A number, or null when it is not finite (an undefined temperature).
+Json number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
+
+// The per-vertex field of (T, q, J), interpolated area-weighted (a temperature is no power:
+// the conservative rescale does not apply).
+VertexField heat_vertex_field(const HeatReport& r) {
+  const ThermalSolution& s = *r.solution;
+  Eigen::MatrixX3d values(s.T.size(), 3);
+  values.col(0) = s.T;
+  values.col(1) = s.q;
+  values.col(2) = s.J;
+  return interpolate_to_vertices(r.loaded->mesh, values, parse_vertex_interpolation("area"));
+}
+
+// Range of column `c` of the field's finite values (lo == hi widened so the map is defined).
+std::pair<double, double> value_range(const VertexField& f, int c) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::int32_t k = 0; k < f.size(); ++k) {
+    const double v = f.values(k, c);
+    if (!std::isfinite(v)) continue;
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  if (!(lo <= hi)) lo = hi = 0.0;
+  if (hi == lo) hi = lo + 1.0;
+  return {lo, hi};
+}
+
+double unit_position(double v, std::pair<double, double> range) {
+  return (v - range.first) / (range.second - range.first);
+}
+
+}  // namespace
+
+void add_heat_output_options(CLI::App* cmd, HeatImageArgs& args) {
+  cmd->add_option("--vertex-exr", args.vertex_exr,
+                  "Per-vertex EXR with channels temperature (K), heat_flux (W/m^2), radiosity")
+      ->check(output_file_check());
+  cmd->add_option("--ply", args.ply,
+                  "PLY mesh coloured by --image-quantity, with temperature, heat_flux, radiosity")
+      ->check(output_file_check());
+  cmd->add_option("--image", args.image, "Colour-mapped rendering (PNG) with a legend")
+      ->check(output_file_check());
+  cmd->add_option("--image-quantity", args.quantity, "What --image and --ply colour")
+      ->check(CLI::IsMember({"temperature", "flux"}))
+      ->capture_default_str();
+  add_camera_options(cmd, args.camera);
+}
+
+void add_heat_outputs_to_plan(JobPlan& plan, const HeatImageArgs& args) {
+  plan.outputs.push_back({"--vertex-exr", args.vertex_exr});
+  plan.outputs.push_back({"--ply", args.ply});
+  plan.outputs.push_back({"--image", args.image});
+}
+
+void write_heat_surfaces_csv(const std::string& path, const HeatReport& r) {
+  const auto& names = r.loaded->mesh.surface_names;
+  write_stream_atomically(path, [&](std::ostream& out) {
+    out << "surface,emissivity,condition,given,area_m2,patches,T_mean_K,T_min_K,T_max_K,J_W_m2,"
+           "q_W_m2,Q_W\n";
+    for (size_t s = 0; s < names.size(); ++s) {
+      const SurfaceHeat& h = (*r.surfaces)[s];
+      const SurfaceCondition& c = (*r.conditions)[s];
+      out << csv_field(names[s]) << ',' << csv_number(c.emissivity) << ',' << condition_name(c)
+          << ',' << csv_number(c.value) << ',' << csv_number(h.area) << ',' << h.patches << ','
+          << csv_number(h.T) << ',' << csv_number(h.T_min) << ',' << csv_number(h.T_max) << ','
+          << csv_number(h.J) << ',' << csv_number(h.q) << ',' << csv_number(h.Q) << '\n';
+    }
+    out << "environment,,,,,,,,,,," << csv_number(r.solution->environment_power) << '\n';
+  });
+}
+
+void write_heat_patches_csv(const std::string& path, const HeatReport& r) {
+  const PatchMesh& mesh = r.loaded->mesh;
+  const ThermalSolution& s = *r.solution;
+  write_stream_atomically(path, [&](std::ostream& out) {
+    out << "patch,surface,area_m2,emissivity,T_K,J_W_m2,H_W_m2,q_W_m2,Q_W\n";
+    for (std::int32_t i = 0; i < mesh.size(); ++i)
+      out << i << ',' << csv_field(mesh.surface_names[mesh.patches[i].surface]) << ','
+          << csv_number(r.problem->area[i]) << ',' << csv_number(r.problem->emissivity[i]) << ','
+          << csv_number(s.T[i]) << ',' << csv_number(s.J[i]) << ',' << csv_number(s.H[i]) << ','
+          << csv_number(s.q[i]) << ',' << csv_number(s.Q[i]) << '\n';
+  });
+}
+
+Json heat_json(const HeatReport& r) {
+  const HeatOptions& o = *r.options;
+  const ThermalSolution& s = *r.solution;
+  const ChannelReport& ch = s.radiosity.channels[0];
+  Json surfaces = Json::array();
+  const auto& names = r.loaded->mesh.surface_names;
+  for (size_t k = 0; k < names.size(); ++k) {
+    const SurfaceHeat& h = (*r.surfaces)[k];
+    const SurfaceCondition& c = (*r.conditions)[k];
+    surfaces.push_back({{"name", names[k]},
+                        {"emissivity", c.emissivity},
+                        {"condition", condition_name(c)},
+                        {"given", c.value},
+                        {"area_m2", h.area},
+                        {"patches", h.patches},
+                        {"temperature_K", number_or_null(h.T)},
+                        {"temperature_min_K", number_or_null(h.T_min)},
+                        {"temperature_max_K", number_or_null(h.T_max)},
+                        {"radiosity_W_m2", h.J},
+                        {"heat_flux_W_m2", h.q},
+                        {"power_W", h.Q}});
+  }
+  double surface_sum = 0.0;
+  for (const auto& h : *r.surfaces) surface_sum += h.Q;
+  return Json{{"scene", r.loaded->scene.source},
+              {"surfaces_file", o.surfaces},
+              {"patches", r.loaded->mesh.size()},
+              {"settings",
+               {{"length_unit", o.length_unit},
+                {"ambient_temperature_K", r.problem->ambient_temperature},
+                {"stefan_boltzmann", kStefanBoltzmann},
+                {"solver", o.solve.solver},
+                {"tol", o.solve.tol},
+                {"max_iterations", o.solve.max_iterations},
+                {"form_factors", ff_settings_json(r.ff->options, o.ff.ff_file)}}},
+              {"status", to_string(s.radiosity.status)},
+              {"iterations", ch.iterations},
+              {"residual", ch.residual},
+              {"closure",
+               {{"surfaces_W", surface_sum},
+                {"environment_W", s.environment_power},
+                {"sum_W", s.closure},
+                {"max_flux_mismatch_W_m2", s.max_flux_mismatch}}},
+              {"undefined_temperatures", s.undefined_temperatures},
+              {"surfaces", surfaces},
+              {"timings",
+               {{"load_and_mesh_seconds", r.timings.load_seconds},
+                {"form_factors_seconds", r.timings.form_factors_seconds},
+                {"solve_seconds", r.timings.solve_seconds},
+                {"total_seconds", r.timings.total_seconds}}}};
+}
+
+void print_heat_table(const HeatReport& r) {
+  const ThermalSolution& s = *r.solution;
+  const ChannelReport& ch = s.radiosity.channels[0];
+  std::printf("heat: %d patches, solver %s: %s, %d iterations, residual %.3e\n",
+              r.loaded->mesh.size(), r.options->solve.solver.c_str(), to_string(s.radiosity.status),
+              ch.iterations, ch.residual);
+  std::printf("%-24s %6s %-11s %12s %10s %10s %12s %14s\n", "surface", "eps", "condition",
+              "area [m2]", "T [K]", "J [W/m2]", "q [W/m2]", "Q [W]");
+  const auto& names = r.loaded->mesh.surface_names;
+  for (size_t k = 0; k < names.size(); ++k) {
+    const SurfaceHeat& h = (*r.surfaces)[k];
+    const SurfaceCondition& c = (*r.conditions)[k];
+    std::printf("%-24s %6.3f %-11s %12.6g %10.6g %10.6g %12.6g %14.8g\n", names[k].c_str(),
+                c.emissivity, condition_name(c), h.area, h.T, h.J, h.q, h.Q);
+  }
+  std::printf("%-24s %6s %-11s %12s %10s %10s %12s %14.8g\n", "environment", "", "", "", "", "", "",
+              s.environment_power);
+  std::printf("closure: sum of Q + environment = %.3e W\n", s.closure);
+}
+
+std::vector<std::string> write_heat_images(const HeatReport& r) {
+  const HeatImageArgs& a = r.options->images;
+  std::vector<std::string> written;
+  if (a.vertex_exr.empty() && a.ply.empty() && a.image.empty()) return written;
+  const VertexField field = heat_vertex_field(r);
+  const int column = a.quantity == "temperature" ? 0 : 1;
+  const auto range = value_range(field, column);
+  const std::string title = column == 0 ? "T [K]" : "q [W/m2]";
+  if (!a.vertex_exr.empty()) {
+    ExrInfo info;
+    info.units = "temperature K, heat_flux W/m^2 (net, leaving), radiosity W/m^2";
+    info.settings = "lambert heat --surfaces " + r.options->surfaces;
+    info.surface_names = r.loaded->mesh.surface_names;
+    info.value_channels = {"temperature", "heat_flux", "radiosity"};
+    write_vertex_exr(a.vertex_exr, field, info);
+    written.push_back(a.vertex_exr);
+  }
+  if (!a.ply.empty()) {
+    PlyValues values;
+    values.names = {"temperature", "heat_flux", "radiosity"};
+    values.comments = {"colours: viridis of " + title + " from " + std::to_string(range.first) +
+                           " to " + std::to_string(range.second),
+                       "temperature K, heat_flux W/m^2 (net, leaving), radiosity W/m^2"};
+    for (std::int32_t k = 0; k < field.size(); ++k)
+      values.colours.push_back(colormap_srgb8(unit_position(field.values(k, column), range)));
+    write_ply_values(a.ply, r.loaded->mesh, field, values);
+    written.push_back(a.ply);
+  }
+  if (!a.image.empty()) {
+    // Colours rendered as radiance: the renderer shows B/π, so B = π × the linear colour
+    // comes back as the map's byte colour at EV 0.
+    VertexField colours = field;
+    for (std::int32_t k = 0; k < field.size(); ++k)
+      colours.values.row(k) =
+          M_PI * srgb8_to_linear(colormap_srgb8(unit_position(field.values(k, column), range)))
+                     .transpose();
+    const PatchMesh& mesh = r.loaded->mesh;
+    Eigen::MatrixX3d patch_colour(mesh.size(), 3);
+    const Eigen::VectorXd& v = column == 0 ? r.solution->T : r.solution->q;
+    for (std::int32_t i = 0; i < mesh.size(); ++i)
+      patch_colour.row(i) =
+          M_PI * srgb8_to_linear(colormap_srgb8(unit_position(v[i], range))).transpose();
+    ShadeArgs shade;
+    shade.exposure = "0";
+    const Camera camera = make_camera(r.loaded->scene, a.camera);
+    const Image image =
+        render_scene(*r.loaded, patch_colour, colours, camera, shade, 0, r.options->run, nullptr);
+    write_png_with_legend(a.image, image, range.first, range.second, title);
+    written.push_back(a.image);
+  }
+  return written;
+}
+
+}  // namespace lambert

@@ -1,0 +1,63 @@
+#pragma once
+// The files and the table `lambert heat` writes: per-surface and per-patch CSV, the JSON
+// summary, the per-vertex EXR and PLY (temperature, heat flux, radiosity) and the
+// colour-mapped image with its legend.
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+#include "apps/common.hpp"
+#include "apps/render_stages.hpp"
+#include "io/heat_surfaces.hpp"
+#include "io/json.hpp"
+#include "solvers/thermal.hpp"
+
+namespace lambert {
+
+struct HeatOptions;
+
+/// --vertex-exr, --ply, --image, --image-quantity and the camera options of `heat`.
+struct HeatImageArgs {
+  std::string vertex_exr;                ///< channels temperature, heat_flux, radiosity
+  std::string ply;                       ///< coloured by --image-quantity
+  std::string image;                     ///< colour-mapped PNG with a legend
+  std::string quantity = "temperature";  ///< temperature or flux
+  CameraArgs camera;
+};
+/// Adds the image and per-vertex output options to `heat`.
+void add_heat_output_options(CLI::App* cmd, HeatImageArgs& args);
+/// Adds those outputs to the job plan (collision and folder checks).
+void add_heat_outputs_to_plan(JobPlan& plan, const HeatImageArgs& args);
+
+/// Seconds spent per stage.
+struct HeatTimings {
+  double load_seconds = 0.0, form_factors_seconds = 0.0, solve_seconds = 0.0, total_seconds = 0.0;
+};
+
+/// Everything a heat report reads (not owned).
+struct HeatReport {
+  const LoadedScene* loaded = nullptr;
+  const ThermalProblem* problem = nullptr;
+  const ThermalSolution* solution = nullptr;
+  const std::vector<SurfaceHeat>* surfaces = nullptr;
+  const std::vector<SurfaceCondition>* conditions = nullptr;  ///< per surface
+  const FormFactors* ff = nullptr;
+  const HeatOptions* options = nullptr;
+  HeatTimings timings;
+};
+
+/// surface,emissivity,condition,given,area_m2,patches,T_mean_K,T_min_K,T_max_K,J_W_m2,
+/// q_W_m2,Q_W — one row per surface, then an `environment` row (Q only), atomically.
+void write_heat_surfaces_csv(const std::string& path, const HeatReport& r);
+/// patch,surface,area_m2,emissivity,T_K,J_W_m2,H_W_m2,q_W_m2,Q_W, atomically.
+void write_heat_patches_csv(const std::string& path, const HeatReport& r);
+/// The JSON summary: settings (scene, surfaces file, length unit, ambient, σ, form factors,
+/// solver), status, closure, environment, per-surface results, timings.
+Json heat_json(const HeatReport& r);
+/// The per-surface table and the closure on stdout.
+void print_heat_table(const HeatReport& r);
+/// Writes --vertex-exr, --ply and --image when asked; returns the paths written.
+std::vector<std::string> write_heat_images(const HeatReport& r);
+
+}  // namespace lambert
