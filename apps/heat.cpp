@@ -11,6 +11,7 @@
 #include "apps/cli.hpp"
 #include "apps/commands.hpp"
 #include "apps/heat_outputs.hpp"
+#include "apps/heat_problem.hpp"
 #include "apps/solve_args.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -22,16 +23,22 @@
 #include "solvers/thermal.hpp"
 
 namespace lambert {
-namespace {
 
-// Metres per scene unit (--length-unit).
-const std::map<std::string, double>& length_units() {
-  static const std::map<std::string, double> kUnits = {
-      {"m", 1.0}, {"cm", 0.01}, {"mm", 0.001}, {"in", 0.0254}};
+const std::vector<std::pair<std::string, double>>& length_units() {
+  static const std::vector<std::pair<std::string, double>> kUnits = {
+      {"cm", 0.01}, {"in", 0.0254}, {"m", 1.0}, {"mm", 0.001}};
   return kUnits;
 }
 
-// The heat problem on the mesh: per patch ε, the boundary kind and value, areas in m².
+double metres_per_unit(const std::string& unit) {
+  std::string names;
+  for (const auto& [name, metres] : length_units()) {
+    if (name == unit) return metres;
+    names += (names.empty() ? "" : ", ") + name;
+  }
+  throw UsageError("unknown length unit \"" + unit + "\" (one of " + names + ")");
+}
+
 ThermalProblem make_heat_problem(const PatchMesh& mesh, const std::vector<SurfaceCondition>& cond,
                                  const SparseRowMatrix& F, double metres, double ambient) {
   ThermalProblem p;
@@ -55,8 +62,9 @@ ThermalProblem make_heat_problem(const PatchMesh& mesh, const std::vector<Surfac
 // An enclosure of known-flux (or ε = 0) surfaces from which nothing escapes fixes no
 // temperature level: the system is singular. find_closed_lossless finds such closed sets of
 // ρ = 1 patches within F's error; the patches' ρ is set to the thermal one for it.
-void refuse_floating_enclosure(PatchMesh& mesh, const ThermalProblem& p, const FormFactors& ff,
-                               const std::string& surfaces_file) {
+void refuse_floating_enclosure(const PatchMesh& original, const ThermalProblem& p,
+                               const FormFactors& ff, const std::string& surfaces_file) {
+  PatchMesh mesh = original;
   for (std::int32_t i = 0; i < mesh.size(); ++i) {
     const double rho = p.boundary[i] == ThermalBoundary::Temperature ? 1.0 - p.emissivity[i] : 1.0;
     mesh.patches[i].rho = Eigen::Vector3d::Constant(rho);
@@ -72,8 +80,6 @@ void refuse_floating_enclosure(PatchMesh& mesh, const ThermalProblem& p, const F
                    "escapes it: no temperature fixes the level (the system is singular); give one "
                    "of them a temperature, or open the scene with --ambient-temperature");
 }
-
-}  // namespace
 
 CLI::App* add_heat_command(CLI::App& app, HeatOptions& opts) {
   auto* cmd = app.add_subcommand(
@@ -127,15 +133,14 @@ int run_heat(const HeatOptions& opts) {
   const std::vector<SurfaceCondition> cond =
       resolve_surface_conditions(conditions, loaded.mesh.surface_names);
   const double load_seconds = total.seconds();
-  const double metres = length_units().at(opts.length_unit);
+  const double metres = metres_per_unit(opts.length_unit);
 
   const Timer ff_timer;
   const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);
   const double ff_seconds = ff_timer.seconds();
   const ThermalProblem problem =
       make_heat_problem(loaded.mesh, cond, ff.F, metres, opts.ambient_temperature);
-  PatchMesh checked = loaded.mesh;
-  refuse_floating_enclosure(checked, problem, ff, opts.surfaces);
+  refuse_floating_enclosure(loaded.mesh, problem, ff, opts.surfaces);
 
   SolveOptions so = opts.solve;
   so.threads = opts.run.threads;

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "apps/common.hpp"
+#include "apps/heat_problem.hpp"
 #include "apps/hierarchical_stage.hpp"
 #include "apps/medium_stage.hpp"
 #include "apps/problem.hpp"
@@ -38,8 +39,10 @@
 #include "geometry/vertex_field.hpp"
 #include "io/exr.hpp"
 #include "io/ff_file.hpp"
+#include "io/heat_surfaces.hpp"
 #include "io/json.hpp"
 #include "io/obj_loader.hpp"
+#include "io/stl_loader.hpp"
 #include "io/tonemap.hpp"
 #include "solvers/radiosity.hpp"
 
@@ -292,6 +295,18 @@ Shading parse_shading(const std::string& s) {
   throw UsageError("shading must be \"gouraud\" or \"flat\", got \"" + s + "\"");
 }
 
+// UsageError for an unknown solver, tol outside (0, 1) or max_iterations < 1.
+void check_solver_args(const std::string& solver, double tol, int max_iterations) {
+  const auto names = solver_names();
+  if (std::find(names.begin(), names.end(), solver) == names.end()) {
+    std::string list;
+    for (const auto& s : names) list += (list.empty() ? "" : ", ") + s;
+    throw UsageError("unknown solver \"" + solver + "\" (one of " + list + ")");
+  }
+  if (!(tol > 0.0 && tol < 1.0)) throw UsageError("tol must be in (0, 1)");
+  if (max_iterations < 1) throw UsageError("max_iterations must be >= 1");
+}
+
 }  // namespace
 }  // namespace lambert
 
@@ -392,7 +407,7 @@ PYBIND11_MODULE(_lambert, m) {
         o.strict = strict;
         for (const auto& [pattern, e] : emit) o.emit.push_back({pattern, vec3(e, "an emit value")});
         py::gil_scoped_release release;
-        return std::make_shared<Scene>(load_obj(path, nullptr, o));
+        return std::make_shared<Scene>(load_scene_path(path, nullptr, o));
       },
       py::arg("path"), py::arg("strict") = false,
       py::arg("emit") = std::vector<std::pair<std::string, std::vector<double>>>{});
@@ -562,14 +577,7 @@ PYBIND11_MODULE(_lambert, m) {
          const ValueArray& data, const std::string& solver, double tol, int max_iterations,
          double omega, const std::string& preconditioner, int restart, int threads,
          std::optional<ValueArray> initial, const py::dict& medium_options) {
-        const auto names = solver_names();
-        if (std::find(names.begin(), names.end(), solver) == names.end()) {
-          std::string list;
-          for (const auto& s : names) list += (list.empty() ? "" : ", ") + s;
-          throw UsageError("unknown solver \"" + solver + "\" (one of " + list + ")");
-        }
-        if (!(tol > 0.0 && tol < 1.0)) throw UsageError("tol must be in (0, 1)");
-        if (max_iterations < 1) throw UsageError("max_iterations must be >= 1");
+        check_solver_args(solver, tol, max_iterations);
         const SparseRowMatrix F = csr_from_arrays(h.mesh.size(), indptr, indices, data, "F");
         SolveOptions o;
         o.solver = solver;
@@ -615,6 +623,74 @@ PYBIND11_MODULE(_lambert, m) {
       py::arg("mesh"), py::arg("indptr"), py::arg("indices"), py::arg("data"), py::arg("solver"),
       py::arg("tol"), py::arg("max_iterations"), py::arg("omega"), py::arg("preconditioner"),
       py::arg("restart"), py::arg("threads"), py::arg("initial_guess"), py::arg("medium"));
+
+  m.def(
+      "heat",
+      [](const MeshHandle& h, const IndexArray& indptr, const IndexArray& indices,
+         const ValueArray& data, const std::string& surfaces_json, double ambient,
+         const std::string& unit, const std::string& solver, double tol, int max_iterations,
+         int threads) {
+        check_solver_args(solver, tol, max_iterations);
+        if (!(ambient >= 0.0) || !std::isfinite(ambient))
+          throw UsageError("ambient_temperature must be finite and >= 0 K");
+        const double metres = metres_per_unit(unit);
+        // The same path as `lambert heat`: conditions resolved per surface, the problem on
+        // the patches, the floating-enclosure refusal, then the solve.
+        const std::vector<SurfaceCondition> cond = resolve_surface_conditions(
+            parse_surface_conditions(surfaces_json, "surfaces"), h.mesh.surface_names);
+        FormFactors ff;
+        ff.F = csr_from_arrays(h.mesh.size(), indptr, indices, data, "F");
+        const ThermalProblem problem = make_heat_problem(h.mesh, cond, ff.F, metres, ambient);
+        refuse_floating_enclosure(h.mesh, problem, ff, "surfaces");
+        SolveOptions o;
+        o.solver = solver;
+        o.tol = tol;
+        o.max_iterations = max_iterations;
+        o.threads = threads;
+        ThermalSolution sol;
+        {
+          py::gil_scoped_release release;
+          sol = solve_thermal(problem, o);
+        }
+        std::vector<std::int32_t> surface_of(h.mesh.size());
+        for (std::int32_t i = 0; i < h.mesh.size(); ++i) surface_of[i] = h.mesh.patches[i].surface;
+        const auto per_surface = surface_heat(
+            sol, problem.area, surface_of, static_cast<std::int32_t>(h.mesh.surface_names.size()));
+        const auto vec = [](const Eigen::VectorXd& v) {
+          return adopt(std::vector<double>(v.data(), v.data() + v.size()), {v.size()});
+        };
+        py::list surfaces;
+        for (size_t k = 0; k < per_surface.size(); ++k) {
+          const SurfaceHeat& sh = per_surface[k];
+          py::dict d;
+          d["name"] = h.mesh.surface_names[k];
+          d["area"] = sh.area;
+          d["patches"] = sh.patches;
+          d["T"] = sh.T;
+          d["T_min"] = sh.T_min;
+          d["T_max"] = sh.T_max;
+          d["J"] = sh.J;
+          d["q"] = sh.q;
+          d["Q"] = sh.Q;
+          surfaces.append(d);
+        }
+        py::dict out = report_dict(sol.radiosity);
+        out["T"] = vec(sol.T);
+        out["J"] = vec(sol.J);
+        out["H"] = vec(sol.H);
+        out["q"] = vec(sol.q);
+        out["Q"] = vec(sol.Q);
+        out["area_m2"] = vec(problem.area);
+        out["surfaces"] = surfaces;
+        out["environment_power"] = sol.environment_power;
+        out["closure"] = sol.closure;
+        out["max_flux_mismatch"] = sol.max_flux_mismatch;
+        out["undefined_temperatures"] = sol.undefined_temperatures;
+        return out;
+      },
+      py::arg("mesh"), py::arg("indptr"), py::arg("indices"), py::arg("data"),
+      py::arg("surfaces_json"), py::arg("ambient_temperature"), py::arg("length_unit"),
+      py::arg("solver"), py::arg("tol"), py::arg("max_iterations"), py::arg("threads"));
 
   m.def(
       "solve_hierarchical",

@@ -24,7 +24,7 @@ from ._lambert import Error, InputError, UsageError, Mesh, Scene, VertexField  #
 
 __all__ = [
     "Error", "InputError", "UsageError", "Scene", "Mesh", "VertexField", "load_scene",
-    "form_factors", "save_form_factors", "load_form_factors", "solve", "solve_hierarchical",
+    "form_factors", "save_form_factors", "load_form_factors", "solve", "solve_hierarchical", "heat",
     "vertex_radiosity",
     "write_vertex_exr", "render", "estimators", "solvers", "set_verbosity",
 ]
@@ -35,7 +35,8 @@ set_verbosity = _lambert.set_verbosity
 
 
 def load_scene(path=None, strict=False, emit=None):
-    """Loads an OBJ scene (None: the built-in Cornell box). `emit` maps a surface or material
+    """Loads an OBJ or STL scene, told apart by content (None: the built-in Cornell box).
+    `emit` maps a surface or material
     glob to an emission (R, G, B), as the CLI's --emit. Raises InputError for a bad file."""
     if path is None:
         path = _lambert.builtin_cornell_box_path()
@@ -130,6 +131,27 @@ def solve(mesh, F, solver="gauss-seidel", tol=1e-8, max_iterations=10000, omega=
                           _int(max_iterations, "max_iterations"), float(omega),
                           str(preconditioner), _int(restart, "restart"), _int(threads, "threads"),
                           initial_guess, medium)
+
+
+def heat(mesh, F, surfaces, ambient_temperature=0.0, length_unit="m", solver="gauss-seidel",
+         tol=1e-8, max_iterations=10000, threads=1):
+    """The CLI's `lambert heat` on a mesh and its view factors F: gray-diffuse radiative
+    exchange. `surfaces` maps surface names (or "*") to {"emissivity": e, "temperature": T}
+    (kelvin) or {"emissivity": e, "heat_flux": q} (W/m^2), as the --surfaces file;
+    `length_unit` ("m", "cm", "mm", "in") the mesh's unit. Returns a dict: per patch T (K), J,
+    H, q (W/m^2), Q (W) and area_m2 arrays; `surfaces` (name, area, T, T_min, T_max, J, q, Q);
+    environment_power, closure (sum of Q + environment power: ~0), and the solver's report
+    (status, iterations, residual, ...). Bad conditions raise InputError (naming the surface),
+    bad arguments UsageError."""
+    import json
+    _check_mesh(mesh)
+    if not isinstance(surfaces, dict):
+        raise TypeError(f"surfaces must be a dict of surface name -> condition, got "
+                        f"{type(surfaces).__name__}")
+    indptr, indices, data = _csr_arrays(F, mesh, "F")
+    return _lambert.heat(mesh, indptr, indices, data, json.dumps(surfaces),
+                         float(ambient_temperature), str(length_unit), str(solver), float(tol),
+                         _int(max_iterations, "max_iterations"), _int(threads, "threads"))
 
 
 def solve_hierarchical(scene, epsilon=1e-4, min_area=0.0, link_rays=16, tol=1e-6,

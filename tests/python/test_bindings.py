@@ -267,3 +267,66 @@ def test_long_calls_release_the_gil(cornell):
     # interpreter only before and after); released, it ticks about once a millisecond
     # (a 20th of that on a loaded machine still passes).
     assert seconds < 0.05 or ticks[0] >= 50 * seconds, (ticks[0], seconds)
+
+
+def test_heat_equals_the_cli_on_the_stl_example(tmp_path):
+    """lambert.heat on the STL worked example gives the CLI's per-patch Q bit for bit (the
+    same F: form_factors equals the CLI's; the same system and solver), and the closure
+    (sum of Q + environment power) is at rounding level."""
+    root = os.path.join(os.path.dirname(__file__), "..", "..", "data", "thermal_box")
+    stl = os.path.join(root, "thermal_box.stl")
+    conditions = {"heater": {"emissivity": 0.9, "temperature": 800},
+                  "cold_plate": {"emissivity": 0.8, "temperature": 300},
+                  "walls": {"emissivity": 0.5, "heat_flux": 0}}
+    surfaces_file = tmp_path / "surfaces.json"
+    import json
+    surfaces_file.write_text(json.dumps(conditions))
+    run_cli("heat", stl, "--surfaces", surfaces_file, "--length-unit", "mm", "--patches", 200,
+            "--estimator", "hybrid", "--samples", 8, "--seed", 5, "--tol", 1e-10, "-q",
+            "-o", tmp_path / "h")
+    scene = lambert.load_scene(stl)  # an STL, told apart by content
+    assert sorted(scene.surfaces) == ["cold_plate", "heater", "walls"]
+    mesh = scene.mesh(patches=200)
+    F = lambert.form_factors(mesh, estimator="hybrid", samples=8, seed=5)
+    r = lambert.heat(mesh, F, conditions, length_unit="mm", tol=1e-10)
+    assert r["status"] == "converged"
+    import csv
+    with open(tmp_path / "h_patches.csv") as f:
+        cli_Q = np.array([float(row["Q_W"]) for row in csv.DictReader(f)])
+    # The CSV holds 17 significant digits: a double read back is the double written.
+    assert np.array_equal(r["Q"], cli_Q)
+    # Closure: with a reciprocal F (hybrid is a pair estimator) sum Q + environment = 0
+    # identically; summing ~200 terms of up to ~10 kW rounds at 1e-16 * 200 * 1e4 ~ 2e-10 W.
+    total = sum(abs(q) for q in r["Q"])
+    assert abs(r["closure"]) <= 1e-12 * total
+    by_name = {s["name"]: s for s in r["surfaces"]}
+    assert by_name["heater"]["Q"] > 0 > by_name["cold_plate"]["Q"]
+    # The re-radiating walls: q = 0 to the solver's tolerance, T between the two plates'.
+    assert abs(by_name["walls"]["Q"]) <= 1e-6 * by_name["heater"]["Q"]
+    assert 300 < by_name["walls"]["T"] < 800
+    with pytest.raises(lambert.InputError):  # a surface the scene does not have
+        lambert.heat(mesh, F, {"floor": {"emissivity": 0.5, "temperature": 300}})
+    with pytest.raises(lambert.UsageError):
+        lambert.heat(mesh, F, conditions, length_unit="furlong")
+    with pytest.raises(TypeError):
+        lambert.heat(mesh, F, [("heater", 800)])
+
+
+def test_heat_isothermal_enclosure_has_no_net_flux(tmp_path):
+    """Every surface of a closed cube at the same T: J* = sigma T^4 solves the system when the
+    rows of F sum to 1, so every q = J - H is 0 up to F's and the solver's errors. Rows of the
+    analytic F are off by at most n tol_f; the solve's |J - J*| <= (n tol_f sigma T^4 + tol
+    ||E||_2) / (1 - rho) (||K^-1|| <= 1/(1 - rho), ||E||_2 <= sqrt(n) sigma T^4), and H = F J
+    adds as much again plus the row error itself: |q| <= 4 (n tol_f + tol sqrt(n)) sigma T^4 /
+    (1 - rho)."""
+    faces = cube_faces()
+    mesh = lambert.load_scene(write_obj(tmp_path / "cube.obj", faces)).mesh(max_edge=0.5)
+    n = len(mesh)
+    tol_f, tol, eps, T = 1e-9, 1e-12, 0.7, 500.0
+    F = lambert.form_factors(mesh, estimator="analytic", tol=tol_f)
+    r = lambert.heat(mesh, F, {"*": {"emissivity": eps, "temperature": T}}, tol=tol)
+    sigma_t4 = 5.670374419e-8 * T ** 4
+    bound = 4 * (n * tol_f + tol * math.sqrt(n)) * sigma_t4 / eps
+    assert r["status"] == "converged"
+    assert np.abs(r["q"]).max() <= bound
+    assert np.abs(r["J"] - sigma_t4).max() <= bound
