@@ -5,6 +5,7 @@
 
 #include "apps/adapt_stage.hpp"
 #include "apps/common.hpp"
+#include "apps/distributed.hpp"
 #include "apps/ff_args.hpp"
 #include "apps/medium_stage.hpp"
 #include "apps/method.hpp"
@@ -35,6 +36,7 @@ struct FormFactorsOptions {
   bool by_surface = false;
   std::vector<double> point, normal;  ///< sensor point and normal (3 each) or empty
   std::string precision = "double";   ///< --ff-precision: "double" or "float" (saved values)
+  DistributedArgs dist;               ///< --distributed
 };
 /// Registers `formfactors` on the app.
 CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts);
@@ -51,6 +53,7 @@ struct SolveCommandOptions {
   AdaptArgs adapt;
   MediumArgs medium;                     ///< participating medium (matrix method)
   std::string output = "radiosity.csv";  ///< per-patch CSV; summary JSON beside it
+  DistributedArgs dist;                  ///< --distributed, --petsc-options
 };
 /// Registers `solve` on the app.
 CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts);

@@ -3,7 +3,9 @@
 #include <iostream>
 #include <sstream>
 
+#include "apps/command_outputs.hpp"
 #include "apps/commands.hpp"
+#include "apps/distributed.hpp"
 #include "apps/ff_args.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -145,18 +147,50 @@ CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts) {
   pt->needs(nm);
   nm->needs(pt);
   pt->excludes(by);
+  add_distributed_options(cmd, opts.dist, false);
   return cmd;
 }
 
+void write_formfactors_outputs(const FormFactorsOptions& opts, const LoadedScene& scene,
+                               const FormFactors& ff, const std::string& report,
+                               const Json& distributed) {
+  namespace fs = std::filesystem;
+  warn_about_lighting(scene.mesh, ff.F);
+  check_closed_lossless(scene.mesh, ff, false);
+  const FormFactorDiagnostics d = diagnose(scene.mesh, ff.F);
+  print_diagnostics(scene, ff, d);
+  const std::string settings = settings_string(ff.options, scene);
+  const std::string ext = fs::path(opts.output).extension().string();
+  const ValuePrecision precision =
+      opts.precision == "float" ? ValuePrecision::Float : ValuePrecision::Double;
+  if (opts.by_surface) {
+    write_json_file(opts.output, surface_json(surface_factors(scene.mesh, ff)));
+  } else if (ext == ".mtx") {
+    write_matrix_market(opts.output, ff.F, {mesh_hash(scene.mesh), settings}, precision);
+  } else {
+    write_ff_binary(opts.output, ff, {mesh_hash(scene.mesh), settings}, precision);
+  }
+  log_info("wrote " + opts.output);
+  Json j = diagnostics_json(scene, ff, d, settings);
+  if (!distributed.is_null()) j["distributed"] = distributed;
+  write_json_file(report, j);
+  log_info("wrote " + report);
+}
+
+std::string formfactors_report_path(const FormFactorsOptions& opts) {
+  namespace fs = std::filesystem;
+  return !opts.report.empty() || opts.output.empty()
+             ? opts.report
+             : fs::path(opts.output).replace_extension(".report.json").string();
+}
+
 int run_formfactors(const FormFactorsOptions& opts) {
+  if (opts.dist.enabled) return run_formfactors_distributed(opts);
   apply_run_options(opts.run);
   namespace fs = std::filesystem;
   if (opts.output.empty() && opts.point.empty())
     throw UsageError("formfactors: -o/--output is required");
-  const std::string report =
-      !opts.report.empty() || opts.output.empty()
-          ? opts.report
-          : fs::path(opts.output).replace_extension(".report.json").string();
+  const std::string report = formfactors_report_path(opts);
   JobPlan plan = job_plan(opts.run);
   plan.outputs = {{"-o", opts.output}};
   if (opts.point.empty()) {
@@ -185,24 +219,7 @@ int run_formfactors(const FormFactorsOptions& opts) {
     return 0;
   }
   const FormFactors ff = obtain_form_factors(scene, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
-  warn_about_lighting(scene.mesh, ff.F);
-  check_closed_lossless(scene.mesh, ff, false);
-  const FormFactorDiagnostics d = diagnose(scene.mesh, ff.F);
-  print_diagnostics(scene, ff, d);
-  const std::string settings = settings_string(ff.options, scene);
-  const std::string ext = fs::path(opts.output).extension().string();
-  const ValuePrecision precision =
-      opts.precision == "float" ? ValuePrecision::Float : ValuePrecision::Double;
-  if (opts.by_surface) {
-    write_json_file(opts.output, surface_json(surface_factors(scene.mesh, ff)));
-  } else if (ext == ".mtx") {
-    write_matrix_market(opts.output, ff.F, {mesh_hash(scene.mesh), settings}, precision);
-  } else {
-    write_ff_binary(opts.output, ff, {mesh_hash(scene.mesh), settings}, precision);
-  }
-  log_info("wrote " + opts.output);
-  write_json_file(report, diagnostics_json(scene, ff, d, settings));
-  log_info("wrote " + report);
+  write_formfactors_outputs(opts, scene, ff, report, Json());
   return 0;
 }
 

@@ -2,7 +2,7 @@
 # Checks the module dependency direction of STYLE.md:
 #   core <- geometry <- io <- apps,  core <- solvers <- apps
 # and that third-party libraries stay at the edge (Embree in geometry/bvh.cpp, OpenEXR in
-# io/*.cpp only). Exits 1 listing every violation.
+# io/*.cpp only, MPI and PETSc in apps/dist_*.cpp only). Exits 1 listing every violation.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 status=0
@@ -19,5 +19,8 @@ hits=$(grep -rlE "#include [<\"]embree" core geometry solvers io apps | grep -v 
 [[ -z "$hits" ]] || { echo "layering: Embree outside geometry/bvh.cpp: $hits"; status=1; }
 hits=$(grep -rlE "#include [<\"](OpenEXR/|Imf)" core geometry solvers io apps | grep -vE '^io/.*\.cpp$' || true)
 [[ -z "$hits" ]] || { echo "layering: OpenEXR outside io/*.cpp: $hits"; status=1; }
+hits=$(grep -rlE "#include [<\"](mpi\.h|petsc)" core geometry solvers io apps tests bench |
+  grep -vE '^apps/dist_[a-z_]+\.cpp$' || true)
+[[ -z "$hits" ]] || { echo "layering: MPI or PETSc outside apps/dist_*.cpp: $hits"; status=1; }
 [[ $status -eq 0 ]] && echo "layering: ok"
 exit $status
