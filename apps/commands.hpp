@@ -121,6 +121,7 @@ struct RunOptions {
   MediumArgs medium;               ///< participating medium (matrix method)
   std::string output_dir = "out";  ///< -o: output directory, created if needed
   std::string name;                ///< file prefix; empty = scene stem ("cornell" built-in)
+  DistributedArgs dist;            ///< --distributed, --petsc-options
 };
 /// Registers `run` on the app.
 CLI::App* add_run_command(CLI::App& app, RunOptions& opts);

@@ -47,7 +47,7 @@ struct DistributedF {
   FormFactorOptions options;  ///< the settings that made F (no row range)
   FormFactorStats stats;      ///< summed over the ranks (seconds: the slowest rank)
   std::vector<std::int32_t> rows;
-  std::vector<double> seconds_per_rank;  ///< on rank 0
+  std::vector<double> seconds_per_rank;  ///< each rank's own computation (rank 0 only)
 };
 
 // The estimator's settings, "auto" resolved: a pair estimator (auto's gather computes whole
@@ -78,6 +78,7 @@ DistributedF distributed_form_factors(const dist::Session& s, const LoadedScene&
   out.rows = dist::row_partition(n, s.size());
   FormFactors partial;
   const Timer timer;
+  double compute_seconds = 0.0;  // this rank's own work, before waiting for the others
   dist::collective([&] {
     if (!args.ff_file.empty()) {  // every rank reads the file and keeps its rows
       const FormFactors whole = obtain_form_factors(scene, args, run, with_stderr);
@@ -97,6 +98,7 @@ DistributedF distributed_form_factors(const dist::Session& s, const LoadedScene&
     }
     o.row_begin = o.row_end = 0;
     out.options = o;
+    compute_seconds = timer.seconds();
   });
   if (!args.ff_file.empty()) return out;
   out.block = dist::exchange_mirrors(partial, out.rows);
@@ -106,7 +108,7 @@ DistributedF distributed_form_factors(const dist::Session& s, const LoadedScene&
   st.pairs_unverified = dist::sum(partial.stats.pairs_unverified);
   st.rays = dist::sum(partial.stats.rays);
   st.seconds = dist::max(timer.seconds());
-  out.seconds_per_rank = dist::gather(timer.seconds());
+  out.seconds_per_rank = dist::gather(compute_seconds);
   log_info("form factors: " + std::to_string(n) + " patches over " + std::to_string(s.size()) +
            " ranks, " + format_si(static_cast<double>(dist::sum(out.block.F.nonZeros()))) +
            " entries, " + format_si(static_cast<double>(st.rays)) + " rays in " +
@@ -168,59 +170,98 @@ int run_formfactors_distributed(const FormFactorsOptions& opts) {
   });
 }
 
-int run_solve_distributed(const SolveCommandOptions& opts) {
-  return dist::run_job(opts.dist.petsc_options, [&](const dist::Session& s) {
-    const RunArgs run = rank_run_args(opts.run, s);
-    const Timer total;
+int run_matrix_distributed(const DistributedArgs& dist, const RunArgs& run_args,
+                           const FormFactorArgs& ff_args, const SolveOptions& solver,
+                           const std::function<LoadedScene(const RunArgs& run, bool root)>& load,
+                           const std::function<int(const LoadedScene&, const RadiosityResult&,
+                                                   const Json& section)>& finish) {
+  return dist::run_job(dist.petsc_options, [&](const dist::Session& s) {
+    const RunArgs run = rank_run_args(run_args, s);
     LoadedScene scene;
     dist::collective([&] {
-      if (opts.method.name != "matrix")
-        throw UsageError("--distributed solves with the matrix method (F over the ranks)");
-      if (opts.medium.active() || opts.adapt.active())
-        throw UsageError("--distributed does not take a participating medium or --adapt yet");
-      for (const char* name : {"--solver", "--preconditioner"})
-        if (opts.method.command && opts.method.command->get_option(name)->count() > 0)
-          throw UsageError(std::string(name) +
-                           " picks a single-process solver: with "
-                           "--distributed the solve is PETSc's (--petsc-options \"-ksp_type "
-                           "bcgs -pc_type jacobi\", README \"Running on a cluster\")");
-      JobPlan plan = job_plan(run);
-      if (s.root()) plan.outputs = {{"-o", opts.output}};
-      if (!opts.ff.ff_file.empty()) plan.inputs = {{"--ff", opts.ff.ff_file}};
-      scene = load_scene(opts.scene, plan);
+      // A solver other than the default was asked for (the same default in solve and run).
+      if (solver.solver != SolveOptions().solver ||
+          solver.preconditioner != SolveOptions().preconditioner)
+        throw UsageError(
+            "--solver and --preconditioner pick a single-process solver: with "
+            "--distributed the solve is PETSc's (--petsc-options \"-ksp_type bcgs "
+            "-pc_type jacobi\", README \"Running on a cluster\")");
+      scene = load(run, s.root());
     });
     check_same_mesh(scene);
-    const double load_seconds = total.seconds();
-    DistributedF f = distributed_form_factors(s, scene, opts.ff, run, false);
-    MatrixSolveResult result;
-    result.options = opts.solve;
-    result.options.solver = "petsc";
-    result.load_seconds = load_seconds;
-    result.ff_seconds = f.stats.seconds;
-    result.ff_options = f.options;
-    result.nonzeros = dist::sum(f.block.F.nonZeros());
+    DistributedF f = distributed_form_factors(s, scene, ff_args, run, false);
+    RadiosityResult r;
+    r.solved = true;
+    r.ff_options = f.options;
+    r.ff_stats = f.stats;
+    r.ff_entries = dist::sum(f.block.F.nonZeros());
+    r.ff_seconds = f.stats.seconds;
+    SolveOptions so = solver;
+    so.solver = "petsc";
     dist::PetscSolve solved;
+    const std::int32_t n = scene.mesh.size();
     dist::collective([&] {
       const RadiosityProblem problem = make_problem(scene.mesh, f.block.F);
-      solved = dist::solve_petsc(problem, f.block, result.options);
+      solved = dist::solve_petsc(problem, f.block, so);
+      // I = F (B - E): this rank's rows, then every rank's (other rows of the block are empty).
+      const Eigen::MatrixX3d mine = indirect_irradiance(scene.mesh, f.block.F, solved.solution.B);
+      r.indirect.resize(n, 3);
+      for (int c = 0; c < 3; ++c) {
+        const std::vector<double> local(mine.col(c).data() + f.block.begin,
+                                        mine.col(c).data() + f.block.end);
+        const std::vector<double> all = dist::allgather_rows(local, f.rows);
+        r.indirect.col(c) = Eigen::Map<const Eigen::VectorXd>(all.data(), n);
+      }
     });
-    result.solution = std::move(solved.solution);
-    result.distributed = distributed_json(s, f, 0);
+    r.solution = std::move(solved.solution);
+    r.B = r.solution.B;
+    r.solve_seconds = r.solution.seconds;
+    Json section = distributed_json(s, f, 0);
     if (s.root()) {
-      result.distributed["ghost_columns"] = solved.ghost_columns;
-      result.distributed["bytes_per_product"] = 8 * solved.ghost_columns;
-      result.distributed["ksp_type"] = solved.ksp_type;
-      result.distributed["pc_type"] = solved.pc_type;
-      result.distributed["petsc_options"] = opts.dist.petsc_options;
+      section["ghost_columns"] = solved.ghost_columns;
+      section["bytes_per_product"] = 8 * solved.ghost_columns;
+      section["ksp_type"] = solved.ksp_type;
+      section["pc_type"] = solved.pc_type;
+      section["petsc_options"] = dist.petsc_options;
     }
     int code = kExitOk;
     dist::collective([&] {
-      if (s.root()) code = write_solve_outputs(opts, scene, result);
+      if (s.root()) code = finish(scene, r, section);
     });
-    return s.root()                                           ? code
-           : result.solution.status == SolveStatus::Converged ? kExitOk
-                                                              : kExitNotConverged;
+    return s.root()                                      ? code
+           : r.solution.status == SolveStatus::Converged ? kExitOk
+                                                         : kExitNotConverged;
   });
+}
+
+int run_solve_distributed(const SolveCommandOptions& opts) {
+  const Timer total;
+  double load_seconds = 0.0;
+  auto load = [&](const RunArgs& run, bool root) {
+    if (opts.method.name != "matrix")
+      throw UsageError("--distributed solves with the matrix method (F over the ranks)");
+    if (opts.medium.active() || opts.adapt.active())
+      throw UsageError("--distributed does not take a participating medium or --adapt yet");
+    JobPlan plan = job_plan(run);
+    if (root) plan.outputs = {{"-o", opts.output}};
+    if (!opts.ff.ff_file.empty()) plan.inputs = {{"--ff", opts.ff.ff_file}};
+    LoadedScene scene = load_scene(opts.scene, plan);
+    load_seconds = total.seconds();
+    return scene;
+  };
+  auto finish = [&](const LoadedScene& scene, const RadiosityResult& r, const Json& section) {
+    MatrixSolveResult result;
+    result.options = opts.solve;
+    result.options.solver = "petsc";
+    result.solution = r.solution;
+    result.ff_options = r.ff_options;
+    result.load_seconds = load_seconds;
+    result.ff_seconds = r.ff_seconds;
+    result.nonzeros = r.ff_entries;
+    result.distributed = section;
+    return write_solve_outputs(opts, scene, result);
+  };
+  return run_matrix_distributed(opts.dist, opts.run, opts.ff, opts.solve, load, finish);
 }
 
 }  // namespace lambert
