@@ -108,7 +108,7 @@ ChannelReport solve_channel(Mat K, Vec e, Vec x, double e_norm, const SolveOptio
   check(KSPGMRESSetRestart(ksp.k, o.restart), "KSPGMRESSetRestart");
   PC pc;
   check(KSPGetPC(ksp.k, &pc), "KSPGetPC");
-  check(PCSetType(pc, PCBJACOBI), "PCSetType");
+  check(PCSetType(pc, PCJACOBI), "PCSetType");
   check(KSPSetPCSide(ksp.k, PC_RIGHT), "KSPSetPCSide");
   check(KSPSetNormType(ksp.k, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
   check(KSPSetTolerances(ksp.k, o.tol, 0.0, PETSC_DEFAULT, o.max_iterations), "KSPSetTolerances");

@@ -12,7 +12,7 @@ void add_distributed_options(CLI::App* cmd, DistributedArgs& args, bool with_sol
   if (with_solver)
     cmd->add_option("--petsc-options", args.petsc_options,
                     "With --distributed: PETSc options for the solve, e.g. \"-ksp_type bcgs "
-                    "-pc_type jacobi\" (default GMRES with block Jacobi)");
+                    "-pc_type jacobi\" (default GMRES with Jacobi)");
 }
 
 }  // namespace lambert

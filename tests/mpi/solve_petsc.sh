@@ -4,7 +4,7 @@
 #     channel. Why: with K = I - diag(rho) F and ||rho F||_inf <= rho_max < 1 (row sums of F
 #     at most 1), ||K^-1||_inf <= 1 / (1 - rho_max), so ||B - B*||_inf <= ||r||_inf /
 #     (1 - rho_max) <= ||r||_2 / (1 - rho_max), and the stopping rule is ||r||_2 <= tol ||E||_2.
-#  2. A --petsc-options pass-through (BiCGStab, Jacobi) meets the same bound and is reported.
+#  2. A --petsc-options pass-through (BiCGStab, block Jacobi) meets the same bound and is reported.
 #  3. The furnace (closed cube, rho = 0.5, E = 1 everywhere): B = E / (1 - rho) = 2, up to
 #     the solver's tol ||E||_2 / (1 - rho) and F's row sums s_i in [s_min, 1] (hybrid's
 #     quadrature): by monotonicity E / (1 - rho s_min) <= B* <= E / (1 - rho).
@@ -17,7 +17,7 @@ mpi 2 formfactors --distributed -q --patches 300 --estimator hybrid --samples 8 
 "$lambert" solve -q --ff "$tmp/F.bin" --patches 300 --solver direct -o "$tmp/direct.csv"
 mpi 2 solve --distributed -q --ff "$tmp/F.bin" --patches 300 --tol 1e-8 -o "$tmp/petsc.csv"
 mpi 2 solve --distributed -q --ff "$tmp/F.bin" --patches 300 --tol 1e-8 \
-  --petsc-options "-ksp_type bcgs -pc_type jacobi" -o "$tmp/bcgs.csv"
+  --petsc-options "-ksp_type bcgs -pc_type bjacobi" -o "$tmp/bcgs.csv"
 # The same without --ff: F computed over the ranks inside solve.
 mpi 2 solve --distributed -q --patches 300 --estimator hybrid --samples 8 --tol 1e-8 \
   -o "$tmp/inline.csv"
@@ -60,7 +60,8 @@ for name, tol in (("petsc", 1e-8), ("bcgs", 1e-8), ("inline", 1e-8)):
         assert abs(got_e - emitted) <= 1e-12 * emitted * len(lights), (got_e, emitted)
     print(name, "distributed:", {k: s["distributed"][k] for k in ("ranks", "ksp_type", "pc_type")})
 b = json.load(open(f"{tmp}/bcgs.json"))["distributed"]
-assert b["ksp_type"] == "bcgs" and b["pc_type"] == "jacobi", b
+assert b["ksp_type"] == "bcgs" and b["pc_type"] == "bjacobi", b
+assert json.load(open(f"{tmp}/petsc.json"))["distributed"]["pc_type"] == "jacobi"
 # Computing F inside solve over the ranks gives the same F as the saved one, hence the same B
 # to the solver's rounding (both runs: the same PETSc method on the same matrix).
 a, i = rows(f"{tmp}/petsc.csv"), rows(f"{tmp}/inline.csv")
