@@ -18,5 +18,11 @@ namespace {
 bool distributed_available() { return false; }
 int run_formfactors_distributed(const FormFactorsOptions&) { refuse(); }
 int run_solve_distributed(const SolveCommandOptions&) { refuse(); }
+int run_matrix_distributed(
+    const DistributedArgs&, const RunArgs&, const FormFactorArgs&, const SolveOptions&,
+    const std::function<LoadedScene(const RunArgs&, bool)>&,
+    const std::function<int(const LoadedScene&, const RadiosityResult&, const Json&)>&) {
+  refuse();
+}
 
 }  // namespace lambert
