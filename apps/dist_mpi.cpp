@@ -7,6 +7,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <new>
@@ -58,8 +59,10 @@ Session::Session(const std::string& petsc_options) {
   MPI_Comm_size(node, &node_ranks_);
   MPI_Comm_free(&node);
   // After MPI is up, so that a bad option string fails the job on every rank alike.
-  if (!petsc_options.empty() && PetscOptionsInsertString(nullptr, petsc_options.c_str()))
+  if (!petsc_options.empty() && PetscOptionsInsertString(nullptr, petsc_options.c_str())) {
+    PetscFinalize();  // no destructor runs for a constructor that throws
     throw UsageError("--petsc-options: PETSc cannot parse '" + petsc_options + "'");
+  }
 }
 
 Session::~Session() { PetscFinalize(); }
@@ -103,9 +106,13 @@ int run_job(const std::string& petsc_options, const std::function<int(const Sess
   try {
     session = std::make_unique<Session>(petsc_options);
   } catch (const Error& e) {  // the same on every rank: each prints, rank 0 alone if known
-    int rank = 0, up = 0;
+    int rank = 0, up = 0, down = 0;
     MPI_Initialized(&up);
-    if (up) MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Finalized(&down);
+    if (up && !down)
+      MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    else if (const char* r = std::getenv("OMPI_COMM_WORLD_RANK"))
+      rank = std::atoi(r);
     if (rank == 0) std::cerr << "lambert: " << e.what() << '\n';
     return dynamic_cast<const UsageError*>(&e) ? 2 : 1;
   }

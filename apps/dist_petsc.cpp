@@ -114,7 +114,8 @@ ChannelReport solve_channel(Mat K, Vec e, Vec x, double e_norm, const SolveOptio
   check(KSPSetTolerances(ksp.k, o.tol, 0.0, PETSC_DEFAULT, o.max_iterations), "KSPSetTolerances");
   Monitor mon{&report, &timer, e_norm, 0};
   check(KSPMonitorSet(ksp.k, monitor, &mon, nullptr), "KSPMonitorSet");
-  check(KSPSetFromOptions(ksp.k), "KSPSetFromOptions (--petsc-options)");
+  if (KSPSetFromOptions(ksp.k))  // the user's options: an unknown type, a bad value
+    throw UsageError("--petsc-options / PETSC_OPTIONS: PETSc refused the KSP or PC options");
   KSPType ksp_type;
   PCType pc_type;
   check(KSPGetType(ksp.k, &ksp_type), "KSPGetType");

@@ -2,7 +2,8 @@
 # without a hang (the timeout in mpi() bounds the test). Two real failures:
 #  1. a bad scene on rank 1 only (mpirun's MPMD form gives the ranks different arguments):
 #     exit 1, the loader's message prefixed "rank 1:" on stderr;
-#  2. a usage error found after MPI started (gather is refused with --distributed): exit 2.
+#  2. a usage error found after MPI started (gather is refused with --distributed): exit 2;
+#  3. PETSc refusing --petsc-options in the solve stage: exit 2.
 source "$(dirname "$0")/common.sh"
 
 printf 'v 0 0 0\nv 1 0 0\nf 1 2 7\n' > "$tmp/bad.obj"  # a face with a vertex that is not there
@@ -25,4 +26,13 @@ set -e
 cat "$tmp/err2"
 [[ $code -eq 2 ]] || { echo "gather: exit $code, expected 2"; exit 1; }
 grep -q "^lambert: .*--distributed takes mc, hybrid or analytic" "$tmp/err2"
+# 3. PETSc refuses an option (an unknown KSP type) on every rank: a usage error, exit 2.
+set +e
+mpi 2 solve --distributed -q --patches 50 --petsc-options "-ksp_type nonsense" \
+  -o "$tmp/B.csv" 2> "$tmp/err3"
+code=$?
+set -e
+cat "$tmp/err3"
+[[ $code -eq 2 ]] || { echo "bad PETSc option: exit $code, expected 2"; exit 1; }
+grep -q "^lambert: --petsc-options" "$tmp/err3"
 echo "ok"
