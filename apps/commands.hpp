@@ -5,6 +5,7 @@
 
 #include "apps/adapt_stage.hpp"
 #include "apps/common.hpp"
+#include "apps/distributed.hpp"
 #include "apps/ff_args.hpp"
 #include "apps/heat_outputs.hpp"
 #include "apps/medium_stage.hpp"
@@ -37,6 +38,7 @@ struct FormFactorsOptions {
   std::vector<double> point, normal;  ///< sensor point and normal (3 each) or empty
   std::string precision = "double";   ///< --ff-precision: "double" or "float" (saved values)
   MediumArgs medium;  ///< participating medium: F then holds its zones after the patches
+  DistributedArgs dist;               ///< --distributed
 };
 /// Registers `formfactors` on the app.
 CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts);
@@ -53,6 +55,7 @@ struct SolveCommandOptions {
   AdaptArgs adapt;
   MediumArgs medium;                     ///< participating medium (matrix method)
   std::string output = "radiosity.csv";  ///< per-patch CSV; summary JSON beside it
+  DistributedArgs dist;                  ///< --distributed, --petsc-options
 };
 /// Registers `solve` on the app.
 CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts);
@@ -121,6 +124,7 @@ struct RunOptions {
   MediumArgs medium;               ///< participating medium (matrix method)
   std::string output_dir = "out";  ///< -o: output directory, created if needed
   std::string name;                ///< file prefix; empty = scene stem ("cornell" built-in)
+  DistributedArgs dist;            ///< --distributed, --petsc-options
 };
 /// Registers `run` on the app.
 CLI::App* add_run_command(CLI::App& app, RunOptions& opts);

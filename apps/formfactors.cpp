@@ -3,7 +3,9 @@
 #include <iostream>
 #include <sstream>
 
+#include "apps/command_outputs.hpp"
 #include "apps/commands.hpp"
+#include "apps/distributed.hpp"
 #include "apps/ff_args.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -193,18 +195,56 @@ CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts) {
   nm->needs(pt);
   pt->excludes(by);
   add_medium_options(cmd, opts.medium);
+  add_distributed_options(cmd, opts.dist, false);
   return cmd;
 }
 
+void write_formfactors_outputs(const FormFactorsOptions& opts, const LoadedScene& scene,
+                               FormFactors& ff, const std::string& report,
+                               const Json& distributed, const Medium* medium) {
+  namespace fs = std::filesystem;
+  warn_about_lighting(scene.mesh, ff.F);
+  check_closed_lossless(scene.mesh, ff, false);
+  // Diagnostics of the patches' F; with a medium they describe the surfaces' exchange before
+  // the medium attenuates it, and the zones are appended to F after them.
+  const FormFactorDiagnostics d = diagnose(scene.mesh, ff.F);
+  print_diagnostics(scene, ff, d);
+  Json j = diagnostics_json(scene, ff, d, "");
+  if (medium) j["medium"] = extend_with_zones(scene, *medium, opts.medium, opts.run, ff);
+  const std::string settings = settings_string(ff.options, scene);
+  j["settings"] = settings;
+  const std::string ext = fs::path(opts.output).extension().string();
+  const ValuePrecision precision =
+      opts.precision == "float" ? ValuePrecision::Float : ValuePrecision::Double;
+  if (opts.by_surface) {
+    write_json_file(opts.output, surface_json(surface_factors(scene.mesh, ff)));
+  } else if (ext == ".mtx") {
+    write_matrix_market(opts.output, ff.F, {mesh_hash(scene.mesh), settings}, precision);
+  } else {
+    write_ff_binary(opts.output, ff, {mesh_hash(scene.mesh), settings}, precision);
+  }
+  log_info("wrote " + opts.output);
+  if (!distributed.is_null()) j["distributed"] = distributed;
+  write_json_file(report, j);
+  log_info("wrote " + report);
+}
+
+std::string formfactors_report_path(const FormFactorsOptions& opts) {
+  namespace fs = std::filesystem;
+  return !opts.report.empty() || opts.output.empty()
+             ? opts.report
+             : fs::path(opts.output).replace_extension(".report.json").string();
+}
+
 int run_formfactors(const FormFactorsOptions& opts) {
+  if (opts.dist.enabled && opts.medium.active())
+    throw UsageError("--distributed does not take a participating medium yet");
+  if (opts.dist.enabled) return run_formfactors_distributed(opts);
   apply_run_options(opts.run);
   namespace fs = std::filesystem;
   if (opts.output.empty() && opts.point.empty())
     throw UsageError("formfactors: -o/--output is required");
-  const std::string report =
-      !opts.report.empty() || opts.output.empty()
-          ? opts.report
-          : fs::path(opts.output).replace_extension(".report.json").string();
+  const std::string report = formfactors_report_path(opts);
   const std::shared_ptr<const Medium> medium = make_medium(opts.medium);
   if (medium && (opts.by_surface || !opts.point.empty() || opts.with_stderr))
     throw UsageError(
@@ -242,29 +282,7 @@ int run_formfactors(const FormFactorsOptions& opts) {
   if (medium) check_medium_scene(scene.mesh, nullptr);
   FormFactors ff =
       obtain_form_factors(scene, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
-  warn_about_lighting(scene.mesh, ff.F);
-  check_closed_lossless(scene.mesh, ff, false);
-  // Diagnostics of the patches' F; with a medium they describe the surfaces' exchange before
-  // the medium attenuates it.
-  const FormFactorDiagnostics d = diagnose(scene.mesh, ff.F);
-  print_diagnostics(scene, ff, d);
-  Json report_json = diagnostics_json(scene, ff, d, "");
-  if (medium) report_json["medium"] = extend_with_zones(scene, *medium, opts.medium, opts.run, ff);
-  const std::string settings = settings_string(ff.options, scene);
-  report_json["settings"] = settings;
-  const std::string ext = fs::path(opts.output).extension().string();
-  const ValuePrecision precision =
-      opts.precision == "float" ? ValuePrecision::Float : ValuePrecision::Double;
-  if (opts.by_surface) {
-    write_json_file(opts.output, surface_json(surface_factors(scene.mesh, ff)));
-  } else if (ext == ".mtx") {
-    write_matrix_market(opts.output, ff.F, {mesh_hash(scene.mesh), settings}, precision);
-  } else {
-    write_ff_binary(opts.output, ff, {mesh_hash(scene.mesh), settings}, precision);
-  }
-  log_info("wrote " + opts.output);
-  write_json_file(report, report_json);
-  log_info("wrote " + report);
+  write_formfactors_outputs(opts, scene, ff, report, Json(), medium.get());
   return 0;
 }
 

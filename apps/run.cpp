@@ -259,8 +259,121 @@ void describe_medium(const MediumResult& medium, MethodOutcome& m) {
   }
 }
 
+// What the matrix method's stages hand to its report besides B and F's statistics.
+struct MatrixExtras {
+  std::string solver;  ///< the solver's name ("petsc" with --distributed)
+  double load_seconds = 0.0;
+  std::vector<AdaptRound> rounds;
+  std::optional<MediumResult> medium;
+  Json distributed;  ///< the "distributed" report section (null: none)
+};
+
+// The matrix method's report pieces and summary lines, then the shared stages.
+int finish_matrix(const RunOptions& opts, const RunPaths& paths, const LoadedScene& loaded,
+                  const Camera& camera, Stages& stages, const RadiosityResult& r,
+                  const MatrixExtras& x) {
+  MethodOutcome m{"matrix", loaded, r.B};
+  if (!x.medium) m.indirect = &r.indirect;
+  std::ostringstream settings;
+  settings << "patches=" << loaded.mesh.size() << " max_edge=" << loaded.max_edge << ' '
+           << ff_settings_text(r.ff_options, opts.ff.ff_file) << " solver=" << x.solver
+           << " tol=" << opts.solver.tol;
+  m.settings = settings.str();
+  if (x.medium) describe_medium(*x.medium, m);
+  if (!x.distributed.is_null()) m.sections["distributed"] = x.distributed;
+  Json& ff = m.sections["form_factors"] = ff_settings_json(r.ff_options, opts.ff.ff_file);
+  ff["entries"] = r.ff_entries;
+  ff["pairs_tested"] = r.ff_stats.pairs_tested;
+  ff["rays"] = r.ff_stats.rays;
+  ff["reciprocity_max_relative_change"] = r.ff_stats.reciprocity_max_relative_change;
+  ff["reciprocity_mean_relative_change"] = r.ff_stats.reciprocity_mean_relative_change;
+  ff["reciprocity_scale_min"] = r.ff_stats.reciprocity_scale_min;
+  ff["reciprocity_scale_max"] = r.ff_stats.reciprocity_scale_max;
+  ff["reciprocity_rows_scaled"] = r.ff_stats.reciprocity_rows_scaled;
+  Json channels = Json::array();
+  for (const auto& c : r.solution.channels)
+    channels.push_back({{"status", to_string(c.status)},
+                        {"iterations", c.iterations},
+                        {"matvecs", c.matvecs},
+                        {"residual", c.residual},
+                        {"seconds", c.seconds}});
+  m.sections["solver"] = {{"name", x.solver},
+                          {"tol", opts.solver.tol},
+                          {"status", to_string(r.solution.status)},
+                          {"channels", channels}};
+  for (const auto& e : r.solution.energy) m.energy.push_back(energy_json(e));
+  if (!x.rounds.empty()) {
+    m.sections["adapt"] = adapt_json(x.rounds);
+    const AdaptRound& last = x.rounds.back();
+    char buf[160];
+    std::snprintf(buf, sizeof buf,
+                  "adapt      %zu rounds: %lld -> %lld patches, estimated error %.3g -> %.3g W/m^2",
+                  x.rounds.size() - 1, static_cast<long long>(x.rounds.front().patches),
+                  static_cast<long long>(last.patches), x.rounds.front().estimated_error,
+                  last.estimated_error);
+    m.summary.push_back(buf);
+  }
+  m.seconds = {{"load_and_mesh", x.load_seconds},
+               {"form_factors", r.ff_seconds},
+               {"solve", r.solve_seconds}};
+  m.time_labels = {"load+mesh", "form factors", "solve"};
+  m.rays = r.ff_stats.rays;
+  m.rays_label = "form factors";
+
+  char line[256];
+  std::string solver_line = "solver     " + x.solver + ": " + to_string(r.solution.status) + ";";
+  for (int c = 0; c < 3; ++c) {
+    std::snprintf(line, sizeof line, " %s %d it (res %.2g)", channel_name(c),
+                  r.solution.channels[c].iterations, r.solution.channels[c].residual);
+    solver_line += line;
+  }
+  m.summary.push_back(solver_line);
+  m.summary.push_back(
+      "energy     emitted / absorbed / escaped (W), relative imbalance (its parts):");
+  for (int c = 0; c < 3; ++c) {
+    const auto& e = r.solution.energy[c];
+    std::snprintf(line, sizeof line, "           %s %.6g / %.6g / %.6g, %.2e (%s)", channel_name(c),
+                  e.emitted, e.absorbed, e.escaped, e.relative_imbalance,
+                  energy_split_text(e).c_str());
+    m.summary.push_back(line);
+  }
+  m.status = r.solution.status;
+  m.not_converged = "solver status " + std::string(to_string(r.solution.status)) +
+                    ": results were written but are not converged";
+  return finish_run(opts, paths, m, camera, stages);
+}
+
+// --method matrix --distributed: every rank loads and meshes, F and the solve over the ranks
+// (distributed.hpp), then rank 0 alone renders and writes (stages 4-6).
+int run_matrix_over_ranks(const RunOptions& opts) {
+  Stages stages(6);
+  RunPaths paths;
+  std::optional<Camera> camera;
+  double load_seconds = 0.0;
+  auto load = [&](const RunArgs& run, bool root) {
+    if (opts.medium.active() || opts.adapt.active())
+      throw UsageError("--distributed does not take a participating medium or --adapt yet");
+    const Timer timer;
+    stages.next(loading_what(opts, "loading and meshing "));
+    JobPlan plan = job_plan(run);
+    if (root) paths = prepare_outputs(opts, plan);  // rank 0 alone creates and writes
+    LoadedScene loaded = load_scene(opts.scene, plan);
+    camera = make_camera(loaded.scene, opts.camera);
+    load_seconds = timer.seconds();
+    stages.next("form factors over the ranks");
+    stages.next("solving (I - rho F) B = E with PETSc over the ranks");
+    return loaded;
+  };
+  auto finish = [&](const LoadedScene& loaded, const RadiosityResult& r, const Json& section) {
+    return finish_matrix(opts, paths, loaded, *camera, stages, r,
+                         {"petsc", load_seconds, {}, std::nullopt, section});
+  };
+  return run_matrix_distributed(opts.dist, opts.run, opts.ff, opts.solver, load, finish);
+}
+
 // --method matrix: mesh, F, solve (stages 1-3 of 6).
 int run_matrix(const RunOptions& opts) {
+  if (opts.dist.enabled) return run_matrix_over_ranks(opts);
   const std::shared_ptr<const Medium> medium = make_medium(opts.medium);
   if (medium && opts.adapt.active())
     throw UsageError("--adapt does not combine with a participating medium yet");
@@ -326,73 +439,8 @@ int run_matrix(const RunOptions& opts) {
     }
   }
 
-  MethodOutcome m{"matrix", loaded, r.B};
-  if (!medium_result) m.indirect = &r.indirect;
-  std::ostringstream settings;
-  settings << "patches=" << loaded.mesh.size() << " max_edge=" << loaded.max_edge << ' '
-           << ff_settings_text(r.ff_options, opts.ff.ff_file) << " solver=" << opts.solver.solver
-           << " tol=" << opts.solver.tol;
-  m.settings = settings.str();
-  if (medium_result) describe_medium(*medium_result, m);
-  Json& ff = m.sections["form_factors"] = ff_settings_json(r.ff_options, opts.ff.ff_file);
-  ff["entries"] = r.ff_entries;
-  ff["pairs_tested"] = r.ff_stats.pairs_tested;
-  ff["rays"] = r.ff_stats.rays;
-  ff["reciprocity_max_relative_change"] = r.ff_stats.reciprocity_max_relative_change;
-  ff["reciprocity_mean_relative_change"] = r.ff_stats.reciprocity_mean_relative_change;
-  ff["reciprocity_scale_min"] = r.ff_stats.reciprocity_scale_min;
-  ff["reciprocity_scale_max"] = r.ff_stats.reciprocity_scale_max;
-  ff["reciprocity_rows_scaled"] = r.ff_stats.reciprocity_rows_scaled;
-  Json channels = Json::array();
-  for (const auto& c : r.solution.channels)
-    channels.push_back({{"status", to_string(c.status)},
-                        {"iterations", c.iterations},
-                        {"matvecs", c.matvecs},
-                        {"residual", c.residual},
-                        {"seconds", c.seconds}});
-  m.sections["solver"] = {{"name", opts.solver.solver},
-                          {"tol", opts.solver.tol},
-                          {"status", to_string(r.solution.status)},
-                          {"channels", channels}};
-  for (const auto& e : r.solution.energy) m.energy.push_back(energy_json(e));
-  if (!rounds.empty()) {
-    m.sections["adapt"] = adapt_json(rounds);
-    const AdaptRound& last = rounds.back();
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "adapt      %zu rounds: %lld -> %lld patches, estimated error %.3g -> %.3g W/m^2",
-                  rounds.size() - 1, static_cast<long long>(rounds.front().patches),
-                  static_cast<long long>(last.patches), rounds.front().estimated_error,
-                  last.estimated_error);
-    m.summary.push_back(buf);
-  }
-  m.seconds = {
-      {"load_and_mesh", load_seconds}, {"form_factors", r.ff_seconds}, {"solve", r.solve_seconds}};
-  m.time_labels = {"load+mesh", "form factors", "solve"};
-  m.rays = r.ff_stats.rays;
-  m.rays_label = "form factors";
-
-  char line[256];
-  std::string solver_line =
-      "solver     " + opts.solver.solver + ": " + to_string(r.solution.status) + ";";
-  for (int c = 0; c < 3; ++c) {
-    std::snprintf(line, sizeof line, " %s %d it (res %.2g)", channel_name(c),
-                  r.solution.channels[c].iterations, r.solution.channels[c].residual);
-    solver_line += line;
-  }
-  m.summary.push_back(solver_line);
-  m.summary.push_back(
-      "energy     emitted / absorbed / escaped (W), relative imbalance (its parts):");
-  for (int c = 0; c < 3; ++c) {
-    const auto& e = r.solution.energy[c];
-    std::snprintf(line, sizeof line, "           %s %.6g / %.6g / %.6g, %.2e (%s)", channel_name(c),
-                  e.emitted, e.absorbed, e.escaped, e.relative_imbalance,
-                  energy_split_text(e).c_str());
-    m.summary.push_back(line);
-  }
-  m.status = r.solution.status;
-  m.not_converged = "solver status " + std::string(to_string(r.solution.status)) +
-                    ": results were written but are not converged";
-  return finish_run(opts, paths, m, camera, stages);
+  return finish_matrix(opts, paths, loaded, camera, stages, r,
+                       {opts.solver.solver, load_seconds, rounds, medium_result, Json()});
 }
 
 // --method hierarchical: load (no meshing), hierarchical solve (stages 1-2 of 5).
@@ -477,10 +525,13 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& opts) {
   cmd->add_option(
       "--name", opts.name,
       "File name prefix (default: the scene file's stem; cornell for the built-in box)");
+  add_distributed_options(cmd, opts.dist, true);
   return cmd;
 }
 
 int run_run(const RunOptions& opts) {
+  if (opts.dist.enabled && opts.method.name != "matrix")
+    throw UsageError("--distributed runs the matrix method (F over the ranks)");
   resolve_shading(opts.shade);  // contradicting shading options: usage error before any work
   static const MethodTable<RunOptions> kMethods = {{"matrix", run_matrix},
                                                    {"hierarchical", run_hierarchical}};

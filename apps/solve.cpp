@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "apps/cli.hpp"
+#include "apps/command_outputs.hpp"
 #include "apps/commands.hpp"
 #include "apps/hierarchical_stage.hpp"
 #include "apps/problem.hpp"
@@ -96,66 +97,16 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
     sol = solve_radiosity(problem, so);
   }
   if (!medium) nonzeros = ff.F.nonZeros();
-
-  const std::string json_path = summary_path(opts.output);
-  write_radiosity_csv(opts.output, loaded.mesh, sol.B);
-  const auto surfaces = surface_averages(loaded.mesh, sol.B);
-  int iterations = 0;
-  double residual = 0.0;
-  for (const auto& r : sol.channels) {
-    iterations = std::max(iterations, r.iterations);
-    residual = std::max(residual, r.residual);
-  }
-  Json j = {{"scene", loaded.scene.source},
-            {"method", "matrix"},
-            {"patches", loaded.mesh.size()},
-            {"solver", so.solver},
-            {"status", to_string(sol.status)},
-            {"options",
-             {{"tol", so.tol},
-              {"max_iterations", so.max_iterations},
-              {"omega", so.omega},
-              {"preconditioner", so.preconditioner},
-              {"restart", so.restart},
-              {"ambient", so.ambient}}},
-            {"iterations", iterations},
-            {"residual", residual},
-            {"timings",
-             {{"load_and_mesh_seconds", load_seconds},
-              {"form_factors_seconds", ff_seconds},
-              {"form_factors_source", opts.ff.ff_file.empty() ? "computed" : opts.ff.ff_file},
-              {"solve_seconds", sol.seconds}}},
-            {"form_factors", ff_settings_json(ff.options, opts.ff.ff_file)},
-            {"form_factor_nonzeros", nonzeros}};
-  if (medium_result) j["medium"] = medium_json(*medium_result);
-  Json& channels = j["channels"] = Json::array();
-  for (int c = 0; c < 3; ++c) channels.push_back(channel_json(sol.channels[c], sol.energy[c], c));
-  j["surfaces"] = surface_averages_json(surfaces);
-  if (!rounds.empty()) j["adapt"] = adapt_json(rounds);
-  write_json_file(json_path, j);
-
-  std::printf("solver %s: %s\n", so.solver.c_str(), to_string(sol.status));
-  for (int c = 0; c < 3; ++c) {
-    const ChannelReport& r = sol.channels[c];
-    std::printf(
-        "  %s: %-15s %6d iterations %8lld matvecs  residual %.3e  %.4fs  energy "
-        "emitted %.6g absorbed %.6g escaped %.6g (imbalance %.2e: %s)\n",
-        channel_name(c), to_string(r.status), r.iterations, static_cast<long long>(r.matvecs),
-        r.residual, r.seconds, sol.energy[c].emitted, sol.energy[c].absorbed, sol.energy[c].escaped,
-        sol.energy[c].relative_imbalance, energy_split_text(sol.energy[c]).c_str());
-  }
-  if (medium_result)
-    for (int c = 0; c < 3; ++c)
-      std::printf("  %s: absorbed by surfaces %.6g, by the medium %.6g (%d zones)\n",
-                  channel_name(c), medium_result->absorbed_surfaces[c],
-                  medium_result->absorbed_medium[c], medium_result->zones.size());
-  std::printf("wrote %s and %s\n", opts.output.c_str(), json_path.c_str());
-  if (sol.status != SolveStatus::Converged) {
-    log_warn("solver " + so.solver + " did not converge (" + to_string(sol.status) +
-             "); results were written anyway");
-    return kExitNotConverged;
-  }
-  return kExitOk;
+  MatrixSolveResult result;
+  result.options = so;
+  result.solution = std::move(sol);
+  result.ff_options = ff.options;
+  result.load_seconds = load_seconds;
+  result.ff_seconds = ff_seconds;
+  result.nonzeros = nonzeros;
+  result.medium = std::move(medium_result);
+  result.rounds = std::move(rounds);
+  return write_solve_outputs(opts, loaded, result);
 }
 
 // --method hierarchical: load (no meshing), solve hierarchically; the leaves are the patches.
@@ -213,6 +164,74 @@ int run_solve_hierarchical(const SolveCommandOptions& opts) {
 
 }  // namespace
 
+int write_solve_outputs(const SolveCommandOptions& opts, const LoadedScene& loaded,
+                        const MatrixSolveResult& r) {
+  const SolveOptions& so = r.options;
+  const RadiositySolution& sol = r.solution;
+  const std::optional<MediumResult>& medium_result = r.medium;
+  const std::string json_path = summary_path(opts.output);
+  write_radiosity_csv(opts.output, loaded.mesh, sol.B);
+  const auto surfaces = surface_averages(loaded.mesh, sol.B);
+  int iterations = 0;
+  double residual = 0.0;
+  for (const auto& cr : sol.channels) {
+    iterations = std::max(iterations, cr.iterations);
+    residual = std::max(residual, cr.residual);
+  }
+  Json j = {{"scene", loaded.scene.source},
+            {"method", "matrix"},
+            {"patches", loaded.mesh.size()},
+            {"solver", so.solver},
+            {"status", to_string(sol.status)},
+            {"options",
+             {{"tol", so.tol},
+              {"max_iterations", so.max_iterations},
+              {"omega", so.omega},
+              {"preconditioner", so.preconditioner},
+              {"restart", so.restart},
+              {"ambient", so.ambient}}},
+            {"iterations", iterations},
+            {"residual", residual},
+            {"timings",
+             {{"load_and_mesh_seconds", r.load_seconds},
+              {"form_factors_seconds", r.ff_seconds},
+              {"form_factors_source", opts.ff.ff_file.empty() ? "computed" : opts.ff.ff_file},
+              {"solve_seconds", sol.seconds}}},
+            {"form_factors", ff_settings_json(r.ff_options, opts.ff.ff_file)},
+            {"form_factor_nonzeros", r.nonzeros}};
+  if (medium_result) j["medium"] = medium_json(*medium_result);
+  Json& channels = j["channels"] = Json::array();
+  for (int c = 0; c < 3; ++c) channels.push_back(channel_json(sol.channels[c], sol.energy[c], c));
+  j["surfaces"] = surface_averages_json(surfaces);
+  if (!r.rounds.empty()) j["adapt"] = adapt_json(r.rounds);
+  if (!r.distributed.is_null()) j["distributed"] = r.distributed;
+  write_json_file(json_path, j);
+
+  std::printf("solver %s: %s\n", so.solver.c_str(), to_string(sol.status));
+  for (int c = 0; c < 3; ++c) {
+    const ChannelReport& cr = sol.channels[c];
+    std::printf(
+        "  %s: %-15s %6d iterations %8lld matvecs  residual %.3e  %.4fs  energy "
+        "emitted %.6g absorbed %.6g escaped %.6g (imbalance %.2e: %s)\n",
+        channel_name(c), to_string(cr.status), cr.iterations, static_cast<long long>(cr.matvecs),
+        cr.residual, cr.seconds, sol.energy[c].emitted, sol.energy[c].absorbed,
+        sol.energy[c].escaped, sol.energy[c].relative_imbalance,
+        energy_split_text(sol.energy[c]).c_str());
+  }
+  if (medium_result)
+    for (int c = 0; c < 3; ++c)
+      std::printf("  %s: absorbed by surfaces %.6g, by the medium %.6g (%d zones)\n",
+                  channel_name(c), medium_result->absorbed_surfaces[c],
+                  medium_result->absorbed_medium[c], medium_result->zones.size());
+  std::printf("wrote %s and %s\n", opts.output.c_str(), json_path.c_str());
+  if (sol.status != SolveStatus::Converged) {
+    log_warn("solver " + so.solver + " did not converge (" + to_string(sol.status) +
+             "); results were written anyway");
+    return kExitNotConverged;
+  }
+  return kExitOk;
+}
+
 CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts) {
   auto* cmd = app.add_subcommand("solve", "Solve the radiosity system and write per-patch B");
   opts.scene.default_patches = 2000;
@@ -228,10 +247,12 @@ CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts) {
       ->check(output_file_check())
       ->capture_default_str();
   add_run_options(cmd, opts.run);
+  add_distributed_options(cmd, opts.dist, true);
   return cmd;
 }
 
 int run_solve(const SolveCommandOptions& opts) {
+  if (opts.dist.enabled) return run_solve_distributed(opts);
   static const MethodTable<SolveCommandOptions> kMethods = {
       {"matrix", run_solve_matrix}, {"hierarchical", run_solve_hierarchical}};
   return run_for_method(kMethods, opts);

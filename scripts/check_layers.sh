@@ -3,7 +3,7 @@
 #   core <- geometry <- io <- apps,  core <- solvers <- apps,  apps <- python (the bindings
 #   sit on top, beside the CLI; nothing includes python/)
 # and that third-party libraries stay at the edge (Embree in geometry/bvh.cpp, OpenEXR in
-# io/*.cpp only). Exits 1 listing every violation.
+# io/*.cpp only, MPI and PETSc in apps/dist_*.cpp only). Exits 1 listing every violation.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 status=0
@@ -21,5 +21,8 @@ hits=$(grep -rlE "#include [<\"]embree" core geometry solvers io apps python | g
 [[ -z "$hits" ]] || { echo "layering: Embree outside geometry/bvh.cpp: $hits"; status=1; }
 hits=$(grep -rlE "#include [<\"](OpenEXR/|Imf)" core geometry solvers io apps python | grep -vE '^io/.*\.cpp$' || true)
 [[ -z "$hits" ]] || { echo "layering: OpenEXR outside io/*.cpp: $hits"; status=1; }
+hits=$(grep -rlE "#include [<\"](mpi\.h|petsc)" core geometry solvers io apps tests bench |
+  grep -vE '^apps/dist_[a-z_]+\.cpp$' || true)
+[[ -z "$hits" ]] || { echo "layering: MPI or PETSc outside apps/dist_*.cpp: $hits"; status=1; }
 [[ $status -eq 0 ]] && echo "layering: ok"
 exit $status

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages lambert needs (only those missing), then configures and
 # builds the Release preset into build/. Usage: scripts/setup.sh [preset]
+# (preset mpi: also OpenMPI and PETSc, builds build-mpi/)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset="${1:-release}"
@@ -10,6 +11,8 @@ packages=(build-essential cmake pkg-config libembree-dev libeigen3-dev libopenex
           pybind11-dev python3-dev python3-numpy python3-scipy python3-matplotlib python3-pytest)
 # The fuzz preset builds with clang and links libFuzzer (from libclang-rt).
 [[ "$preset" == fuzz ]] && packages+=(clang libclang-rt-14-dev)
+# The mpi preset builds distributed support (--distributed) against OpenMPI and PETSc 3.18.
+[[ "$preset" == mpi ]] && packages+=(libopenmpi-dev openmpi-bin petsc-dev python3)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

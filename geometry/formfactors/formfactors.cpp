@@ -36,17 +36,25 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
                        options.tol};
   const double plane_eps = kPlaneEps * mesh.scale;
   const std::int64_t total_pairs = static_cast<std::int64_t>(n) * (n - 1) / 2;
+  // A row range (distributed form factors) computes the pairs of rows [first, last) only;
+  // every pair keeps its stream hash_keys(seed, i, j), so its entries are the same doubles.
+  const bool ranged = options.row_end > options.row_begin;
+  const std::int32_t first = ranged ? options.row_begin : 0;
+  const std::int32_t last = ranged ? options.row_end : n;
+  auto pairs_before = [n](std::int64_t i) { return i * (n - 1) - i * (i - 1) / 2; };
+  const std::int64_t range_pairs = pairs_before(last) - pairs_before(first);
 
-  // Room for every pair in both triangles; pages of pairs that do not exchange energy are
-  // never written, so they cost address space only.
-  CsrAppender upper(n, 2 * total_pairs, options.with_stderr);
+  // Room for every pair of the range in both triangles; pages of pairs that do not exchange
+  // energy are never written, so they cost address space only.
+  CsrAppender upper(n, 2 * range_pairs, options.with_stderr);
   std::vector<std::vector<RowEntry>> rows(n);
   std::vector<std::int64_t> tested(n, 0), rays(n, 0), unverified(n, 0);
-  Progress progress("form factors", options.progress ? total_pairs : 0, "rays");
+  Progress progress("form factors", options.progress ? range_pairs : 0, "rays");
   const std::int64_t block_pairs = std::max<std::int64_t>(1, total_pairs / kBlocks);
-  for (std::int32_t block_begin = 0; block_begin < n;) {
+  for (std::int32_t i = 0; i < first; ++i) upper.append_row({});
+  for (std::int32_t block_begin = first; block_begin < last;) {
     std::int32_t block_end = block_begin;
-    for (std::int64_t pairs = 0; block_end < n && pairs < block_pairs; ++block_end)
+    for (std::int64_t pairs = 0; block_end < last && pairs < block_pairs; ++block_end)
       pairs += n - 1 - block_end;
     parallel_for(block_end - block_begin, 1, options.threads,
                  [&](std::int64_t begin, std::int64_t end) {
@@ -73,6 +81,7 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
     }
     block_begin = block_end;
   }
+  for (std::int32_t i = last; i < n; ++i) upper.append_row({});
   progress.finish();
 
   FormFactors out;
@@ -82,7 +91,7 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
     out.stats.rays += rays[i];
     out.stats.pairs_unverified += unverified[i];
   }
-  out.stats.pairs_culled = total_pairs - out.stats.pairs_tested;
+  out.stats.pairs_culled = range_pairs - out.stats.pairs_tested;
   upper.finish(out.F, out.stderr_F);
   std::vector<double> area(n);
   for (std::int32_t i = 0; i < n; ++i) area[i] = geom[i].area;
@@ -97,6 +106,7 @@ namespace {
 
 struct EstimatorEntry {
   const char* name;
+  bool pairwise;     ///< computes each unordered pair once (compute_pairwise): accepts a row range
   bool traces_rays;  ///< reports replicate standard errors (needs count >= 4); follows mirrors
   bool uses_bvh;     ///< queries a BVH (rays, or the analytic estimator's blocker search)
   const char* count_option;  ///< "samples", "rays", "tol" or "" (estimator_count_option)
@@ -152,27 +162,27 @@ double gather_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
 
 const std::vector<EstimatorEntry>& registry() {
   static const std::vector<EstimatorEntry> table = {
-      {"hybrid", true, true, "samples", false,
+      {"hybrid", true, true, true, "samples", false,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
          return ff::compute_pairwise(m, o, *b, ff::estimate_hybrid);
        },
        pairwise_peak_bytes},
-      {"mc", true, true, "samples", false,
+      {"mc", true, true, true, "samples", false,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
          return ff::compute_pairwise(m, o, *b, ff::estimate_mc);
        },
        pairwise_peak_bytes},
-      {"hemicube", false, false, "", false,
+      {"hemicube", false, false, false, "", false,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh*) {
          return ff::compute_hemicube(m, o);  // rasterises: no rays
        },
        hemicube_peak_bytes},
-      {"gather", true, true, "rays", true,
+      {"gather", false, true, true, "rays", true,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
          return ff::compute_gather(m, o, *b);
        },
        gather_peak_bytes},
-      {"analytic", false, true, "tol", false,
+      {"analytic", true, false, true, "tol", false,
        [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
          return ff::compute_pairwise(m, o, *b, ff::estimate_analytic);
        },
@@ -230,6 +240,32 @@ std::string auto_estimator(std::int64_t patches, bool tol_given) {
   return patches >= kAutoGatherPatches ? "gather" : "hybrid";
 }
 
+std::vector<std::int32_t> balanced_pair_rows(std::int32_t n, int parts) {
+  LAMBERT_CHECK(parts >= 1 && n >= 0, "balanced_pair_rows: bad arguments");
+  // Pairs of rows [0, i): P(i) = i (n - 1) - i (i - 1) / 2, increasing in i. Part r starts at
+  // the first row i with P(i) >= r P(n) / parts (a binary search in exact integers).
+  const std::int64_t m = n;
+  auto pairs_before = [m](std::int64_t i) { return i * (m - 1) - i * (i - 1) / 2; };
+  const std::int64_t total = pairs_before(m);
+  std::vector<std::int32_t> first(static_cast<size_t>(parts) + 1, n);
+  first[0] = 0;
+  for (int r = 1; r < parts; ++r) {
+    const std::int64_t target = (total / parts) * r + (total % parts) * r / parts;
+    std::int64_t lo = 0, hi = m;
+    while (lo < hi) {
+      const std::int64_t mid = (lo + hi) / 2;
+      if (pairs_before(mid) >= target)
+        hi = mid;
+      else
+        lo = mid + 1;
+    }
+    first[r] = static_cast<std::int32_t>(std::max<std::int64_t>(lo, first[r - 1]));
+  }
+  return first;
+}
+
+bool is_pair_estimator(const std::string& estimator) { return find_estimator(estimator).pairwise; }
+
 std::string estimator_count_option(const std::string& estimator) {
   return find_estimator(estimator).count_option;
 }
@@ -279,8 +315,32 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
     own = std::make_unique<Bvh>(mesh, o.threads);
     bvh = own.get();
   }
+  const bool ranged = o.row_end > o.row_begin;
+  if (ranged) {
+    if (o.row_begin < 0 || o.row_end > mesh.size())
+      throw UsageError("row range [" + std::to_string(o.row_begin) + ", " +
+                       std::to_string(o.row_end) + ") outside the mesh");
+    if (!e.pairwise)
+      throw UsageError("--estimator " + o.estimator +
+                       " computes whole rows and its reciprocity "
+                       "needs whole columns: distributed form factors take mc, hybrid or analytic");
+    if (o.reciprocity == "average")
+      throw UsageError(
+          "--reciprocity average needs whole columns: distributed form factors "
+          "take the pair estimators' own reciprocity (--reciprocity none)");
+    if (specular)
+      throw UsageError(
+          "specular paths cross every row: distributed form factors need "
+          "--specular-depth 0 on a scene with mirrors or glass");
+    if (!o.only.empty()) throw UsageError("a row range does not combine with an update");
+  }
   FormFactors out = e.compute(mesh, o, bvh);
   out.options = o;
+  if (ranged) {
+    // Each pair's two entries are on this side, so the pair threshold applies as a whole.
+    apply_threshold(out, o.threshold);
+    return out;
+  }
   if (!o.only.empty()) {
     LAMBERT_CHECK(o.only.size() == mesh.patches.size(), "row flags do not match the mesh");
     return out;  // partial: update_form_factors completes it

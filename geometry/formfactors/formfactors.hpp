@@ -65,6 +65,14 @@ struct FormFactorOptions {
   /// pair; gather and hemicube: the flagged rows); everything else is left empty, and
   /// reciprocity averaging and the threshold are not applied (see update_form_factors).
   std::vector<char> only;
+  /// Distributed form factors (README "Running on a cluster"): when row_end > row_begin,
+  /// a pair estimator computes only the pairs (i, j > i) with i in [row_begin, row_end),
+  /// each with the stream it has in a whole computation, and returns both of their entries
+  /// (F_ij and F_ji: rows outside the range receive mirrors), the threshold applied per
+  /// pair. Row estimators, reciprocity averaging and specular paths refuse a range (they
+  /// need whole columns). The default [0, 0) is every row.
+  std::int32_t row_begin = 0;
+  std::int32_t row_end = 0;
 };
 
 /// What a computation did (for diagnostics and reports).
@@ -142,6 +150,15 @@ constexpr std::int64_t kAutoGatherPatches = 6000;
 /// clean enclosure. Above it, auto ignores --ff-tol with a warning (name the estimator to
 /// force it).
 constexpr std::int64_t kAutoAnalyticMaxPatches = 500;
+
+/// Splits the rows of an n-patch pair computation into `parts` consecutive ranges of about
+/// equal cost, the cost of row i being its n - 1 - i pairs (i, j > i): returns parts + 1
+/// first rows (0, ..., n). Deterministic; independent of threads. O(parts).
+std::vector<std::int32_t> balanced_pair_rows(std::int32_t n, int parts);
+
+/// True when `estimator` (a name from form_factor_estimators()) computes each unordered
+/// pair once (mc, hybrid, analytic), the estimators that accept a row range.
+bool is_pair_estimator(const std::string& estimator);
 
 /// The estimator "auto" stands for at `patches` patches: "analytic" when an error target was
 /// given (`tol_given`) and patches <= kAutoAnalyticMaxPatches, else by kAutoGatherPatches.

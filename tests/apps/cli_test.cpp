@@ -1,10 +1,12 @@
 #include "apps/cli.hpp"
-#include "common/run_cli.hpp"
 
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
+
+#include "apps/distributed.hpp"
+#include "common/run_cli.hpp"
 
 namespace lambert {
 
@@ -16,6 +18,15 @@ namespace {
 TEST(Cli, HelpAndVersionSucceed) {
   EXPECT_EQ(run({"--help"}), kExitOk);
   EXPECT_EQ(run({"--version"}), kExitOk);
+}
+
+// The default build has no MPI: --distributed is a usage error naming the MPI build, before
+// any work (the MPI build's own tests are tests/mpi/*.sh under mpirun).
+TEST(Cli, DistributedWithoutMpiIsAUsageError) {
+  if (distributed_available()) GTEST_SKIP() << "built with LAMBERT_MPI";
+  EXPECT_EQ(run({"formfactors", "--distributed", "--patches", "20", "-o", "F.bin"}), kExitUsage);
+  EXPECT_EQ(run({"solve", "--distributed", "--patches", "20", "-o", "B.csv"}), kExitUsage);
+  EXPECT_EQ(run({"run", "--distributed", "--patches", "20", "-o", "out"}), kExitUsage);
 }
 
 TEST(Cli, UsageErrorsExitWithTwo) {

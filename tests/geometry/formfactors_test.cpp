@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
+#include "core/error.hpp"
 #include "geometry/analytic.hpp"
 
 namespace lambert {
@@ -176,6 +178,81 @@ TEST(FormFactors, BitwiseIdenticalForAnyThreadCount) {
       }
     }
   }
+}
+
+// Distributed form factors (README "Running on a cluster") rest on this: the row ranges of
+// balanced_pair_rows, computed separately, hold every entry of the whole F exactly once and
+// bit for bit (row i's entries come from the range of row i or, mirrored, of row j < i).
+TEST(FormFactors, RowRangesTogetherAreTheWholeFBitForBit) {
+  Scene s = unit_cube();
+  Material m{"plate", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
+  add_polygon(s, "plate", m, {{0.3, 0.3, 0.5}, {0.7, 0.3, 0.5}, {0.7, 0.7, 0.5}, {0.3, 0.7, 0.5}});
+  const PatchMesh mesh = mesh_scene(s, {0.2, 0});
+  for (const std::string est : {"mc", "hybrid"}) {
+    FormFactorOptions o;
+    o.estimator = est;
+    o.samples = 8;
+    o.seed = 7;
+    o.with_stderr = true;
+    o.threshold = 1e-3;  // applied per pair: both entries of a pair live in one range
+    o.progress = false;
+    const FormFactors whole = compute_form_factors(mesh, o);
+    for (int parts : {1, 2, 3, 7}) {
+      const std::vector<std::int32_t> rows = balanced_pair_rows(mesh.size(), parts);
+      ASSERT_EQ(rows.size(), static_cast<size_t>(parts) + 1);
+      ASSERT_EQ(rows.front(), 0);
+      ASSERT_EQ(rows.back(), mesh.size());
+      std::vector<Eigen::Triplet<double, std::int64_t>> entries, errors;
+      for (int r = 0; r < parts; ++r) {
+        if (rows[r + 1] == rows[r]) continue;
+        o.row_begin = rows[r];
+        o.row_end = rows[r + 1];
+        const FormFactors part = compute_form_factors(mesh, o);
+        for (std::int32_t i = 0; i < mesh.size(); ++i)
+          for (SparseF::InnerIterator it(part.F, i), e(part.stderr_F, i); it; ++it, ++e) {
+            entries.emplace_back(i, it.col(), it.value());
+            errors.emplace_back(i, it.col(), e.value());
+          }
+      }
+      o.row_begin = o.row_end = 0;
+      // setFromTriplets sums duplicates: an entry computed twice would show as a mismatch.
+      SparseF F(mesh.size(), mesh.size()), err(mesh.size(), mesh.size());
+      F.setFromTriplets(entries.begin(), entries.end());
+      err.setFromTriplets(errors.begin(), errors.end());
+      ASSERT_EQ(F.nonZeros(), whole.F.nonZeros()) << est << " parts " << parts;
+      for (std::int64_t k = 0; k < F.nonZeros(); ++k) {
+        ASSERT_EQ(F.innerIndexPtr()[k], whole.F.innerIndexPtr()[k]);
+        ASSERT_EQ(F.valuePtr()[k], whole.F.valuePtr()[k]) << est << " parts " << parts;
+        ASSERT_EQ(err.valuePtr()[k], whole.stderr_F.valuePtr()[k]);
+      }
+    }
+  }
+}
+
+TEST(FormFactors, BalancedPairRowsSplitThePairsEvenly) {
+  // Row i has n - 1 - i pairs; each part's pairs are within one row's worth (at most n - 1)
+  // of the even share, since a boundary moves by whole rows.
+  const std::int32_t n = 1000;
+  for (int parts : {1, 2, 5, 64}) {
+    const std::vector<std::int32_t> rows = balanced_pair_rows(n, parts);
+    const double share = 0.5 * n * (n - 1) / parts;
+    for (int r = 0; r < parts; ++r) {
+      double pairs = 0.0;
+      for (std::int32_t i = rows[r]; i < rows[r + 1]; ++i) pairs += n - 1 - i;
+      EXPECT_NEAR(pairs, share, n - 1) << "part " << r << " of " << parts;
+    }
+  }
+  EXPECT_EQ(balanced_pair_rows(3, 5).back(), 3);  // more parts than rows: empty parts
+}
+
+TEST(FormFactors, RowRangeRefusesRowEstimators) {
+  const PatchMesh mesh = mesh_scene(unit_cube(), {0.5, 0});
+  FormFactorOptions o;
+  o.estimator = "gather";
+  o.row_begin = 0;
+  o.row_end = 2;
+  o.progress = false;
+  EXPECT_THROW(compute_form_factors(mesh, o), UsageError);
 }
 
 }  // namespace lambert
