@@ -316,12 +316,10 @@ void write_surfaces_csv(const std::string& path, const std::vector<SurfaceRadios
 // a tight tolerance when direct does not fit), compared per surface (the meshes differ).
 int compare_hierarchical(const CompareOptions& opts) {
   // The matrix reference's options are accepted here, but a medium has no hierarchical side.
-  for (const std::string& o : medium_option_names())
-    if (const CLI::Option* given = opts.medium.command->get_option_no_throw(o);
-        given != nullptr && given->count() > 0)
-      throw UsageError(o +
-                       " is not available with --method hierarchical (a participating "
-                       "medium is solved by the matrix method only)");
+  if (const std::string o = first_medium_option_given(opts.medium); !o.empty())
+    throw UsageError(o +
+                     " is not available with --method hierarchical (a participating "
+                     "medium is solved by the matrix method only)");
   const std::string base = output_prefix(opts.output, "compare");
   const std::string table = base + "_table.csv", surfaces_csv = base + "_surfaces.csv";
   JobPlan plan = job_plan(opts.run);

@@ -34,6 +34,12 @@ const std::vector<std::string>& medium_option_names() {
   return kNames;
 }
 
+std::string first_medium_option_given(const MediumArgs& args) {
+  for (const std::string& o : medium_option_names())
+    if (given(args, o)) return o;
+  return "";
+}
+
 void add_medium_options(CLI::App* cmd, MediumArgs& args) {
   args.command = cmd;
   const CLI::Validator non_negative = finite_number(0.0, std::numeric_limits<double>::infinity());
@@ -79,11 +85,11 @@ std::shared_ptr<const Medium> make_medium(const MediumArgs& args) {
   const bool coefficients =
       !args.sigma_a.empty() || !args.sigma_s.empty() || !args.emission.empty();
   if (!args.active()) {
-    for (const std::string& o : medium_option_names())
-      if (given(args, o))
-        throw UsageError(o +
-                         " needs a medium: --medium-box (with --sigma-a/--sigma-s) or "
-                         "--medium-grid");
+    const std::string o = first_medium_option_given(args);
+    if (!o.empty())
+      throw UsageError(o +
+                       " needs a medium: --medium-box (with --sigma-a/--sigma-s) or "
+                       "--medium-grid");
     return nullptr;
   }
   if (!args.grid.empty()) {

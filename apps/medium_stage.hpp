@@ -40,6 +40,9 @@ struct MediumArgs {
 /// method's row in apps/method.cpp lists them: the hierarchical method refuses them).
 const std::vector<std::string>& medium_option_names();
 
+/// The first of medium_option_names() given on the command line, or "" for none.
+std::string first_medium_option_given(const MediumArgs& args);
+
 /// Adds the medium options to a subcommand.
 void add_medium_options(CLI::App* cmd, MediumArgs& args);
 
