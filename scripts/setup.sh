@@ -1,18 +1,18 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages lambert needs (only those missing), then configures and
-# builds the Release preset into build/. Usage: scripts/setup.sh [preset]
-# (preset mpi: also OpenMPI and PETSc, builds build-mpi/)
+# builds the Release preset into build/ (with --distributed: OpenMPI and PETSc).
+# Usage: scripts/setup.sh [preset]   (asan: clang, the sanitizer tests and the fuzz targets,
+# into build-asan/). Compiles go through ccache, whose cache lives outside the clone.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset="${1:-release}"
 
 packages=(build-essential cmake pkg-config libembree-dev libeigen3-dev libopenexr-dev
           libgtest-dev libcli11-dev zlib1g-dev nlohmann-json3-dev libcgal-dev
-          pybind11-dev python3-dev python3-numpy python3-scipy python3-matplotlib python3-pytest)
-# The fuzz preset builds with clang and links libFuzzer (from libclang-rt).
-[[ "$preset" == fuzz ]] && packages+=(clang libclang-rt-14-dev)
-# The mpi preset builds distributed support (--distributed) against OpenMPI and PETSc 3.18.
-[[ "$preset" == mpi ]] && packages+=(libopenmpi-dev openmpi-bin petsc-dev python3)
+          pybind11-dev python3-dev python3-numpy python3-scipy python3-matplotlib python3-pytest
+          ccache libopenmpi-dev openmpi-bin petsc-dev)
+# The asan preset builds with clang and links libFuzzer (from libclang-rt).
+[[ "$preset" == asan ]] && packages+=(clang libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -113,7 +113,7 @@ std::vector<std::pair<std::string, std::vector<Tri>>> plates_box(bool walls) {
   return s;
 }
 
-TEST(HeatCli, ConcentricSpheresMatchTheTwoSurfaceFormula) {
+TEST(HeatCliSlow, ConcentricSpheresMatchTheTwoSurfaceFormula) {
   const TempDir dir;
   // Level 2: 320 triangles per sphere; one patch each (--max-edge above every edge).
   const std::string stl = dir.write("spheres.stl", ascii_stl({{"inner", icosphere(1.0, 2, false)},
@@ -190,7 +190,7 @@ std::string coaxial_obj(double r1, double r2, double len, int n, int rows) {
   return s;
 }
 
-TEST(HeatCli, LongCoaxialCylindersMatchTheInfiniteFormulaInTheMiddle) {
+TEST(HeatCliSlow, LongCoaxialCylindersMatchTheInfiniteFormulaInTheMiddle) {
   const TempDir dir;
   const double r1 = 1.0, r2 = 2.0, len = 40.0;
   const std::string obj = dir.write("coax.obj", coaxial_obj(r1, r2, len, 24, 20));

@@ -159,7 +159,7 @@ TEST(HierarchicalRun, CornellBoxWritesEveryFileWithABalancedReport) {
 // err_m(4N) <= 2 (|B_h(eps) - B_h(eps/4)| + |B_m(N) - B_m(4N)|): a one-step estimate
 // underrates an error by 1/(1 - r), r the ratio of successive errors, 2 for r <= 1/2. The
 // matrix runs use hybrid with 4 samples: its visibility noise is part of |B_m(N) - B_m(4N)|.
-TEST(HierarchicalSolve, SurfaceAveragesAgreeWithTheMatrixMethodWithinBothErrors) {
+TEST(HierarchicalSolveSlow, SurfaceAveragesAgreeWithTheMatrixMethodWithinBothErrors) {
   testing::TempDir dir;
   const auto solve = [&](std::vector<std::string> args, const std::string& name) {
     args.insert(args.begin(), "solve");

@@ -250,7 +250,7 @@ TEST(MediumSolvers, EverySolverMatchesDirectOnTheExtendedSystem) {
   }
 }
 
-TEST(MediumSlab, PlateExchangeThroughAbsorbingSlabMatchesTwoE3) {
+TEST(MediumSlabSlow, PlateExchangeThroughAbsorbingSlabMatchesTwoE3) {
   // Plates W x W at distance d = 1, a purely absorbing slab of optical thickness tau = 1
   // filling the prism between them (every ray between the plates stays inside it).
   const double W = 8.0, d = 1.0, tau = 1.0;

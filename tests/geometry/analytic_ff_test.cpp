@@ -239,7 +239,7 @@ Scene cube_with_plate() {
   return s;
 }
 
-TEST(AnalyticEstimator, ClosedBoxWithTiltedPlateRowsSumToOne) {
+TEST(AnalyticEstimatorSlow, ClosedBoxWithTiltedPlateRowsSumToOne) {
   const PatchMesh mesh = mesh_scene(cube_with_plate(), {});  // one patch per face
   ASSERT_EQ(mesh.size(), 8);
   FormFactorOptions o;

@@ -118,7 +118,7 @@ void calibrate(const std::string& estimator, int samples) {
 
 }  // namespace
 
-TEST(ErrorBars, HybridCoverageAndSpreadAreCalibrated) { calibrate("hybrid", 64); }
+TEST(ErrorBarsSlow, HybridCoverageAndSpreadAreCalibrated) { calibrate("hybrid", 64); }
 TEST(ErrorBars, McCoverageAndSpreadAreCalibrated) { calibrate("mc", 256); }
 
 // A tapered receiver (width 2 -> 0.1) with its narrow half hidden: sampling a bilinear
@@ -190,7 +190,7 @@ double cyl_z(double t) { return t <= 1.0 / 3 ? -1.0 : t >= 2.0 / 3 ? 1.0 : 6.0 *
 // exactly. Large, partly hidden sphere patches are where a kernel-weighted ratio of few
 // rays was biased (+1.67 % with 16 segments); an unbiased visible fraction keeps every row
 // at 1 within its own error.
-TEST(ErrorBars, EnclosedCylinderPastABlockerHasRowSumsOfOne) {
+TEST(ErrorBarsSlow, EnclosedCylinderPastABlockerHasRowSumsOfOne) {
   Scene s;
   add_revolved(s, "sphere", 16, 8, false, sphere_r, sphere_z, {0, 0, 0});
   add_revolved(s, "emitter", 8, 3, true, cyl_r, cyl_z, {-1.2, 0, 0});

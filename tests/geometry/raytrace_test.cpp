@@ -300,7 +300,7 @@ TEST(FinalGather, FurnaceIsExactForAnyRayCount) {
   }
 }
 
-TEST(FinalGather, ConvergesToTheRadiositySolutionOverAPatch) {
+TEST(FinalGatherSlow, ConvergesToTheRadiositySolutionOverAPatch) {
   // The lit cube without blockers: F by the unoccluded quadrature (~1e-8 per entry), B by a
   // dense solve of (I − ρF) B = E. Over patch i, the final gather's expectation at x is
   // E_i + ρ_i (Σ_e E_e F_{x→e} + Σ_j (B_j − E_j) F_{x→j}); its mean over x uniform on i is
@@ -390,7 +390,7 @@ TEST(FinalGather, ConvergesToTheRadiositySolutionOverAPatch) {
 // (N = 256 rays per hit: ρ σ_g / √N, σ_g the spread of the B − E values the rays read, the
 // walls' reflected radiosity, below 1 here) adds at most ~0.5 / 16 = 0.03 to it. Measured:
 // difference 0.083, estimate 0.117 (seeded: deterministic).
-TEST(FinalGather, DiffersFromGouraudByLessThanTheMeshingErrorEstimate) {
+TEST(FinalGatherSlow, DiffersFromGouraudByLessThanTheMeshingErrorEstimate) {
   const Scene s = cube_of();
   const PatchMesh mesh = mesh_scene(s, {0.5, 0});
   const Bvh bvh(mesh);

@@ -160,7 +160,7 @@ Scene furnace_with_block() {
 // on the discontinuity mesh is the estimator's noise (hybrid, fixed seed). Also a
 // regression test: this scene (every face a source, many near-concurrent lines) crashed
 // CGAL's refinement before crossings were merged (split_at_crossings).
-TEST(DiscontinuityRadiosity, FurnaceWithABlockPerSurfaceAveragesBeatUniform) {
+TEST(DiscontinuityRadiositySlow, FurnaceWithABlockPerSurfaceAveragesBeatUniform) {
   const Scene scene = furnace_with_block();
   auto worst = [&](const PatchMesh& m) {
     const auto avg = surface_averages(m, solve_hybrid(m, 16).B);
@@ -189,7 +189,7 @@ TEST(DiscontinuityRadiosity, FurnaceWithABlockPerSurfaceAveragesBeatUniform) {
 // also a source in some of them: discontinuity meshing gives a conforming mesh with every
 // surface's area, and never crashes (such scenes crashed CGAL's refinement; a plane whose
 // lines it cannot refine is now meshed without them, with a warning).
-TEST(DiscontinuityMesh, RandomBoxScenesGiveValidMeshes) {
+TEST(DiscontinuityMeshSlow, RandomBoxScenesGiveValidMeshes) {
   Lcg uniform{2026};
   for (int trial = 0; trial < 8; ++trial) {
     Scene scene;
@@ -237,7 +237,7 @@ TEST(DiscontinuityMesh, RandomBoxScenesGiveValidMeshes) {
 // its silhouette's hundreds of short edges cast lines onto the floor, the walls and itself.
 // The lines' length budget per plane keeps the mesh within a few times the request
 // (measured 8,166 patches for 2,000); without it this scene made 64,554 (32x).
-TEST(DiscontinuityMesh, TessellatedBlockersStayWithinTheRequestedSize) {
+TEST(DiscontinuityMeshSlow, TessellatedBlockersStayWithinTheRequestedSize) {
   Scene scene;
   const Material grey{"grey", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
   const Material lamp{"lamp", Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()};
@@ -285,7 +285,7 @@ double floor_error(const PatchMesh& mesh, const Eigen::MatrixX3d& B) {
 // scene has no other light (the floor's indirect irradiance is exactly 0: the light and
 // the blocker do not reflect), so the errors are the meshes' alone and deterministic: no
 // Monte Carlo tolerance enters.
-TEST(DiscontinuityRadiosity, PenumbraLineErrorFiveTimesBelowUniform) {
+TEST(DiscontinuityRadiositySlow, PenumbraLineErrorFiveTimesBelowUniform) {
   const Scene scene = partial_shadow_scene();
   MeshOptions mo;
   mo.target_patches = 2000;
@@ -394,7 +394,7 @@ TEST(PartialShadowReference, FloorToLightFactorConverges) {
 
 // Adaptive meshing on the partial-shadow scene: the floor error falls round by round, and
 // at the final patch count it is below the uniform mesh's with as many patches.
-TEST(AdaptiveRadiosity, ImprovesMonotonicallyAndBeatsUniformAtEqualPatches) {
+TEST(AdaptiveRadiositySlow, ImprovesMonotonicallyAndBeatsUniformAtEqualPatches) {
   const Scene scene = partial_shadow_scene();
   FormFactorArgs ff;
   ff.estimator = "hybrid";

@@ -38,7 +38,7 @@ std::vector<Eigen::Vector3d> matrix_means(const Scene& scene, std::int64_t patch
 // the size of the reference's own discretisation error (its per-surface averages move by up
 // to 0.9 % from 2000 to 8000 patches, measured), so the methods agree as far as the
 // reference can tell; hybrid's visibility noise on surface averages is < 1e-3 relative.
-TEST(HierarchicalCornell, AgreesWithTheMatrixMethodAndConvergesAsEpsilonFalls) {
+TEST(HierarchicalCornellSlow, AgreesWithTheMatrixMethodAndConvergesAsEpsilonFalls) {
   const Scene scene = load_obj(builtin_cornell_box_path());
   const auto ref = matrix_means(scene, 2000);
   std::vector<double> worst;
