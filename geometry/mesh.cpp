@@ -29,7 +29,9 @@ struct SurfaceElements {
   std::vector<Element> elements;
 };
 
-SurfaceElements collect(const Scene& scene, std::int32_t surface) {
+// `faces`: the indices of the surface's faces, in scene order.
+SurfaceElements collect(const Scene& scene, std::int32_t surface,
+                        const std::vector<std::int32_t>& faces) {
   SurfaceElements out;
   std::map<std::array<double, 3>, std::int32_t> weld;  // exact-position welding
   auto local = [&](const Eigen::Vector3d& p) {
@@ -43,8 +45,8 @@ SurfaceElements collect(const Scene& scene, std::int32_t surface) {
   };
   std::vector<Eigen::Vector3d> poly;
   const Eigen::Vector3d& material_rho = scene.material_of(surface).rho;
-  for (const auto& f : scene.faces) {
-    if (f.surface != surface) continue;
+  for (const std::int32_t fi : faces) {
+    const auto& f = scene.faces[fi];
     const Eigen::Vector3d rho = f.rho ? *f.rho : material_rho;
     poly.clear();
     for (auto v : f.vertices) poly.push_back(scene.vertices[v]);
@@ -57,12 +59,17 @@ SurfaceElements collect(const Scene& scene, std::int32_t surface) {
       out.elements.push_back(e);
       continue;
     }
-    const double diam = polygon_diameter(poly);
+    // The polygon's scale: its bounding box's diagonal (the exact diameter was an O(n²) pair
+    // scan: seconds for a 20,000-gon).
+    const double diam = polygon_extent(poly);
     for (const auto& t : triangulate(poly)) {
-      // Skip slivers of a degenerate triangulation (collinear corners): zero area, no normal.
-      // Same relative threshold as the loader's zero-area test.
+      // Skip the slivers of collinear corners: zero area up to rounding, no normal. The cross
+      // product of two edges shorter than diam errs by a few eps diam² (eps = 2.2e-16), so
+      // 1e-13 diam² keeps every real triangle above 500x rounding: the ears of a fine convex
+      // polygon (consecutive corners 3e-4 rad apart on a circle: area 1.5e-11) are real
+      // area, and a relative 1e-10 (the loader's whole-face test) dropped them.
       const double area = 0.5 * (poly[t[1]] - poly[t[0]]).cross(poly[t[2]] - poly[t[0]]).norm();
-      if (area <= 1e-10 * diam * diam) continue;
+      if (area <= 1e-13 * diam * diam) continue;
       Element e;
       e.rho = rho;
       for (int k = 0; k < 3; ++k) e.v[k] = local(poly[t[k]]);
@@ -78,52 +85,102 @@ std::uint64_t edge_key(std::int32_t a, std::int32_t b) {
          static_cast<std::uint32_t>(b);
 }
 
+// The conformity constraints of mesh_scene as classes of edges: a triangle's three edges get
+// one segment count (a uniform n x n split), a quad's opposite edges one each, and an edge
+// shared by two elements has one count. The classes are the connected components of that
+// "same count" relation (union-find, near O(E)), so that the count of a class is the largest
+// ceil(length / max_edge) among its edges: what a fixpoint of pairwise maxima converges to,
+// without its passes (a chain of n elements, such as the fan of a convex n-gon, took O(n²)).
+struct EdgeClasses {
+  std::unordered_map<std::uint64_t, std::int32_t> edge;  ///< edge key -> class
+  std::vector<double> longest;                          ///< per class: its longest edge
+};
+
+EdgeClasses edge_classes(const SurfaceElements& s) {
+  std::unordered_map<std::uint64_t, std::int32_t> id;  // edge key -> edge index
+  std::vector<double> length;
+  auto edge_of = [&](const Element& e, int k) {
+    const auto a = e.v[k % e.n], b = e.v[(k + 1) % e.n];
+    const auto [it, added] = id.emplace(edge_key(a, b), static_cast<std::int32_t>(length.size()));
+    if (added) length.push_back((s.points[a] - s.points[b]).norm());
+    return it->second;
+  };
+  std::vector<std::int32_t> parent;
+  auto find = [&](std::int32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];  // path halving
+    return x;
+  };
+  auto unite = [&](std::int32_t a, std::int32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  };
+  std::vector<std::array<std::int32_t, 4>> element_edges;
+  element_edges.reserve(s.elements.size());
+  for (const auto& e : s.elements) {
+    std::array<std::int32_t, 4> ids{};
+    for (int k = 0; k < e.n; ++k) ids[k] = edge_of(e, k);
+    element_edges.push_back(ids);
+  }
+  parent.resize(length.size());
+  for (std::size_t k = 0; k < parent.size(); ++k) parent[k] = static_cast<std::int32_t>(k);
+  for (std::size_t i = 0; i < s.elements.size(); ++i) {
+    const auto& ids = element_edges[i];
+    if (s.elements[i].n == 3) {
+      unite(ids[0], ids[1]);
+      unite(ids[1], ids[2]);
+    } else {
+      unite(ids[0], ids[2]);
+      unite(ids[1], ids[3]);
+    }
+  }
+  EdgeClasses c;
+  std::vector<std::int32_t> class_of_root(parent.size(), -1);
+  for (std::size_t k = 0; k < parent.size(); ++k) {
+    const auto r = find(static_cast<std::int32_t>(k));
+    if (class_of_root[r] < 0) {
+      class_of_root[r] = static_cast<std::int32_t>(c.longest.size());
+      c.longest.push_back(0.0);
+    }
+  }
+  c.edge.reserve(id.size());
+  for (const auto& [key, k] : id) {
+    const auto cls = class_of_root[find(k)];
+    c.edge.emplace(key, cls);
+    c.longest[cls] = std::max(c.longest[cls], length[k]);
+  }
+  return c;
+}
+
+// Segments per class for `max_edge` (1 when max_edge <= 0: one element per face). Capped at
+// 1e9 segments so that counts and their products stay inside int64; any such mesh is refused
+// by mesh_scene's patch limit anyway.
+std::vector<std::int64_t> class_counts(const EdgeClasses& c, double max_edge) {
+  std::vector<std::int64_t> n(c.longest.size(), 1);
+  if (max_edge > 0)
+    for (std::size_t k = 0; k < n.size(); ++k)
+      n[k] = static_cast<std::int64_t>(std::clamp(std::ceil(c.longest[k] / max_edge), 1.0, 1e9));
+  return n;
+}
+
 // Segment counts per edge satisfying the conformity constraints (see mesh_scene).
 std::unordered_map<std::uint64_t, std::int64_t> edge_counts(const SurfaceElements& s,
                                                             double max_edge) {
+  const EdgeClasses c = edge_classes(s);
+  const std::vector<std::int64_t> n = class_counts(c, max_edge);
   std::unordered_map<std::uint64_t, std::int64_t> count;
-  for (const auto& e : s.elements) {
-    for (int k = 0; k < e.n; ++k) {
-      const auto a = e.v[k], b = e.v[(k + 1) % e.n];
-      const double len = (s.points[a] - s.points[b]).norm();
-      std::int64_t n = 1;
-      // Capped at 1e9 segments so that counts and their products stay inside int64; any
-      // such mesh is refused by mesh_scene's patch limit anyway.
-      if (max_edge > 0) n = static_cast<std::int64_t>(std::clamp(std::ceil(len / max_edge), 1.0, 1e9));
-      count[edge_key(a, b)] = n;
-    }
-  }
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (const auto& e : s.elements) {
-      auto key = [&](int k) { return edge_key(e.v[k % e.n], e.v[(k + 1) % e.n]); };
-      auto unify = [&](std::initializer_list<int> edges) {
-        std::int64_t m = 0;
-        for (int k : edges) m = std::max(m, count[key(k)]);
-        for (int k : edges) {
-          if (count[key(k)] != m) {
-            count[key(k)] = m;
-            changed = true;
-          }
-        }
-      };
-      if (e.n == 3) {
-        unify({0, 1, 2});
-      } else {
-        unify({0, 2});
-        unify({1, 3});
-      }
-    }
-  }
+  count.reserve(c.edge.size());
+  for (const auto& [key, cls] : c.edge) count.emplace(key, n[cls]);
   return count;
 }
 
-std::int64_t count_patches(const SurfaceElements& s, double max_edge) {
-  const auto count = edge_counts(s, max_edge);
+// Patches of one surface at `max_edge`, from its edge classes (O(elements)).
+std::int64_t count_patches(const SurfaceElements& s, const EdgeClasses& c, double max_edge) {
+  const std::vector<std::int64_t> n = class_counts(c, max_edge);
   std::int64_t total = 0;
   for (const auto& e : s.elements) {
-    const auto n0 = count.at(edge_key(e.v[0], e.v[1]));
-    const auto n1 = count.at(edge_key(e.v[1], e.v[2]));
+    const auto n0 = n[c.edge.at(edge_key(e.v[0], e.v[1]))];
+    const auto n1 = n[c.edge.at(edge_key(e.v[1], e.v[2]))];
     total += e.n == 3 ? n0 * n0 : n0 * n1;
   }
   return total;
@@ -260,19 +317,32 @@ std::string shortest(double x) {
   return buf;
 }
 
+// Every surface's elements, faces bucketed by surface first: O(faces + surfaces), where a
+// scan of every face for every surface was quadratic on scenes of many one-face surfaces.
 std::vector<SurfaceElements> collect_all(const Scene& scene) {
+  std::vector<std::vector<std::int32_t>> faces(scene.surfaces.size());
+  for (std::size_t f = 0; f < scene.faces.size(); ++f) {
+    const auto surface = scene.faces[f].surface;
+    LAMBERT_CHECK(surface >= 0 && static_cast<std::size_t>(surface) < faces.size(),
+                  "a face of no surface");
+    faces[surface].push_back(static_cast<std::int32_t>(f));
+  }
   std::vector<SurfaceElements> surfaces;
+  surfaces.reserve(scene.surfaces.size());
   for (size_t s = 0; s < scene.surfaces.size(); ++s)
-    surfaces.push_back(collect(scene, static_cast<std::int32_t>(s)));
+    surfaces.push_back(collect(scene, static_cast<std::int32_t>(s), faces[s]));
   return surfaces;
 }
 
 MeshPlan plan_surfaces(const Scene& scene, const std::vector<SurfaceElements>& surfaces,
                        const MeshOptions& options) {
   LAMBERT_CHECK(options.max_edge >= 0 && options.target_patches >= 0, "negative mesh target");
+  std::vector<EdgeClasses> classes;  // once per surface, reused by every step of the search
+  classes.reserve(surfaces.size());
+  for (const auto& s : surfaces) classes.push_back(edge_classes(s));
   auto total = [&](double h) {
     std::int64_t t = 0;
-    for (const auto& s : surfaces) t += count_patches(s, h);
+    for (std::size_t k = 0; k < surfaces.size(); ++k) t += count_patches(surfaces[k], classes[k], h);
     return t;
   };
   double max_edge = options.max_edge;
