@@ -136,11 +136,15 @@ SparseRowMatrix csr_from_arrays(std::int64_t n, const IndexArray& indptr, const 
   const std::int64_t* c = indices.data();
   const double* v = data.data();
   if (p[0] != 0 || p[n] != nnz) throw UsageError(what + ": indptr must run from 0 to nnz");
+  // indptr whole before any use of it (a reserve or a row's range): a decreasing or
+  // overshooting entry would size rows negative or read past indices and data.
+  for (std::int64_t i = 0; i < n; ++i)
+    if (p[i + 1] < p[i] || p[i + 1] > nnz)
+      throw UsageError(what + ": indptr decreases or passes nnz at row " + std::to_string(i));
   SparseRowMatrix F(n, n);
   F.reserve(Eigen::Matrix<std::int64_t, Eigen::Dynamic, 1>::Map(p, n + 1).tail(n) -
             Eigen::Matrix<std::int64_t, Eigen::Dynamic, 1>::Map(p, n + 1).head(n));
   for (std::int64_t i = 0; i < n; ++i) {
-    if (p[i + 1] < p[i]) throw UsageError(what + ": indptr decreases at row " + std::to_string(i));
     for (std::int64_t k = p[i]; k < p[i + 1]; ++k) {
       if (c[k] < 0 || c[k] >= n || (k > p[i] && c[k] <= c[k - 1]))
         throw UsageError(what + ": row " + std::to_string(i) +

@@ -227,6 +227,11 @@ def _csr_arrays(F, mesh, name):
     if F.shape != (n, n):
         raise UsageError(f"{name} has shape {F.shape}, the mesh has {n} patches")
     F = F.tocsr()
+    # indptr checked before scipy's own routines walk it (sum_duplicates trusts it).
+    ip = _np.asarray(F.indptr)
+    if (ip.ndim != 1 or len(ip) != n + 1 or ip[0] != 0 or ip[-1] != len(F.indices)
+            or len(F.data) != len(F.indices) or (_np.diff(ip) < 0).any()):
+        raise UsageError(f"{name}: indptr must run from 0 to nnz without decreasing")
     if not F.has_canonical_format:
         F = F.copy()
         F.sum_duplicates()

@@ -202,6 +202,26 @@ def test_wrong_arguments_raise_not_crash(cornell_mesh):
     assert issubclass(lambert.UsageError, ValueError)
 
 
+# Regression (issue 33, item 5): an F whose indptr is not monotone corrupted the heap in
+# lambert.solve (free(): invalid size) or leaked a RuntimeError; now a UsageError, from the
+# Python checks and, below them, from the extension's own (called directly).
+def test_non_monotone_indptr_is_a_usage_error(cornell_mesh):
+    import lambert._lambert as ext
+    n = len(cornell_mesh)
+    F = sp.csr_matrix((np.full(3, 0.1), ([0, 1, 2], [1, 2, 0])), shape=(n, n))
+    for bad in ((3, 1), (2, 0)):  # indptr[1], indptr[2]: decreasing
+        G = F.copy()
+        G.indptr[1], G.indptr[2] = bad
+        with pytest.raises(lambert.UsageError, match="indptr"):
+            lambert.solve(cornell_mesh, G)
+    indptr = F.indptr.astype(np.int64).copy()
+    indices = F.indices.astype(np.int64)
+    indptr[1], indptr[2] = 3, 1  # row 0 would run past row 1's start
+    with pytest.raises(lambert.UsageError, match="indptr"):
+        ext.solve(cornell_mesh, indptr, indices, F.data.astype(np.float64), "gauss-seidel",
+                  1e-8, 100, 1.5, "diagonal", 30, 1, None, {})
+
+
 def test_medium_solve_equals_the_cli(tmp_path, cornell):
     fog = ["--medium-box", "0,0,0,556,548.8,559.2", "--sigma-a", "0.001,0.001,0.001",
            "--voxels", 4, "--medium-rays", 64]
