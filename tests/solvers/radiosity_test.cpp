@@ -134,6 +134,51 @@ TEST(SolverRegistry, NamesAreUniqueDescribedAndInRegistryOrder) {
   EXPECT_STREQ(to_string(SolveStatus::MaxIterations), "max-iterations");
 }
 
+// Regression (issue 33, item 6): an F that physics forbids solved to "converged" with
+// negative B and negative absorbed power. Now refused before any iteration, for every
+// solver: row sums of 10, a negative entry, an entry above 1. Row sums up to 1.25 (Monte
+// Carlo noise, radiosity.cpp's kRowSlack) are accepted and, with rho 0.5 (K an M-matrix),
+// solve to B >= 0. With every row summing to 1.2 and rho 0.99, rho F has spectral radius
+// 1.188 (a non-negative matrix with constant row sums c has radius c): the Neumann series
+// diverges, K^-1 E is not >= 0, and no solver may report it as converged.
+TEST(SolveRadiosity, ImpossibleFormFactorsAreRefusedOrNotConverged) {
+  OwnedProblem o;
+  make_open(o, 40, 5, 0.0);
+  o.p.rho.setConstant(0.5);
+  ASSERT_NO_THROW(validate_problem(o.p)) << "the open system itself is physical";
+  auto refused = [&](SparseRowMatrix F, const char* what) {
+    o.F = std::move(F);
+    o.p.F = std::make_shared<CsrOperator>(o.F);
+    for (const auto& name : solver_names())
+      EXPECT_THROW(solve_radiosity(o.p, options_for(name, 1e-8)), SceneError) << what << name;
+  };
+  const SparseRowMatrix good = o.F;  // row sums <= 0.95
+  refused(good * 10.0, "row sums of 10 ");
+  SparseRowMatrix negative = good;
+  negative.valuePtr()[3] = -0.01;
+  refused(negative, "a negative entry ");
+  SparseRowMatrix above_one = good;
+  above_one.valuePtr()[0] = 1.5;
+  refused(above_one, "an entry above 1 ");
+  o.F = good * (1.2 / 0.95);  // row sums up to 1.2
+  o.p.F = std::make_shared<CsrOperator>(o.F);
+  const RadiositySolution s = solve_radiosity(o.p, options_for("gauss-seidel", 1e-10));
+  EXPECT_EQ(s.status, SolveStatus::Converged);
+  EXPECT_GE(s.B.minCoeff(), 0.0);
+  OwnedProblem e;  // a closed enclosure (rows sum to 1, ~24 entries each), scaled by 1.2
+  make_enclosure(e, 40, 11);
+  e.F *= 1.2;
+  e.p.F = std::make_shared<CsrOperator>(e.F);
+  e.p.rho = Eigen::MatrixX3d::Constant(40, 3, 0.99);
+  e.p.emission = Eigen::MatrixX3d::Ones(40, 3);
+  for (const auto& name : solver_names()) {
+    SolveOptions opt = options_for(name, 1e-10);
+    opt.max_iterations = 2000;
+    const RadiositySolution r = solve_radiosity(e.p, opt);
+    EXPECT_NE(r.status, SolveStatus::Converged) << name << ": min B " << r.B.minCoeff();
+  }
+}
+
 // The furnace: a closed enclosure of n patches, uniform rho and E; returns the largest
 // row-sum defect |sum_j F_ij - 1|.
 double make_furnace(OwnedProblem& o, int n, const Eigen::Vector3d& rho, const Eigen::Vector3d& e) {
