@@ -93,7 +93,7 @@ std::uint64_t edge_key(std::int32_t a, std::int32_t b) {
 // without its passes (a chain of n elements, such as the fan of a convex n-gon, took O(n²)).
 struct EdgeClasses {
   std::unordered_map<std::uint64_t, std::int32_t> edge;  ///< edge key -> class
-  std::vector<double> longest;                          ///< per class: its longest edge
+  std::vector<double> longest;                           ///< per class: its longest edge
 };
 
 EdgeClasses edge_classes(const SurfaceElements& s) {
@@ -342,7 +342,8 @@ MeshPlan plan_surfaces(const Scene& scene, const std::vector<SurfaceElements>& s
   for (const auto& s : surfaces) classes.push_back(edge_classes(s));
   auto total = [&](double h) {
     std::int64_t t = 0;
-    for (std::size_t k = 0; k < surfaces.size(); ++k) t += count_patches(surfaces[k], classes[k], h);
+    for (std::size_t k = 0; k < surfaces.size(); ++k)
+      t += count_patches(surfaces[k], classes[k], h);
     return t;
   };
   double max_edge = options.max_edge;

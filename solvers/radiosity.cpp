@@ -243,8 +243,8 @@ RadiositySolution solve_radiosity(const RadiosityProblem& problem, const SolveOp
     for (int c = 0; c < 3; ++c) {
       const double rho_max = problem.rho.col(c).maxCoeff();
       const double e_norm = problem.emission.col(c).norm();
-      const double bound = 10.0 * options.tol *
-                           (rho_max < 1.0 ? e_norm / (1.0 - rho_max) : sol.B.col(c).maxCoeff());
+      const double bound =
+          10.0 * options.tol * (rho_max < 1.0 ? e_norm / (1.0 - rho_max) : sol.B.col(c).maxCoeff());
       if (sol.B.col(c).minCoeff() < -bound) sol.status = SolveStatus::NumericalIssue;
     }
   }

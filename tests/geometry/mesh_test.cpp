@@ -174,8 +174,8 @@ TEST(Mesh, EightyThousandOneFaceSurfacesKeepTheirFaces) {
     s.surfaces.push_back({"s" + std::to_string(k), 0});
     Face f;
     f.surface = k;
-    for (const Eigen::Vector3d& c : {Eigen::Vector3d(x, y, 0), Eigen::Vector3d(x + 1, y, 0),
-                                     Eigen::Vector3d(x, y + 1, 0)}) {
+    for (const Eigen::Vector3d& c :
+         {Eigen::Vector3d(x, y, 0), Eigen::Vector3d(x + 1, y, 0), Eigen::Vector3d(x, y + 1, 0)}) {
       f.vertices.push_back(static_cast<std::int32_t>(s.vertices.size()));
       s.vertices.push_back(c);
     }
