@@ -112,24 +112,30 @@ std::vector<Polygon3> visible_emitter_region(const Eigen::Vector3d& x, const Eig
   // would divide by rounding noise (a patch touching the emitter's plane along an edge puts
   // refined quadrature points there). The rounding of dx is relative to the coordinates'
   // magnitude, so the tolerance is too (ff::kPlaneEps, the one plane epsilon).
-  if (!(dx > ff::kPlaneEps * (x.norm() + f.o.norm() + polygon_extent(emitter)))) return {};
+  const double plane_tol = ff::kPlaneEps * (x.norm() + f.o.norm() + polygon_extent(emitter));
+  if (!(dx > plane_tol)) return {};
   PolygonSet2 visible = polygon_set(emitter, f);
 
   // The horizon: emitter points y with n . (y - x) > 0, the half-plane a + b s + c t > 0.
+  // Corners within plane_tol of x's tangent plane count as on it: an emitter sharing an edge
+  // with x's surface (a wall and the floor) has corners there whose computed height is
+  // rounding noise of either sign, and cutting along that noise put a corner at an
+  // arbitrary point of the shared edge. What lies behind such corners is a sliver on
+  // which cos θ_x <= plane_tol / distance, far below the factor's rounding.
   const double a = n.dot(f.o - x), b = n.dot(f.u), c = n.dot(f.v);
   double lo_val = INFINITY, hi_val = -INFINITY, extent = 0.0;
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   for (const auto& p : emitter) {
     const Eigen::Vector2d q((p - f.o).dot(f.u), (p - f.o).dot(f.v));
-    const double val = a + b * q.x() + c * q.y();
+    const double val = n.dot(p - x);
     lo_val = std::min(lo_val, val);
     hi_val = std::max(hi_val, val);
     centre += q / static_cast<double>(emitter.size());
   }
   for (const auto& p : emitter)
     extent = std::max(extent, (Eigen::Vector2d((p - f.o).dot(f.u), (p - f.o).dot(f.v)) - centre).norm());
-  if (hi_val <= 0.0) return {};  // wholly behind x's horizon
-  if (lo_val < 0.0) {
+  if (hi_val <= plane_tol) return {};  // behind x's horizon, or on it within rounding
+  if (lo_val < -plane_tol) {
     // A rectangle covering the positive side of the line within the emitter's disc.
     const Eigen::Vector2d normal = Eigen::Vector2d(b, c).normalized();
     const double g = std::hypot(b, c);
