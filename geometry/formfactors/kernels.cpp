@@ -33,8 +33,9 @@ bool can_exchange(const PatchGeom& a, const PatchGeom& b, double eps) {
 }
 
 int clip_to_horizon(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& g,
-                    Eigen::Vector3d* out) {
-  // Sutherland-Hodgman clip of the polygon (relative to x) against n_x · r >= 0.
+                    ClippedCorners& out) {
+  // Sutherland-Hodgman clip of the polygon (relative to x) against n_x · r >= 0: at most
+  // kMaxClippedCorners corners (a warped quad crossed on all four edges).
   Eigen::Vector3d in[4];
   double d[4];
   bool all_front = true;
@@ -78,9 +79,9 @@ double contour_factor(const Eigen::Vector3d& nx, const Eigen::Vector3d* r, int m
 
 double point_to_patch(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& g) {
   if (g.normal.dot(x - g.p[0]) <= 0.0) return 0.0;  // x behind the receiving patch
-  Eigen::Vector3d out[5];
+  ClippedCorners out;
   const int m = clip_to_horizon(x, nx, g, out);
-  return m < 3 ? 0.0 : contour_factor(nx, out, m);
+  return m < 3 ? 0.0 : contour_factor(nx, out.data(), m);
 }
 
 namespace {

@@ -76,10 +76,20 @@ inline Eigen::Vector3d quadrature_point(const PatchGeom& g, double u, double v,
   return sample_patch(g, u, v, jacobian);
 }
 
+/// Most corners a patch keeps when clipped by a plane (clip_to_horizon): its corners in front
+/// plus one point per edge the plane crosses. A plane crosses a planar convex quad on 2 edges
+/// at most (5 corners), but a warped quad on all 4 when it passes within the warp of the
+/// quad's plane (2 corners in front + 4 crossings): the OBJ loader keeps quads off their plane
+/// by up to 1e-4 of their extent as quads, and a point of a neighbouring, nearly coplanar face
+/// sees them that way (a hexagon, whose contour sum is still the factor of the loop).
+constexpr int kMaxClippedCorners = 6;
+/// The corners of a clipped patch, relative to the clipping point.
+using ClippedCorners = std::array<Eigen::Vector3d, kMaxClippedCorners>;
+
 /// The corners of patch g relative to x, clipped to the half-space in front of x
-/// (n_x · r >= 0); writes up to 5 corners to `out` and returns their count (< 3: nothing).
+/// (n_x · r >= 0); writes them to `out` and returns their count (< 3: nothing).
 int clip_to_horizon(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& g,
-                    Eigen::Vector3d* out);
+                    ClippedCorners& out);
 
 /// Point-to-polygon form factor (Lambert's contour formula, exact):
 ///   F_{dx->P} = -(1/2π) Σ_k θ_k  n_x · (r_k × r_{k+1}) / |r_k × r_{k+1}|

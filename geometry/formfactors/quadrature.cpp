@@ -16,7 +16,7 @@ void front_part(const PatchGeom& a, const PatchGeom& b, std::vector<PatchGeom>& 
     pieces.push_back(a);
     return;
   }
-  Eigen::Vector3d poly[8];  // <= 5 used: a plane cuts a quad into at most a pentagon
+  Eigen::Vector3d poly[kMaxClippedCorners];  // a plane cuts a warped quad into a hexagon
   int m = 0;
   for (int k = 0; k < a.n; ++k) {
     const int l = (k + 1) % a.n;

@@ -65,18 +65,19 @@ KernelSampler::KernelSampler(const Eigen::Vector3d& x, const Eigen::Vector3d& nx
     : x_(x), nx_(nx), nb_(b.normal), plane_(b.normal.dot(b.p[0])) {
   const double height = nb_.dot(x) - plane_;  // x's height above b's plane
   if (!(height > 0.0)) return;               // b's back faces x: nothing to receive
-  Eigen::Vector3d r[5];
+  ClippedCorners r;
   const int m = clip_to_horizon(x, nx, b, r);
   if (m < 3) return;
-  factor_ = contour_factor(nx, r, m);
+  factor_ = contour_factor(nx, r.data(), m);
   if (!(factor_ > 0.0)) return;
-  Eigen::Vector3d w[5];
+  ClippedCorners w;
   for (int k = 0; k < m; ++k) w[k] = r[k].normalized();
-  const double cos_max = max_cosine(nx, w, m);
+  const double cos_max = max_cosine(nx, w.data(), m);
   // The fan's triangle areas, and the solid angle they subtend to first order (A cosθ / r²
   // at each centroid, cosθ = height / r): below kSmallSolidAngle, area sampling; above,
   // the exact solid angles (an atan2 each) for Arvo's sampling.
-  double measure[3] = {0, 0, 0}, estimate = 0.0;
+  std::array<double, kMaxClippedCorners - 2> measure{};
+  double estimate = 0.0;
   for (int k = 0; k + 2 < m; ++k) {
     measure[k] = 0.5 * (r[k + 1] - r[0]).cross(r[k + 2] - r[0]).norm();
     const double rc = ((r[0] + r[k + 1] + r[k + 2]) / 3.0).norm();

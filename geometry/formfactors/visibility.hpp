@@ -42,12 +42,12 @@ class KernelSampler {
  private:
   Eigen::Vector3d try_once(double u0, double u1, double u2, double& accept) const;
   Eigen::Vector3d x_, nx_, nb_;
-  double plane_ = 0.0;            // n_b · p_b
-  Eigen::Vector3d w_[5];          // clipped corners (unit directions, or points in area mode)
-  double cdf_[3] = {0, 0, 0};     // fan triangles (0, k+1, k+2), cumulative measure
+  double plane_ = 0.0;  // n_b · p_b
+  ClippedCorners w_;    // clipped corners (unit directions, or points in area mode)
+  std::array<double, kMaxClippedCorners - 2> cdf_{};  // fan triangles (0, k+1, k+2), cumulative
   int triangles_ = 0;
   bool area_mode_ = false;
-  double bound_ = 1.0;            // upper bound of the acceptance numerator
+  double bound_ = 1.0;  // upper bound of the acceptance numerator
   double factor_ = 0.0;
 };
 

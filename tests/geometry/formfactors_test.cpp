@@ -7,6 +7,8 @@
 
 #include "core/error.hpp"
 #include "geometry/analytic.hpp"
+#include "geometry/formfactors/kernels.hpp"
+#include "geometry/formfactors/visibility.hpp"
 
 namespace lambert {
 namespace {
@@ -350,6 +352,45 @@ TEST(FormFactors, ThresholdDropsPairsTogetherAndKeepsReciprocity) {
   EXPECT_EQ(kept.F.coeff(1, 0), f_small);
   o.threshold = 2 * f_small;  // above both
   EXPECT_EQ(compute_form_factors(mesh, o).F.nonZeros(), 0);
+}
+
+TEST(KernelSampler, WarpedNeighbourQuadClipsToAHexagonAndSamplesOnIt) {
+  // A unit tile whose corners alternate between z = 0 and delta (5e-5 of it off its mean
+  // plane: the OBJ loader keeps it a quad), seen from a point of a flat neighbour that lies
+  // inside that warp and sees q (F > 0): the horizon crosses all four edges, 2 corners + 4
+  // crossings (issue 33: one more corner than point_to_patch and KernelSampler had room for).
+  const double delta = 1e-4;
+  ff::PatchGeom q;
+  q.n = 4;
+  q.p = {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(2, 0, delta), Eigen::Vector3d(2, 1, 0),
+         Eigen::Vector3d(1, 1, delta)};
+  q.normal = Eigen::Vector3d::UnitZ();
+  q.centroid = Eigen::Vector3d(1.5, 0.5, 0.5 * delta);
+  q.area = 1.0;
+  const Eigen::Vector3d x(0.75, 0.2, delta / 2), nx = Eigen::Vector3d::UnitZ();
+  ff::ClippedCorners r;
+  ASSERT_EQ(ff::clip_to_horizon(x, nx, q, r), ff::kMaxClippedCorners);
+  // Every point of q lies within elevation alpha of x's horizon, sin alpha <= delta / 0.25
+  // (heights <= delta, distances >= 0.25), and the projected solid angle of that band is
+  // pi sin^2 alpha: 0 <= F <= sin^2 alpha.
+  const double f = ff::point_to_patch(x, nx, q);
+  EXPECT_GE(f, 0.0);
+  EXPECT_LE(f, std::pow(delta / 0.25, 2));
+  const ff::KernelSampler sampler(x, nx, q);
+  EXPECT_EQ(sampler.factor(), f);
+  ASSERT_FALSE(sampler.empty());
+  // The samples lie on q: within its bounding box (rounding aside).
+  Eigen::AlignedBox3d box;
+  for (const auto& p : q.p) box.extend(p);
+  box.extend(box.min() - Eigen::Vector3d::Constant(1e-12));
+  box.extend(box.max() + Eigen::Vector3d::Constant(1e-12));
+  Rng rng(7);
+  for (int k = 0; k < 64; ++k) {
+    bool exhausted = false;
+    const Eigen::Vector3d y =
+        sampler.sample(rng.uniform(), rng.uniform(), rng.uniform(), rng, exhausted);
+    EXPECT_TRUE(box.contains(y)) << "sample " << k << ": " << y.transpose();
+  }
 }
 
 }  // namespace lambert
