@@ -305,3 +305,48 @@ TEST(Hierarchical, AClusterHandsLightOnlyToFacesTurnedTowardsIt) {
 
 }  // namespace
 }  // namespace lambert
+namespace lambert {
+namespace {
+
+// A floor of n x n unit tiles whose corners alternate between the heights 0 and delta, so
+// every tile is a saddle off its mean plane by delta / 2 and neighbours share their corners
+// (a real floor whose vertices were rounded), under a sky square at `height` facing down.
+Scene warped_floor_under_sky(int n, double delta, double height) {
+  Scene s;
+  auto corner = [&](int i, int j) { return V(i, j, (i + j) % 2 ? delta : 0.0); };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      add_polygon(s, "floor", mat("floor", 0.5, 0),
+                  {corner(i, j), corner(i + 1, j), corner(i + 1, j + 1), corner(i, j + 1)});
+  add_polygon(s, "sky", mat("sky", 0, 1), rect(0, n, 0, n, height, false));
+  return s;
+}
+
+TEST(Hierarchical, WarpedFloorTilesUnderASkyMatchTheFlatFloor) {
+  // Issue 33 (Sponza's floor under a sky quad crashed in element_link): a quad off its plane
+  // by up to 1e-4 of its extent stays a quad (the OBJ loader's kPlanarityRelTol), and from a
+  // point of a neighbouring tile, which lies within that warp of the tile's mean plane, the
+  // horizon cuts all four of its edges: 6 clipped corners, one more than the kernels had room
+  // for (point_to_patch, KernelSampler), which overwrote the sampler's fan and crashed. Here
+  // the warp is 5e-5 of a tile (delta = 1e-4, half of it off the mean plane).
+  const int n = 3;
+  const double delta = 1e-4, height = 1.0;
+  const Scene s = warped_floor_under_sky(n, delta, height);
+  const HierarchicalResult r = solve_hierarchical(s, options(1e-3));
+  ASSERT_TRUE(r.stats.converged);
+  const Mean m = surface_mean(r, 0);
+  // The floor only reflects what the sky sends (the tiles see each other at grazing angles
+  // through their warp only): its mean B is half its mean factor to the sky, that of the flat
+  // floor at the mean height delta / 2 (closed form). The warp moves the floor's points by
+  // delta / 2 and tilts them by ~delta: a relative change of ~2 delta / height in the factor
+  // and ~delta from the tiles' mutual exchange, 3e-4 in all; 1e-3 of the value covers it.
+  const double G = parallel_rectangles_G(0, n, 0, n, 0, n, 0, n, height - 0.5 * delta);
+  const double exact = 0.5 * G / m.area;
+  EXPECT_NEAR(m.B, exact, m.bound + 1e-3 * exact)
+      << "leaves " << r.stats.leaves << " links " << r.stats.links;
+  // Energy: the Jacobi sweeps stop at a relative change of 1e-12 (FurnaceGivesEOverOneMinusRho).
+  EXPECT_LT(r.stats.energy[0].relative_imbalance, 1e-9);
+}
+
+}  // namespace
+}  // namespace lambert
