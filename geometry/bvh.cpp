@@ -2,7 +2,9 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -71,10 +73,53 @@ std::shared_ptr<RTCDeviceTy> process_device(int threads) {
 
 }  // namespace
 
+// Embree works in single precision, and its intersection tests multiply three coordinates
+// (cross products dotted with the direction): scene coordinates near 1e13 overflow float
+// there (3.4e38) and near 1e-13 underflow, so occlusion was lost and the Cornell box scaled
+// by 3e10 or 1e-20 gave wrong factors (issue 33, item 4). The BVH therefore holds the scene
+// scaled by a power of two, 2^-e with the largest |coordinate| in [2^(e-1), 2^e): inside
+// (-1, 1), exactly (a power-of-two scale commutes with rounding), and every query is scaled
+// by the same factor (origin and direction alike, so ray parameters t are unchanged).
+// kMaxCoordinate, kMinCoordinate: the scene magnitudes whose single-precision images stay
+// normal numbers with room for the callers' arithmetic (float spans 1.2e-38 .. 3.4e38).
+constexpr double kMaxCoordinate = 1e30, kMinCoordinate = 1e-30;
+// Embree refuses (asserts on) rays whose origin or direction exceed 1.844e18 in magnitude.
+constexpr float kMaxRayComponent = 1e18f;
+
 struct Bvh::Impl {
   std::shared_ptr<RTCDeviceTy> device;
   std::unique_ptr<RTCSceneTy, SceneDeleter> scene;  // released before the device
+  int exponent = 0;                                 // the BVH holds the scene scaled by 2^exponent
 };
+
+namespace {
+// A query in the BVH's frame: origin and direction scaled by 2^exponent, and the direction
+// by a further 2^-shift when its length is far from 1 (a unit camera ray in a tiny scene),
+// ray parameters by 2^shift to match. Every factor is a power of two: nothing is rounded.
+struct FrameRay {
+  Eigen::Vector3f o, d;
+  int shift = 0;  // t in the BVH's frame = t * 2^shift
+};
+
+// Throws SceneError for a ray Embree cannot take (a medium box or sensor point far outside
+// the scene, a non-finite origin).
+FrameRay to_bvh_frame(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
+                      int exponent) {
+  FrameRay r;
+  for (int k = 0; k < 3; ++k) r.o[k] = std::ldexp(origin[k], exponent);
+  const float length = std::ldexp(direction.cwiseAbs().maxCoeff(), exponent);
+  if (length > 0.0f && std::isfinite(length) && (length > 0x1p30f || length < 0x1p-30f))
+    r.shift = std::ilogb(length) + 1;
+  for (int k = 0; k < 3; ++k) r.d[k] = std::ldexp(direction[k], exponent - r.shift);
+  if (!(r.o.cwiseAbs().maxCoeff() <= kMaxRayComponent &&
+        r.d.cwiseAbs().maxCoeff() <= kMaxRayComponent))
+    throw SceneError("a ray from (" + std::to_string(origin.x()) + ", " +
+                     std::to_string(origin.y()) + ", " + std::to_string(origin.z()) +
+                     ") lies too far outside the scene for the ray tracer (more than 1e18 "
+                     "times the scene's size; a medium box or point far beyond the geometry?)");
+  return r;
+}
+}  // namespace
 
 std::int64_t Bvh::builds() { return g_builds.load(); }
 
@@ -85,6 +130,15 @@ std::int64_t Bvh::devices() {
 }
 
 Bvh::Bvh(const PatchMesh& mesh, int threads) : impl_(std::make_unique<Impl>()) {
+  double largest = 0.0;
+  for (const auto& v : mesh.vertices) largest = std::max(largest, v.cwiseAbs().maxCoeff());
+  if (!mesh.vertices.empty()) {
+    if (!(largest <= kMaxCoordinate) || largest < kMinCoordinate)
+      throw SceneError("the scene's coordinates reach " + std::to_string(largest) +
+                       " in magnitude: the ray tracer (single precision) needs them between "
+                       "1e-30 and 1e30; rescale the scene (e.g. other length units)");
+    if (largest > 0.0) impl_->exponent = -(std::ilogb(largest) + 1);
+  }
   ++g_builds;
   impl_->device = process_device(threads);
   RTCDevice device = impl_->device.get();
@@ -109,7 +163,8 @@ Bvh::Bvh(const PatchMesh& mesh, int threads) : impl_(std::make_unique<Impl>()) {
     throw Error("embree: cannot allocate geometry buffers");
   }
   for (size_t v = 0; v < mesh.vertices.size(); ++v)
-    for (int d = 0; d < 3; ++d) vb[3 * v + d] = static_cast<float>(mesh.vertices[v][d]);
+    for (int d = 0; d < 3; ++d)
+      vb[3 * v + d] = static_cast<float>(std::ldexp(mesh.vertices[v][d], impl_->exponent));
   for (size_t p = 0; p < mesh.patches.size(); ++p) {
     const auto& patch = mesh.patches[p];
     for (int k = 0; k < 4; ++k)
@@ -128,15 +183,16 @@ bool Bvh::occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& directi
                    float tfar) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
+  const FrameRay f = to_bvh_frame(origin, direction, impl_->exponent);
   RTCRay ray;
-  ray.org_x = origin.x();
-  ray.org_y = origin.y();
-  ray.org_z = origin.z();
-  ray.dir_x = direction.x();
-  ray.dir_y = direction.y();
-  ray.dir_z = direction.z();
-  ray.tnear = tnear;
-  ray.tfar = tfar;
+  ray.org_x = f.o.x();
+  ray.org_y = f.o.y();
+  ray.org_z = f.o.z();
+  ray.dir_x = f.d.x();
+  ray.dir_y = f.d.y();
+  ray.dir_z = f.d.z();
+  ray.tnear = std::ldexp(tnear, f.shift);
+  ray.tfar = std::ldexp(tfar, f.shift);
   ray.time = 0.0f;
   ray.mask = 0xFFFFFFFFu;
   ray.id = 0;
@@ -155,12 +211,14 @@ bool collect_patch(RTCPointQueryFunctionArguments* args) {
 
 void Bvh::patches_near(const Eigen::Vector3d& centre, double radius,
                        std::vector<std::int32_t>& out) const {
+  const int e = impl_->exponent;
   RTCPointQuery query;
-  query.x = static_cast<float>(centre.x());
-  query.y = static_cast<float>(centre.y());
-  query.z = static_cast<float>(centre.z());
+  query.x = static_cast<float>(std::ldexp(centre.x(), e));
+  query.y = static_cast<float>(std::ldexp(centre.y(), e));
+  query.z = static_cast<float>(std::ldexp(centre.z(), e));
   query.time = 0.0f;
-  query.radius = static_cast<float>(radius * (1.0 + 1e-6) + 1e-6 * centre.lpNorm<Eigen::Infinity>());
+  query.radius = static_cast<float>(
+      std::ldexp(radius * (1.0 + 1e-6) + 1e-6 * centre.lpNorm<Eigen::Infinity>(), e));
   RTCPointQueryContext context;
   rtcInitPointQueryContext(&context);
   rtcPointQuery(impl_->scene.get(), &query, &context, collect_patch, &out);
@@ -170,15 +228,16 @@ RayHit Bvh::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& dire
                       float tnear, float tfar) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
+  const FrameRay f = to_bvh_frame(origin, direction, impl_->exponent);
   RTCRayHit rh;
-  rh.ray.org_x = origin.x();
-  rh.ray.org_y = origin.y();
-  rh.ray.org_z = origin.z();
-  rh.ray.dir_x = direction.x();
-  rh.ray.dir_y = direction.y();
-  rh.ray.dir_z = direction.z();
-  rh.ray.tnear = tnear;
-  rh.ray.tfar = tfar;
+  rh.ray.org_x = f.o.x();
+  rh.ray.org_y = f.o.y();
+  rh.ray.org_z = f.o.z();
+  rh.ray.dir_x = f.d.x();
+  rh.ray.dir_y = f.d.y();
+  rh.ray.dir_z = f.d.z();
+  rh.ray.tnear = std::ldexp(tnear, f.shift);
+  rh.ray.tfar = std::ldexp(tfar, f.shift);
   rh.ray.time = 0.0f;
   rh.ray.mask = 0xFFFFFFFFu;
   rh.ray.id = 0;
@@ -189,7 +248,7 @@ RayHit Bvh::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& dire
   RayHit hit;
   if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
     hit.patch = static_cast<std::int32_t>(rh.hit.primID);
-    hit.t = rh.ray.tfar;
+    hit.t = std::ldexp(rh.ray.tfar, -f.shift);
   }
   return hit;
 }

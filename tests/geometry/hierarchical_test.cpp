@@ -118,7 +118,8 @@ Scene cube(const std::function<Material(int)>& m) {
 
 TEST(Hierarchical, UnitCubeOppositeAndAdjacentFactors) {
   // Bottom emits; only the receiver under test reflects (so it gets exactly one bounce).
-  for (const auto& [receiver, F] : {std::pair{1, kCubeOpposite}, std::pair{2, kCubeAdjacent}}) {
+  for (const auto& [face, F] : {std::pair{1, kCubeOpposite}, std::pair{2, kCubeAdjacent}}) {
+    const int receiver = face;  // a lambda may not capture a structured binding (C++17)
     const Scene s = cube([&](int f) {
       return f == 0 ? mat("e", 0, 1) : mat("m" + std::to_string(f), f == receiver ? 0.5 : 0, 0);
     });
