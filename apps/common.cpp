@@ -207,7 +207,10 @@ void add_scene_options(CLI::App* cmd, SceneArgs& args) {
                 "Refuse missing or undefined materials and Kd = 1 instead of defaulting with a warning");
   cmd->add_option_function<std::string>(
          "--default-reflectance",
-         [&args](const std::string& s) { parse_rgb(s, true, args.load.default_reflectance); },
+         [&args](const std::string& s) {
+           parse_rgb(s, true, args.load.default_reflectance);
+           args.default_reflectance_given = true;
+         },
          "Reflectance R,G,B of the default material (default 0.5,0.5,0.5)")
       ->check([](const std::string& s) {
         Eigen::Vector3d c;
@@ -247,6 +250,7 @@ void add_scene_options(CLI::App* cmd, SceneArgs& args) {
 }
 
 void add_run_options(CLI::App* cmd, RunArgs& args) {
+  args.command = cmd;
   cmd->add_option("-j,--threads", args.threads, "Worker threads (default: all cores)")
       ->check(CLI::Range(1, 1024));
   cmd->add_option("--seed", args.seed, "Random seed (results are bitwise reproducible)");
@@ -258,6 +262,10 @@ void add_run_options(CLI::App* cmd, RunArgs& args) {
       ->check([](const std::string& s) {
         return parse_size(s) ? std::string() : "'" + s + "' is not a size such as 512M or 8G";
       });
+}
+
+void check_options_read(const RunArgs& args, const Selection& selection) {
+  if (args.command != nullptr) check_option_scopes(*args.command, selection);
 }
 
 void apply_run_options(const RunArgs& args) {
@@ -307,8 +315,13 @@ Scene load_scene_file(const SceneArgs& args) {
     if (!why.empty()) throw UsageError("--emit: " + why);
     options.emit.push_back(rule);
   }
-  return load_scene_path(args.scene.empty() ? builtin_cornell_box_path() : args.scene, nullptr,
-                         options);
+  const std::string path = args.scene.empty() ? builtin_cornell_box_path() : args.scene;
+  LoadReport report;
+  Scene scene = load_scene_path(path, &report, options);
+  if (args.default_reflectance_given && !report.default_material_used)
+    throw UsageError("--default-reflectance does not apply: every face of " + path +
+                     " has a defined material");
+  return scene;
 }
 
 Scene load_checked_scene(const SceneArgs& args, const JobPlan& plan) {

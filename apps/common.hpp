@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/option_scope.hpp"
 #include "geometry/bvh.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/mesh.hpp"
@@ -22,6 +23,7 @@ struct Medium;
 struct SceneArgs {
   std::string scene;                 ///< OBJ path; empty = built-in Cornell box
   LoadOptions load;  ///< --strict, --default-reflectance, --max-reflectance, --vertex-colors-as-reflectance
+  bool default_reflectance_given = false;  ///< --default-reflectance was on the command line
   std::vector<std::string> emit;     ///< --emit NAME_OR_GLOB=R,G,B, parsed by load_scene
   double max_edge = 0.0;             ///< --max-edge
   std::int64_t patches = 0;          ///< --patches
@@ -37,6 +39,9 @@ struct RunArgs {
   bool quiet = false;       ///< -q
   bool verbose = false;     ///< -v
   std::string max_memory;   ///< --max-memory SIZE; empty = $LAMBERT_MAX_MEMORY or MemAvailable
+  /// The subcommand these options belong to (set by add_run_options; it outlives the run),
+  /// asked after parsing which options were given (apps/option_scope.hpp).
+  const CLI::App* command = nullptr;
 };
 
 /// Adds the positional SCENE, the loading options (--strict, --default-reflectance,
@@ -45,6 +50,9 @@ struct RunArgs {
 void add_scene_options(CLI::App* cmd, SceneArgs& args);
 /// Adds -j/--threads, --seed, -q/--quiet, -v/--verbose and --max-memory to a subcommand.
 void add_run_options(CLI::App* cmd, RunArgs& args);
+/// Refuses (UsageError) an option given on the command line of `args.command` that the
+/// choices in `selection` do not read (apps/option_scope.hpp).
+void check_options_read(const RunArgs& args, const Selection& selection);
 /// Applies --quiet / --verbose to the logger.
 void apply_run_options(const RunArgs& args);
 

@@ -414,7 +414,13 @@ int run_compare(const CompareOptions& opts) {
   static const MethodTable<CompareOptions> kMethods = {{"matrix", compare_matrix},
                                                        {"hierarchical", compare_hierarchical}};
   // The hierarchical comparison runs a matrix reference: its problem options set it up.
-  return run_for_method(kMethods, opts, opts.method.name == "hierarchical" ? "matrix" : "");
+  // Its matrix reference computes F (F + direct): the estimator's options apply, no solver's.
+  Selection selection{"compare", opts.method.name,    selected_estimator(opts.ff), {},
+                      "",        opts.medium.active()};
+  if (opts.method.name == "matrix")
+    selection.solvers = opts.solvers.empty() ? solver_names() : opts.solvers;
+  return run_for_method(kMethods, opts, selection,
+                        opts.method.name == "hierarchical" ? "matrix" : "");
 }
 
 }  // namespace lambert

@@ -67,6 +67,10 @@ FormFactorOptions distributed_ff_options(const FormFactorArgs& args, const RunAr
     throw UsageError("--estimator " + o.estimator +
                      " computes whole rows and its reciprocity "
                      "needs whole columns: --distributed takes mc, hybrid or analytic");
+  const std::vector<std::string> unused = unused_count_options(args, o.estimator);
+  if (!unused.empty())
+    throw UsageError(unused.front() + " does not apply: --distributed computes F with " +
+                     o.estimator + " at " + std::to_string(n) + " patches");
   return o;
 }
 

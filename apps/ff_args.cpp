@@ -48,21 +48,25 @@ void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load, bool to
                       "Replace A_i F_ij and A_j F_ji by their mean: none, average, or auto "
                       "(average for gather, none for the others)")
           ->check(CLI::IsMember({"auto", "none", "average"}))
+          ->each([&args](const std::string&) { args.reciprocity_given = true; })
           ->capture_default_str();
   compute_only.push_back(reciprocity);
   compute_only.push_back(
       cmd->add_flag("--symmetrize", args.symmetrize, "Alias of --reciprocity average")
+          ->each([&args](const std::string&) { args.reciprocity_given = true; })
           ->excludes(reciprocity));
   cmd->add_option("--specular-depth", args.specular_depth,
                   "Specular bounces a ray follows through mirrors and glass (extended form "
                   "factors, ray-traced shading); 0 = specular surfaces only receive and block")
       ->check(CLI::Range(0, 64))
+      ->each([&args](const std::string&) { args.specular_given = true; })
       ->capture_default_str();
   compute_only.push_back(
       cmd->add_option("--specular-rays", args.specular_rays,
                       "Rays per patch that trace the specular paths of the extended form "
                       "factors (scenes with mirrors or glass)")
           ->check(CLI::Range(1, 1 << 24))
+          ->each([&args](const std::string&) { args.specular_given = true; })
           ->capture_default_str());
   if (!with_load) return;
   CLI::Option* ff = cmd->add_option(
@@ -82,6 +86,10 @@ void plan_form_factors(JobPlan& plan, const FormFactorArgs& args, const RunArgs&
   }
   plan.ff = make_ff_options(args, run);
   plan.ff->with_stderr = with_stderr;
+}
+
+std::string selected_estimator(const FormFactorArgs& args) {
+  return args.ff_file.empty() ? args.estimator : "";
 }
 
 FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run) {
@@ -109,22 +117,37 @@ FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run
   return o;
 }
 
+void check_auto_pick(const FormFactorArgs& args, std::int64_t patches) {
+  if (args.estimator != "auto") return;
+  const std::string pick = auto_estimator(patches, args.tol_given);
+  const std::vector<std::string> unused = unused_count_options(args, pick);
+  if (args.reciprocity_given && pick != "gather")
+    throw UsageError((args.symmetrize ? "--symmetrize" : "--reciprocity") +
+                     std::string(" does not apply: --estimator auto picks ") + pick + " for " +
+                     std::to_string(patches) +
+                     " patches, whose F is reciprocal by construction (gather and hemicube "
+                     "read it)");
+  if (!unused.empty())
+    throw UsageError(unused.front() + " does not apply: --estimator auto picks " + pick + " for " +
+                     std::to_string(patches) +
+                     " patches (name the estimator that reads it: --samples mc or hybrid, "
+                     "--rays gather, --ff-tol analytic)");
+}
+
 std::vector<std::string> unused_count_options(const FormFactorArgs& args,
                                               const std::string& estimator) {
   const std::string used = estimator_count_option(estimator);
   std::vector<std::string> out;
   if (args.rays_given && used != "rays") out.push_back("--rays");
-  // The hemicube has ignored --samples since it existed; gather and analytic refuse it.
-  if (args.samples_given && (used == "rays" || used == "tol")) out.push_back("--samples");
+  if (args.samples_given && used != "samples") out.push_back("--samples");
   if (args.tol_given && used != "tol") out.push_back("--ff-tol");
   return out;
 }
 
 namespace {
 
-// "form factors: auto picked gather (N patches >= T)", and a warning per count option the
-// picked estimator ignores.
-void log_auto_pick(const FormFactors& ff, const FormFactorArgs& args, std::int32_t patches) {
+// "form factors: auto picked gather (N patches >= T)".
+void log_auto_pick(const FormFactors& ff, std::int32_t patches) {
   if (ff.options.estimator_requested != "auto") return;
   const std::string n = std::to_string(patches) + " patches";
   const std::string why =
@@ -137,8 +160,6 @@ void log_auto_pick(const FormFactors& ff, const FormFactorArgs& args, std::int32
                            " patches, name it to force it"
                      : "");
   log_info("form factors: auto picked " + ff.options.estimator + " (" + why + ")");
-  for (const std::string& opt : unused_count_options(args, ff.options.estimator))
-    log_warn(opt + " is ignored: --estimator auto picked " + ff.options.estimator);
 }
 
 // ", reciprocity averaged (...)" for the summary line, or "".
@@ -201,10 +222,15 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
              " entries, " + ff_settings_text(ff.options, "") + ")");
     return ff;
   }
+  check_auto_pick(args, scene.mesh.size());
+  if (args.specular_given && !scene.mesh.has_specular())
+    throw UsageError(
+        "--specular-depth and --specular-rays do not apply: the scene has no mirror or glass "
+        "surface (MTL illum 3 to 9)");
   FormFactorOptions o = make_ff_options(args, run);
   o.with_stderr = with_stderr;
   FormFactors ff = compute_form_factors(scene.mesh, o, &scene_bvh(scene, run.threads));
-  log_auto_pick(ff, args, scene.mesh.size());
+  log_auto_pick(ff, scene.mesh.size());
   log_info("form factors: " + std::to_string(scene.mesh.size()) + " patches, " +
            format_si(static_cast<double>(ff.F.nonZeros())) + " entries, " +
            format_si(static_cast<double>(ff.stats.rays)) + " rays in " +

@@ -32,6 +32,9 @@ struct FormFactorArgs {
   /// ray-traced view pass (with --ff it steers the view pass only; F keeps its own).
   int specular_depth = 8;
   int specular_rays = 1024;  ///< --specular-rays: rays per patch of the extended part
+  bool specular_given = false;
+  bool reciprocity_given = false;  ///< --reciprocity or --symmetrize was on the command line  ///<
+                                   ///< --specular-depth or --specular-rays was on the command line
 };
 
 /// Adds the form-factor options to a subcommand. `with_load` adds --ff FILE, which excludes
@@ -49,6 +52,14 @@ void plan_form_factors(JobPlan& plan, const FormFactorArgs& args, const RunArgs&
 /// Builds FormFactorOptions from the arguments ("auto" stays unresolved: it needs the patch
 /// count). Throws UsageError when a named estimator does not read a count that was given
 /// (--rays with a pair estimator or the hemicube, --samples with gather).
+/// The estimator of a selection (apps/option_scope.hpp): --estimator, or "" when F is loaded
+/// from --ff.
+std::string selected_estimator(const FormFactorArgs& args);
+
+/// Refuses (UsageError) a count option (--samples, --rays, --ff-tol) that the estimator
+/// --estimator auto picks for `patches` patches does not read; nothing for a named estimator.
+void check_auto_pick(const FormFactorArgs& args, std::int64_t patches);
+
 FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run);
 
 /// The count options given on the command line that `estimator` (resolved) ignores, as

@@ -239,6 +239,8 @@ std::string formfactors_report_path(const FormFactorsOptions& opts) {
 int run_formfactors(const FormFactorsOptions& opts) {
   if (opts.dist.enabled && opts.medium.active())
     throw UsageError("--distributed does not take a participating medium yet");
+  check_options_read(opts.run,
+                     {"formfactors", "matrix", opts.ff.estimator, {}, "", opts.medium.active()});
   if (opts.dist.enabled) return run_formfactors_distributed(opts);
   apply_run_options(opts.run);
   namespace fs = std::filesystem;

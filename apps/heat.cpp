@@ -114,6 +114,8 @@ CLI::App* add_heat_command(CLI::App& app, HeatOptions& opts) {
 }
 
 int run_heat(const HeatOptions& opts) {
+  check_options_read(opts.run,
+                     {"heat", "matrix", selected_estimator(opts.ff), {opts.solve.solver}, ""});
   if (opts.solve.ambient)
     throw UsageError(
         "--ambient (southwell's display term) does not apply to heat: it would "

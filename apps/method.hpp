@@ -83,14 +83,16 @@ template <class Options>
 using MethodTable = std::vector<std::pair<std::string, std::function<int(const Options&)>>>;
 
 /// Runs a command: applies its --quiet / --verbose, refuses the options of other methods
-/// (check_method_options with `reference`), then runs the row of `table` for --method. Every
+/// (check_method_options with `reference`) and those `selection` does not read
+/// (check_options_read), then runs the row of `table` for --method. Every
 /// command that offers --method has a row for every registry method: a missing row is a bug
 /// (LAMBERT_CHECK), never a silent fallback.
 template <class Options>
 int run_for_method(const MethodTable<Options>& table, const Options& opts,
-                   const std::string& reference = "") {
+                   const Selection& selection, const std::string& reference = "") {
   apply_run_options(opts.run);
   check_method_options(opts.method, reference);
+  check_options_read(opts.run, selection);
   for (const auto& [name, run] : table)
     if (name == opts.method.name) return run(opts);
   LAMBERT_CHECK(false, "no implementation of --method " + opts.method.name + " in this command");

@@ -168,10 +168,14 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opts) {
 }
 
 int run_render(const RenderOptions& opts) {
-  resolve_shading(opts.shade);  // contradicting shading options: usage error before any work
   static const MethodTable<RenderOptions> kMethods = {{"matrix", render_matrix},
                                                       {"hierarchical", render_hierarchical}};
-  return run_for_method(kMethods, opts);
+  // Contradicting shading options: usage error before any work. A given B (--radiosity)
+  // needs neither F nor a solver.
+  const bool solves = opts.method.name == "matrix" && opts.radiosity.empty();
+  return run_for_method(kMethods, opts,
+                        render_selection("render", opts.method.name, solves, opts.ff,
+                                         opts.solver.solver, opts.shade, opts.medium.active()));
 }
 
 }  // namespace lambert

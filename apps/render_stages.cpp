@@ -64,6 +64,21 @@ Camera make_camera(const Scene& scene, const CameraArgs& args) {
   return cam;
 }
 
+Selection render_selection(const std::string& command, const std::string& method, bool solves,
+                           const FormFactorArgs& ff, const std::string& solver,
+                           const ShadeArgs& shade, bool medium) {
+  const Shading shading = resolve_shading(shade);
+  Selection s{command,
+              method,
+              solves ? selected_estimator(ff) : "",
+              {},
+              shading_name(shading),
+              medium,
+              shading == Shading::Raytrace || shade.antialias > 1};
+  if (solves) s.solvers = {solver};
+  return s;
+}
+
 void add_shade_options(CLI::App* cmd, ShadeArgs& args) {
   cmd->add_option("--shading", args.shading,
                   "gouraud (B/pi interpolated from the vertices), flat (per patch) or raytrace "

@@ -47,6 +47,13 @@ void add_shade_options(CLI::App* cmd, ShadeArgs& args);
 /// The shading the options ask for: --shading, else flat with --flat, raytrace with
 /// --final-gather, else Gouraud. Throws UsageError when they contradict each other.
 Shading resolve_shading(const ShadeArgs& args);
+/// The choices of a command that solves and renders (run, render) for the option check
+/// (apps/option_scope.hpp): the estimator and `solver` when it computes F and solves
+/// (`solves`), the shading the options resolve to, and whether pixels draw random numbers.
+Selection render_selection(const std::string& command, const std::string& method, bool solves,
+                           const FormFactorArgs& ff, const std::string& solver,
+                           const ShadeArgs& shade, bool medium);
+
 /// "gouraud", "flat" or "raytrace".
 const char* shading_name(Shading shading);
 /// The shading part of a settings line: "shading=S" and, raytraced, " specular_depth=D" and

@@ -532,10 +532,14 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& opts) {
 int run_run(const RunOptions& opts) {
   if (opts.dist.enabled && opts.method.name != "matrix")
     throw UsageError("--distributed runs the matrix method (F over the ranks)");
-  resolve_shading(opts.shade);  // contradicting shading options: usage error before any work
   static const MethodTable<RunOptions> kMethods = {{"matrix", run_matrix},
                                                    {"hierarchical", run_hierarchical}};
-  return run_for_method(kMethods, opts);
+  // Contradicting shading options: usage error before any work. --distributed solves with
+  // PETSc's GMRES over the ranks.
+  return run_for_method(kMethods, opts,
+                        render_selection("run", opts.method.name, opts.method.name == "matrix",
+                                         opts.ff, opts.dist.enabled ? "petsc" : opts.solver.solver,
+                                         opts.shade, opts.medium.active()));
 }
 
 }  // namespace lambert

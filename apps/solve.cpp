@@ -252,10 +252,18 @@ CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts) {
 }
 
 int run_solve(const SolveCommandOptions& opts) {
-  if (opts.dist.enabled) return run_solve_distributed(opts);
+  const bool matrix = opts.method.name == "matrix";
+  Selection selection{"solve", opts.method.name,    matrix ? selected_estimator(opts.ff) : "", {},
+                      "",      opts.medium.active()};
+  // --distributed solves with PETSc's GMRES over the ranks.
+  if (matrix) selection.solvers = {opts.dist.enabled ? "petsc" : opts.solve.solver};
+  if (opts.dist.enabled) {
+    check_options_read(opts.run, selection);
+    return run_solve_distributed(opts);
+  }
   static const MethodTable<SolveCommandOptions> kMethods = {
       {"matrix", run_solve_matrix}, {"hierarchical", run_solve_hierarchical}};
-  return run_for_method(kMethods, opts);
+  return run_for_method(kMethods, opts, selection);
 }
 
 }  // namespace lambert

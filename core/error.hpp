@@ -30,6 +30,12 @@ class UsageError : public Error {
   using Error::Error;
 };
 
+/// The work was asked to stop (request_cancel, core/parallel.hpp: Python's Ctrl-C).
+class Cancelled : public Error {
+ public:
+  using Error::Error;
+};
+
 /// Thrown by LAMBERT_CHECK: a bug in lambert, never a user error.
 class InternalError : public std::logic_error {
  public:

@@ -7,7 +7,18 @@
 #include <thread>
 #include <vector>
 
+#include "core/error.hpp"
+
 namespace lambert {
+
+namespace {
+std::atomic<bool> g_cancel{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "request_cancel must be signal-safe");
+}  // namespace
+
+void request_cancel() { g_cancel.store(true, std::memory_order_relaxed); }
+void clear_cancel() { g_cancel.store(false, std::memory_order_relaxed); }
+bool cancel_requested() { return g_cancel.load(std::memory_order_relaxed); }
 
 int resolve_threads(int requested) {
   if (requested > 0) return requested;
@@ -22,7 +33,7 @@ void parallel_for(std::int64_t n, std::int64_t chunk, int threads,
   const std::int64_t chunks = (n + chunk - 1) / chunk;
   const int workers = static_cast<int>(std::min<std::int64_t>(resolve_threads(threads), chunks));
   std::atomic<std::int64_t> next{0};
-  std::atomic<bool> failed{false};
+  std::atomic<bool> failed{false}, cancelled{false};
   std::exception_ptr error;
   std::mutex error_mutex;
 
@@ -30,6 +41,10 @@ void parallel_for(std::int64_t n, std::int64_t chunk, int threads,
     for (;;) {
       const std::int64_t c = next.fetch_add(1);
       if (c >= chunks || failed.load()) return;
+      if (cancel_requested()) {
+        cancelled = true;
+        return;
+      }
       const std::int64_t begin = c * chunk;
       try {
         body(begin, std::min(n, begin + chunk));
@@ -51,6 +66,7 @@ void parallel_for(std::int64_t n, std::int64_t chunk, int threads,
     for (auto& th : pool) th.join();
   }
   if (error) std::rethrow_exception(error);
+  if (cancelled) throw Cancelled("interrupted");
 }
 
 }  // namespace lambert

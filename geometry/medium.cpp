@@ -1,6 +1,7 @@
 #include "geometry/medium.hpp"
 
 #include <cstring>
+#include <sstream>
 
 #include "core/error.hpp"
 #include "core/sampling.hpp"
@@ -54,8 +55,20 @@ void validate_medium(const Medium& m, const std::string& what) {
   check(m.sigma_a, "sigma_a");
   check(m.sigma_s, "sigma_s");
   check(m.emission, "emission");
+  // Optical thickness across the whole box: below 1e-100 a voxel attenuates nothing a double
+  // can hold (1 - 1e-100 == 1) while its albedo and emission divide by sigma_t (1e-320 gave
+  // NaN energies); above 1e100 every transmittance underflows. 0 means no medium there.
+  const double diagonal = (m.hi - m.lo).norm();
   for (std::int32_t v = 0; v < n; ++v) {
     const Eigen::Vector3d t = (m.sigma_a.row(v) + m.sigma_s.row(v)).transpose();
+    const double depth = t.maxCoeff() * diagonal;
+    if (depth != 0.0 && !(depth >= 1e-100 && depth <= 1e100)) {
+      std::ostringstream msg;
+      msg << what << ": voxel " << v << ": sigma_a + sigma_s = " << t.maxCoeff()
+          << " over the box's diagonal " << diagonal << " is an optical thickness of " << depth
+          << ", outside [1e-100, 1e100] (0 for no medium)";
+      throw UsageError(msg.str());
+    }
     if (t.maxCoeff() - t.minCoeff() > 1e-12 * t.maxCoeff())
       throw UsageError(what +
                        ": sigma_a + sigma_s (the extinction) must be the same in every "

@@ -3,6 +3,10 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
+
+#include "core/error.hpp"
 
 namespace lambert {
 namespace {
@@ -113,6 +117,12 @@ std::vector<std::array<int, 3>> triangulate(const std::vector<Eigen::Vector3d>& 
     return tris;
   }
   const auto p = project(poly);
+  if (m > kEarClippingCorners) {
+    if (auto cdt = triangulate_simple(p)) return std::move(*cdt);
+    if (m > 2000)
+      throw SceneError("a face of " + std::to_string(m) +
+                       " corners is not a simple polygon (repeated corners or crossing edges)");
+  }
   std::vector<int> idx(poly.size());
   for (size_t k = 0; k < idx.size(); ++k) idx[k] = static_cast<int>(k);
   auto inside = [&](int a, int b, int c, int q) {

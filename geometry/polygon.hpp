@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace lambert {
@@ -51,10 +52,19 @@ struct PlaneFrame {
 };
 PlaneFrame plane_frame(const std::vector<Eigen::Vector3d>& poly);
 
-/// Triangulates a simple polygon by ear clipping in its Newell plane; returns index
-/// triples into `poly`, wound like the polygon. Works for convex and concave polygons;
-/// O(n) for strictly convex ones (the fan ear clipping would produce), O(n^2) or more else.
+/// Triangulates a simple polygon in its Newell plane; returns index triples into `poly`,
+/// wound like the polygon. Works for convex and concave polygons: O(n) for strictly convex
+/// ones (the fan ear clipping would produce), ear clipping up to kEarClippingCorners corners
+/// (O(n^2) or more), triangulate_simple above (O(n log n)). A non-simple polygon above that
+/// size is a SceneError (ear clipping could take hours on it).
 std::vector<std::array<int, 3>> triangulate(const std::vector<Eigen::Vector3d>& poly);
+constexpr int kEarClippingCorners = 64;
+
+/// Triangulates a simple polygon given counter-clockwise in 2D, in O(n log n) (constrained
+/// Delaunay, geometry/polygon_cdt.cpp): index triples, counter-clockwise. Empty when the
+/// polygon is not simple (repeated corners, crossing edges).
+std::optional<std::vector<std::array<int, 3>>> triangulate_simple(
+    const std::vector<Eigen::Vector2d>& p);
 
 /// True when the planar polygon is strictly convex in its Newell plane.
 bool is_convex(const std::vector<Eigen::Vector3d>& poly);

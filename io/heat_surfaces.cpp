@@ -7,6 +7,7 @@
 #include <iterator>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include "core/error.hpp"
 #include "io/json.hpp"
@@ -66,10 +67,22 @@ SurfaceCondition parse_entry(const Json& e, const std::string& where) {
 }  // namespace
 
 SurfaceConditions parse_surface_conditions(const std::string& text, const std::string& name) {
+  // A key given twice in one object is an error (nlohmann keeps the last silently): the
+  // keys of each open object, innermost last.
+  std::vector<std::set<std::string>> open_objects;
+  const Json::parser_callback_t no_duplicates = [&](int, Json::parse_event_t event, Json& parsed) {
+    if (event == Json::parse_event_t::object_start) open_objects.emplace_back();
+    if (event == Json::parse_event_t::object_end && !open_objects.empty()) open_objects.pop_back();
+    if (event == Json::parse_event_t::key && !open_objects.empty() &&
+        !open_objects.back().insert(parsed.get<std::string>()).second)
+      throw SceneError(name + ": key \"" + parsed.get<std::string>() +
+                       "\" given twice in one object");
+    return true;
+  };
   Json j;
   try {
-    j = Json::parse(text);
-  } catch (const Json::parse_error& e) {
+    j = Json::parse(text, no_duplicates);
+  } catch (const Json::exception& e) {  // syntax, and numbers out of range such as 1e400
     throw SceneError(name + ": not valid JSON: " + e.what());
   }
   if (!j.is_object() || j.empty())

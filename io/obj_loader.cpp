@@ -554,11 +554,14 @@ std::uint64_t hash_key(const std::vector<std::array<double, 3>>& key) {
   return h;
 }
 
+}  // namespace
+
 // Faces with exactly the corners of an earlier face (a second copy of the floor) count
 // their area twice and push row sums of F above 1: one warning per pair of surfaces.
 // Faces are bucketed by a hash of their sorted corners and compared exactly.
-void report_coincident(const Scene& scene, const std::string& name, Diagnostics& diag,
-                       LoadReport& report) {
+std::vector<std::string> coincident_face_warnings(const Scene& scene, const std::string& name,
+                                                  int& coincident_faces) {
+  std::vector<std::string> warnings;
   std::unordered_multimap<std::uint64_t, size_t> seen;
   seen.reserve(scene.faces.size());
   std::map<std::pair<std::int32_t, std::int32_t>, std::pair<size_t, int>> pairs;  // -> (f, count)
@@ -572,7 +575,7 @@ void report_coincident(const Scene& scene, const std::string& name, Diagnostics&
       seen.emplace(h, f);
       continue;
     }
-    ++report.coincident_faces;
+    ++coincident_faces;
     const Face& a = scene.faces[it->second];
     const Face& b = scene.faces[f];
     auto [p, fresh] = pairs.emplace(std::minmax(a.surface, b.surface), std::make_pair(f, 0));
@@ -583,14 +586,16 @@ void report_coincident(const Scene& scene, const std::string& name, Diagnostics&
     const Face& a = scene.faces[fa];
     const Face& b = scene.faces[fb];
     const int count = pairs[std::minmax(a.surface, b.surface)].second;
-    diag.warn(where(name, b.line) + ": face coincides with the face at line " + std::to_string(a.line) +
-              " (surfaces '" + scene.surfaces[a.surface].name + "' and '" +
-              scene.surfaces[b.surface].name + "', " + std::to_string(count) +
-              " coincident face(s)): its area counts twice");
+    // Binary STL facets have no line: name the pair of surfaces only.
+    const std::string first =
+        a.line > 0 ? "the face at line " + std::to_string(a.line) : "an earlier face";
+    warnings.push_back(where(name, b.line) + ": face coincides with " + first + " (surfaces '" +
+                       scene.surfaces[a.surface].name + "' and '" + scene.surfaces[b.surface].name +
+                       "', " + std::to_string(count) +
+                       " coincident face(s)): its area counts twice");
   }
+  return warnings;
 }
-
-}  // namespace
 
 void apply_emit(const std::vector<EmitRule>& rules, const std::string& name, Scene& scene) {
   auto matches = [](const std::string& pattern, const std::string& s) {
@@ -657,7 +662,12 @@ Scene load_obj_stream(std::istream& in, const std::string& name, const MtlOpener
   if ((hi - lo).norm() < kMinSceneExtent)
     throw SceneError(name + ": scene extent " + num((hi - lo).norm()) +
                      " is below 1e-50, where form factors underflow: rescale the scene");
-  report_coincident(scene, name, diag, report);
+  report.default_material_used =
+      std::any_of(mats.undefined.begin(), mats.undefined.end(), [](bool u) { return u; }) ||
+      std::any_of(obj.faces.begin(), obj.faces.end(),
+                  [](const ObjFace& f) { return f.material < 0; });
+  for (const std::string& w : coincident_face_warnings(scene, name, report.coincident_faces))
+    diag.warn(w);
   apply_emit(options.emit, name, scene);
   for (const auto& s : scene.surfaces) report.has_emitter = report.has_emitter || scene.materials[s.material].emits();
   if (!report.has_emitter && options.warn_without_emitter)

@@ -41,8 +41,17 @@ struct LoadReport {
   int skipped_statements = 0;  ///< statements (and vertex colours/weights) radiosity does not use
   int coincident_faces = 0;    ///< faces with exactly the corners of an earlier face
   bool has_emitter = false;
+  /// Some face takes the default material (no or an undefined material; every STL facet),
+  /// whose reflectance --default-reflectance sets.
+  bool default_material_used = false;
   std::vector<std::string> warnings;  ///< every warning, in the order it was logged
 };
+
+/// One warning per pair of surfaces with faces of exactly the same corners (their area counts
+/// twice), naming the file `name` and the lines; adds the number of such faces to
+/// `coincident_faces`. OBJ and STL loaders share it. O(faces) expected (hashed corners).
+std::vector<std::string> coincident_face_warnings(const Scene& scene, const std::string& name,
+                                                  int& coincident_faces);
 
 /// A material library opened for an `mtllib` statement: `stream` is null when there is no
 /// such library; `name` is used in messages.

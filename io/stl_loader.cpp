@@ -20,6 +20,8 @@
 #include "geometry/polygon.hpp"
 #include "io/camera_file.hpp"
 #include "io/line_reader.hpp"
+#include "io/obj_loader.hpp"
+#include "io/obj_parser.hpp"
 #include "io/strict_number.hpp"
 
 namespace lambert {
@@ -108,11 +110,19 @@ class SceneBuilder {
            "(counter-clockwise about the front) is used");
     if (scene_.faces.empty())
       throw SceneError(name_ + ": empty scene: no facets with positive area");
+    for (const std::string& w : coincident_face_warnings(scene_, name_, report_.coincident_faces))
+      warn(w);
     scene_.materials.push_back({"default", options.default_reflectance, Eigen::Vector3d::Zero()});
+    report_.default_material_used = true;
     apply_emit(options.emit, name_, scene_);
     for (const auto& s : scene_.surfaces)
       report_.has_emitter = report_.has_emitter || scene_.materials[s.material].emits();
     const auto [lo, hi] = scene_.bounds();
+    // The OBJ loader's floor (io/obj_loader.cpp): distances^4 must stay normal doubles.
+    if ((hi - lo).norm() < 1e-50)
+      throw SceneError(name_ +
+                       ": scene extent below 1e-50, where form factors underflow: "
+                       "rescale the scene");
     scene_.camera = framing_camera(lo, hi);
     return std::move(scene_);
   }
@@ -192,6 +202,9 @@ class AsciiReader {
     for (int k = 0; k < 3; ++k) {
       const std::string why = parse_finite(tok_[first + k], v[k]);
       if (!why.empty()) fail("'" + std::string(tok_[first + k]) + "': " + why);
+      // The OBJ loader's limit (io/obj_parser.hpp): distances^4 must stay finite.
+      if (std::string(what) == "vertex" && std::abs(v[k]) > kMaxObjCoordinate)
+        fail("'" + std::string(tok_[first + k]) + "': coordinate beyond +-1e50: rescale the scene");
     }
     return v;
   }

@@ -12,10 +12,12 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <signal.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -32,6 +34,7 @@
 #include "apps/problem.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/parallel.hpp"
 #include "geometry/bvh.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/mesh.hpp"
@@ -299,6 +302,50 @@ Shading parse_shading(const std::string& s) {
   throw UsageError("shading must be \"gouraud\" or \"flat\", got \"" + s + "\"");
 }
 
+// Releases the GIL for a long call and makes Ctrl-C stop it: Python runs its own SIGINT
+// handler only once the GIL is back, so while the call runs SIGINT requests a stop of the
+// parallel loops instead (core/parallel.hpp), whose Cancelled becomes KeyboardInterrupt.
+// Nested or concurrent calls share one installation (the first installs, the last restores).
+class Released {
+ public:
+  Released() {
+    std::lock_guard<std::mutex> lock(mutex());
+    if (users()++ == 0) {
+      clear_cancel();
+      struct sigaction sa {};
+      sa.sa_handler = [](int) { request_cancel(); };
+      sigemptyset(&sa.sa_mask);
+      sigaction(SIGINT, &sa, &previous());
+    }
+  }
+  ~Released() {
+    std::lock_guard<std::mutex> lock(mutex());
+    if (--users() > 0) return;
+    sigaction(SIGINT, &previous(), nullptr);
+    // A Ctrl-C that no parallel loop saw (a sequential solver ran) is handed back to Python;
+    // one that threw Cancelled is already becoming KeyboardInterrupt.
+    if (cancel_requested() && std::uncaught_exceptions() == 0) PyErr_SetInterrupt();
+    clear_cancel();
+  }
+  Released(const Released&) = delete;
+  Released& operator=(const Released&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  static int& users() {
+    static int n = 0;
+    return n;
+  }
+  static struct sigaction& previous() {
+    static struct sigaction p {};
+    return p;
+  }
+  py::gil_scoped_release release_;
+};
+
 // UsageError for an unknown solver, tol outside (0, 1) or max_iterations < 1.
 void check_solver_args(const std::string& solver, double tol, int max_iterations) {
   const auto names = solver_names();
@@ -332,6 +379,8 @@ PYBIND11_MODULE(_lambert, m) {
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
+    } catch (const Cancelled&) {
+      PyErr_SetNone(PyExc_KeyboardInterrupt);
     } catch (const UsageError& e) {
       PyErr_SetString(usage_error, e.what());
     } catch (const SceneError& e) {
@@ -410,7 +459,7 @@ PYBIND11_MODULE(_lambert, m) {
         LoadOptions o;
         o.strict = strict;
         for (const auto& [pattern, e] : emit) o.emit.push_back({pattern, vec3(e, "an emit value")});
-        py::gil_scoped_release release;
+        Released release;
         return std::make_shared<Scene>(load_scene_path(path, nullptr, o));
       },
       py::arg("path"), py::arg("strict") = false,
@@ -475,7 +524,7 @@ PYBIND11_MODULE(_lambert, m) {
         if (patches < 0) throw UsageError("patches must be >= 0");
         auto h = std::make_shared<MeshHandle>();
         h->loaded.scene = scene;
-        py::gil_scoped_release release;
+        Released release;
         MeshOptions mo;
         mo.max_edge = max_edge;
         mo.target_patches = patches;
@@ -503,7 +552,7 @@ PYBIND11_MODULE(_lambert, m) {
           throw UsageError("unknown estimator \"" + estimator + "\"");
         if (estimator != "auto") {
           const std::string used = estimator_count_option(estimator);
-          if (samples && used != "samples" && estimator != "hemicube")
+          if (samples && used != "samples")
             throw UsageError("samples does not apply to estimator " + estimator);
           if (rays && used != "rays")
             throw UsageError("rays does not apply to estimator " + estimator);
@@ -522,7 +571,7 @@ PYBIND11_MODULE(_lambert, m) {
         o.progress = false;
         FormFactors ff;
         {
-          py::gil_scoped_release release;
+          Released release;
           ff = compute_form_factors(h.mesh, o, &h.get_bvh());
         }
         return ff_result(std::move(ff), h);
@@ -547,7 +596,7 @@ PYBIND11_MODULE(_lambert, m) {
         const ValuePrecision p =
             precision == "float" ? ValuePrecision::Float : ValuePrecision::Double;
         const FormFactorFileInfo info{mesh_hash(h.mesh), settings};
-        py::gil_scoped_release release;
+        Released release;
         const std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
         if (ext == ".mtx") {
           if (ff.stderr_F.size() > 0)
@@ -566,7 +615,7 @@ PYBIND11_MODULE(_lambert, m) {
         FormFactors ff;
         FormFactorFileInfo info;
         {
-          py::gil_scoped_release release;
+          Released release;
           ff = read_form_factors(path, mesh_hash(h.mesh), h.mesh.size(), &info);
         }
         py::dict out = ff_result(std::move(ff), h);
@@ -607,7 +656,7 @@ PYBIND11_MODULE(_lambert, m) {
           RadiosityResult r;
           MediumResult mr;
           {
-            py::gil_scoped_release release;
+            Released release;
             h.get_bvh();
             mr = solve_scene_with_medium(h.loaded, surface, medium, margs, o, run, r);
           }
@@ -617,7 +666,7 @@ PYBIND11_MODULE(_lambert, m) {
         }
         RadiositySolution sol;
         {
-          py::gil_scoped_release release;
+          Released release;
           const RadiosityProblem problem = make_problem(h.mesh, F);
           validate_problem(problem);
           sol = solve_radiosity(problem, o);
@@ -653,7 +702,7 @@ PYBIND11_MODULE(_lambert, m) {
         o.threads = threads;
         ThermalSolution sol;
         {
-          py::gil_scoped_release release;
+          Released release;
           sol = solve_thermal(problem, o);
         }
         std::vector<std::int32_t> surface_of(h.mesh.size());
@@ -718,7 +767,7 @@ PYBIND11_MODULE(_lambert, m) {
         auto h = std::make_shared<MeshHandle>();
         HierarchicalRun run;
         {
-          py::gil_scoped_release release;
+          Released release;
           run = solve_scene_hierarchical(scene, o);
           h->loaded = std::move(run.loaded);
         }
@@ -773,7 +822,7 @@ PYBIND11_MODULE(_lambert, m) {
       [](const MeshHandle& h, const ValueArray& B, const std::string& mode) {
         const Eigen::MatrixX3d b = matrix_n3(B, h.mesh.size(), "B");
         const VertexInterpolation im = parse_vertex_interpolation(mode);
-        py::gil_scoped_release release;
+        Released release;
         return std::make_shared<VertexField>(interpolate_to_vertices(h.mesh, b, im));
       },
       py::arg("mesh"), py::arg("B"), py::arg("mode"));
@@ -786,7 +835,7 @@ PYBIND11_MODULE(_lambert, m) {
         info.units = "radiosity B (units of the scene's emission E)";
         info.settings = settings;
         info.surface_names = h.mesh.surface_names;
-        py::gil_scoped_release release;
+        Released release;
         write_vertex_exr(path, field, info);
       },
       py::arg("path"), py::arg("mesh"), py::arg("field"), py::arg("settings"));
@@ -827,7 +876,7 @@ PYBIND11_MODULE(_lambert, m) {
         rs.progress = false;
         Image img;
         {
-          py::gil_scoped_release release;
+          Released release;
           const VertexField field = interpolate_to_vertices(h.mesh, b);
           img = render(h.mesh, h.get_bvh(), cam, b, field, rs);
           if (!exr.empty()) {

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Builds the `asan` preset (clang, AddressSanitizer + UBSan, the libraries instrumented with
-# fuzzer-no-link; it holds the sanitizer tests and the libFuzzer targets) into build-asan/
+# Builds the `asan` preset (clang, AddressSanitizer + UBSan, the parsers of io/ instrumented
+# with fuzzer-no-link; it holds the sanitizer tests and the libFuzzer targets) into build-asan/
 # and runs each fuzz target for SECONDS (default 30), starting from its seed corpus in
 # tests/fuzz/seeds/<parser>/ and growing a working corpus in build-asan/corpus/<target>/.
 # Exits non-zero if a target crashes (the reproducer is written to build-asan/crashes/).
@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-30}"
 shift || true
 targets=("$@")
-((${#targets[@]})) || targets=(obj_fuzz ff_fuzz csv_fuzz camera_fuzz medium_fuzz stl_fuzz)
+((${#targets[@]})) || targets=(obj_fuzz ff_fuzz csv_fuzz camera_fuzz medium_fuzz stl_fuzz heat_fuzz)
 
 scripts/setup.sh asan >/dev/null
 mkdir -p build-asan/crashes

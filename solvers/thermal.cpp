@@ -76,6 +76,13 @@ ThermalSolution solve_thermal(const ThermalProblem& p, const SolveOptions& optio
     const double e = p.emissivity[i];
     s.max_flux_mismatch = std::max(s.max_flux_mismatch, std::abs(s.q[i] - p.value[i]));
     const double emitted = (s.J[i] - (1.0 - e) * s.H[i]) / (e * kStefanBoltzmann);
+    // Overflow (a flux of 1e308, an emissivity of 1e-320 under e sigma) is no temperature:
+    // an error, never T = inf in the outputs (issue 33).
+    if (std::isinf(emitted) || (std::isnan(emitted) && !std::isfinite(s.J[i])))
+      throw Error("patch " + std::to_string(i) + " (emissivity " + std::to_string(e) +
+                  ", heat flux " + std::to_string(p.value[i]) +
+                  " W/m^2): its temperature overflows double precision (sigma T^4 = " +
+                  std::to_string(emitted) + "); check the surface conditions");
     if (emitted >= 0.0) {
       s.T[i] = std::sqrt(std::sqrt(emitted));
     } else {

@@ -295,6 +295,11 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
   if (options.rays < 1) throw UsageError("--rays must be at least 1");
   if (!(options.tol > 0.0) || !std::isfinite(options.tol))
     throw UsageError("--ff-tol must be a positive number");
+  // Not `threshold < 0`: NaN passes that and drops nothing (issue 33: Python took nan).
+  if (!(options.threshold >= 0.0 && options.threshold <= 1.0))
+    throw UsageError("--threshold must be a number in [0, 1]");
+  if (options.hemicube_resolution < 4 || options.hemicube_resolution > 8192)
+    throw UsageError("--hemicube-res must be in [4, 8192]");
   if (mesh.patches.empty()) throw UsageError("the scene has no patches");
   const FormFactorOptions o = resolve_form_factor_options(options, mesh.size());
   const EstimatorEntry& e = find_estimator(o.estimator);

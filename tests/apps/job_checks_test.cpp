@@ -24,6 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::run;
+using testing::run_capturing;
 using testing::slurp;
 
 // Every file of a folder (recursively) with its content.
@@ -32,13 +33,6 @@ std::map<std::string, std::string> snapshot(const fs::path& dir) {
   for (const auto& e : fs::recursive_directory_iterator(dir))
     if (e.is_regular_file()) files[e.path().string()] = slurp(e.path().string());
   return files;
-}
-
-// Runs the command, returns its exit code and stderr.
-std::pair<int, std::string> run_capturing(const std::vector<std::string>& args) {
-  ::testing::internal::CaptureStderr();
-  const int code = run(args);
-  return {code, ::testing::internal::GetCapturedStderr()};
 }
 
 // A temp folder holding a copy of the Cornell box (OBJ, MTL, camera sidecar), a small F of

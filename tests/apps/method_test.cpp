@@ -20,15 +20,7 @@ namespace lambert {
 namespace {
 
 using testing::run;
-
-// Runs the command, returns its exit code and stderr.
-std::pair<int, std::string> run_capturing(const std::vector<std::string>& args) {
-  ::testing::internal::CaptureStderr();
-  ::testing::internal::CaptureStdout();
-  const int code = run(args);
-  ::testing::internal::GetCapturedStdout();
-  return {code, ::testing::internal::GetCapturedStderr()};
-}
+using testing::run_capturing;
 
 // An option with a valid value, and the commands that have it.
 struct OptionCase {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "apps/cli.hpp"
+#include "apps/ff_args.hpp"
 #include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
 #include "geometry/bvh.hpp"
@@ -224,14 +225,14 @@ TEST(RunCommand, ReportRecordsTheViewPass) {
   const std::string out = dir.file("results");
   ::testing::internal::CaptureStdout();
   const int code = run({"run", dir.file("tiny.obj"), "-o", out, "--patches", "60", "--samples", "4",
-                        "--size", "16x12", "--final-gather", "2", "--specular-depth", "5", "-q"});
+                        "--size", "16x12", "--final-gather", "2", "-q"});
   ::testing::internal::GetCapturedStdout();
   ASSERT_EQ(code, kExitOk);
   const nlohmann::json report = nlohmann::json::parse(slurp(out + "/report.json"));
   const auto& r = report.at("render");
   EXPECT_EQ(r.at("shading"), "raytrace");
   EXPECT_EQ(r.at("final_gather").get<int>(), 2);
-  EXPECT_EQ(r.at("specular_depth").get<int>(), 5);
+  EXPECT_EQ(r.at("specular_depth").get<int>(), FormFactorArgs().specular_depth);
   // At least the camera rays and two gather rays per diffuse camera hit.
   EXPECT_GT(r.at("rays").get<std::int64_t>(), 16 * 12 * 4);
   EXPECT_NE(report.at("settings").get<std::string>().find("final_gather=2"), std::string::npos);

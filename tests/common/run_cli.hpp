@@ -1,9 +1,12 @@
 #pragma once
 // Runs the lambert CLI in-process, as the tests' stand-in for the `lambert` binary.
 
+#include <gtest/gtest.h>
+
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "apps/cli.hpp"
@@ -16,6 +19,15 @@ inline int run(std::vector<std::string> args) {
   std::vector<const char*> argv;
   for (const auto& a : args) argv.push_back(a.c_str());
   return run_cli(static_cast<int>(argv.size()), argv.data());
+}
+
+/// run(args) with stdout and stderr captured: the exit code and what went to stderr.
+inline std::pair<int, std::string> run_capturing(const std::vector<std::string>& args) {
+  ::testing::internal::CaptureStderr();
+  ::testing::internal::CaptureStdout();
+  const int code = run(args);
+  ::testing::internal::GetCapturedStdout();
+  return {code, ::testing::internal::GetCapturedStderr()};
 }
 
 /// The whole content of a file ("" if it cannot be read).

@@ -2,10 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <numeric>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/sampling.hpp"
 
 namespace lambert {
@@ -27,6 +31,35 @@ TEST(ParallelFor, RethrowsTheWorkersExceptionOnTheCaller) {
                               if (b == 42) throw std::runtime_error("boom");
                             }),
                std::runtime_error);
+}
+
+TEST(ParallelFor, ACancelRequestSkipsTheRestAndThrowsCancelled) {
+  // Python's Ctrl-C (issue 33, item 8) sets the request from a signal handler; every loop
+  // stops claiming chunks and the call ends with Cancelled instead of running to the end.
+  for (int threads : {1, 3}) {
+    std::atomic<int> ran{0};
+    clear_cancel();
+    EXPECT_THROW(parallel_for(1000, 1, threads,
+                              [&](std::int64_t b, std::int64_t) {
+                                ++ran;
+                                if (b == 0) request_cancel();
+                                // Slow chunks: the request lands long before the end.
+                                std::this_thread::sleep_for(std::chrono::microseconds(200));
+                              }),
+                 Cancelled);
+    // One thread: chunk 0 asked and nothing more ran; more threads: the chunks they had
+    // claimed still end (a few of the 1000).
+    if (threads == 1) {
+      EXPECT_EQ(ran.load(), 1);
+    }
+    EXPECT_LT(ran.load(), 100) << threads;
+    EXPECT_TRUE(cancel_requested());
+    clear_cancel();
+    // Withdrawn, the next loop runs whole.
+    std::atomic<int> all{0};
+    parallel_for(1000, 1, threads, [&](std::int64_t, std::int64_t) { ++all; });
+    EXPECT_EQ(all.load(), 1000);
+  }
 }
 
 TEST(Sampling, KroneckerPointsAreEquidistributed) {

@@ -119,7 +119,7 @@ void calibrate(const std::string& estimator, int samples) {
 }  // namespace
 
 TEST(ErrorBarsSlow, HybridCoverageAndSpreadAreCalibrated) { calibrate("hybrid", 64); }
-TEST(ErrorBars, McCoverageAndSpreadAreCalibrated) { calibrate("mc", 256); }
+TEST(ErrorBarsSlow, McCoverageAndSpreadAreCalibrated) { calibrate("mc", 256); }
 
 // A tapered receiver (width 2 -> 0.1) with its narrow half hidden: sampling a bilinear
 // quad uniformly in (u, v) without its Jacobian weighted the visible fraction by the

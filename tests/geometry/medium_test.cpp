@@ -106,6 +106,23 @@ TEST(MediumModel, ValidationNamesTheProblem) {
   Medium inverted = homogeneous_medium({0, 0, 0}, {1, -1, 1}, {1, 1, 1}, Eigen::Vector3d::Ones(),
                                        Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
   EXPECT_THROW(validate_medium(inverted, "x"), UsageError);
+  // Issue 33, item 8: sigma 1e-320 gave NaN energies, 1e300 a message naming no file; both
+  // are refused by optical thickness (sigma_t x the box's diagonal), naming the source.
+  for (const double sigma : {1e-320, 1e-120, 1e300}) {
+    const Medium bad =
+        homogeneous_medium({0, 0, 0}, {1, 1, 1}, {1, 1, 1}, Eigen::Vector3d::Zero(),
+                           Eigen::Vector3d::Constant(sigma), Eigen::Vector3d::Zero());
+    try {
+      validate_medium(bad, "fog.txt");
+      ADD_FAILURE() << sigma << " accepted";
+    } catch (const UsageError& err) {
+      EXPECT_EQ(std::string(err.what()).rfind("fog.txt: voxel 0:", 0), 0u) << err.what();
+    }
+  }
+  EXPECT_NO_THROW(
+      validate_medium(homogeneous_medium({0, 0, 0}, {1, 1, 1}, {1, 1, 1}, Eigen::Vector3d::Zero(),
+                                         Eigen::Vector3d::Constant(1e-90), Eigen::Vector3d::Zero()),
+                      "x"));
   // --voxels N: N along the longest axis, the others in proportion.
   EXPECT_EQ(medium_resolution({0, 0, 0}, {556, 548.8, 559.2}, 16, 0.0),
             Eigen::Vector3i(16, 16, 16));

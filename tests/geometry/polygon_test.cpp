@@ -4,6 +4,10 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <utility>
+#include <vector>
+
+#include "core/error.hpp"
 
 namespace lambert {
 
@@ -32,6 +36,46 @@ TEST(Polygon, ConvexFanIsTheEarClippingOrder) {
   EXPECT_EQ(t[0], (std::array<int, 3>{5, 0, 1}));
   EXPECT_EQ(t[2], (std::array<int, 3>{5, 2, 3}));
   EXPECT_EQ(t[3], (std::array<int, 3>{3, 4, 5}));
+}
+
+// A star of n corners alternating between radii 1 and 0.5 (n even), in the plane z = 0.3,
+// counter-clockwise seen from +z; its exact area is n/2 triangles (0, r1, r2) twice.
+std::vector<Eigen::Vector3d> star(int n) {
+  std::vector<Eigen::Vector3d> p;
+  for (int k = 0; k < n; ++k) {
+    const double t = 2.0 * M_PI * k / n, r = k % 2 ? 0.5 : 1.0;
+    p.emplace_back(r * std::cos(t), r * std::sin(t), 0.3);
+  }
+  return p;
+}
+
+TEST(Polygon, NonConvexPolygonOfAHundredThousandCornersTriangulatesInNLogN) {
+  // Issue 33, item 7: ear clipping is O(n^2) or worse on a non-convex polygon (a 10^5-corner
+  // outline took hours); above kEarClippingCorners the constrained Delaunay triangulation
+  // runs in O(n log n) (about 0.1 s here).
+  const int n = 100000;
+  const std::vector<Eigen::Vector3d> p = star(n);
+  const auto tris = triangulate(p);
+  ASSERT_EQ(tris.size(), static_cast<size_t>(n - 2));
+  double area = 0.0;
+  for (const auto& t : tris) {
+    for (int v : t) ASSERT_TRUE(v >= 0 && v < n);
+    // Wound like the polygon: every triangle's normal along +z.
+    const double z = (p[t[1]] - p[t[0]]).cross(p[t[2]] - p[t[0]]).z();
+    ASSERT_GT(z, 0.0);
+    area += 0.5 * z;
+  }
+  // n/2 kites of two triangles (0, r=1, r=0.5) with angle 2 pi / n between corners:
+  // area = n * 0.5 * 1 * 0.5 * sin(2 pi / n); the triangles tile it to rounding.
+  const double exact = n * 0.25 * std::sin(2.0 * M_PI / n);
+  EXPECT_NEAR(area, exact, 1e-12 * exact * std::sqrt(n));
+  // The same outline with two corners swapped crosses itself: refused, not hours of clipping.
+  std::vector<Eigen::Vector3d> crossed = p;
+  std::swap(crossed[10], crossed[20]);
+  EXPECT_THROW(triangulate(crossed), SceneError);
+  // Small non-convex polygons keep ear clipping (its order is part of meshes' bitwise results).
+  const auto small = triangulate(star(kEarClippingCorners));
+  EXPECT_EQ(small.size(), static_cast<size_t>(kEarClippingCorners - 2));
 }
 
 }  // namespace lambert

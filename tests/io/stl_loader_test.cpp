@@ -174,6 +174,42 @@ TEST(StlLoader, NonFiniteNumbersAreRefused) {
   EXPECT_NE(ea.find("t.stl:4: 'inf'"), std::string::npos) << ea;
 }
 
+TEST(StlLoader, CoordinatesBeyondTheObjLimitAreRefused) {
+  // Issue 33, item 8: OBJ refuses |x| > 1e50 (distances^4 overflow); ASCII STL took them.
+  std::string text = ascii({{"a", tetrahedron()}});
+  const auto at = text.find("vertex ") + 7;
+  text.replace(at, text.find(' ', at) - at, "-2e50");
+  const std::string e = error_of(text);
+  EXPECT_NE(e.find("t.stl:4: '-2e50': coordinate beyond +-1e50"), std::string::npos) << e;
+  // And a scene below 1e-50 across, where form factors underflow.
+  const std::string tiny = error_of(
+      "solid a\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1e-60 0 0\n"
+      "vertex 0 1e-60 0\nendloop\nendfacet\nendsolid\n");
+  EXPECT_NE(tiny.find("t.stl: scene extent below 1e-50"), std::string::npos) << tiny;
+}
+
+TEST(StlLoader, CoincidentFacetsAreWarnedOncePerPairOfSurfaces) {
+  // Issue 33, item 8: OBJ warned of faces with the same corners (their area counts twice);
+  // STL did not. Two solids holding the same tetrahedron: four coincident faces, one warning.
+  LoadReport report;
+  const Scene s =
+      load_stl_bytes(ascii({{"a", tetrahedron()}, {"b", tetrahedron()}}), "t.stl", &report);
+  EXPECT_EQ(s.faces.size(), 8u);
+  EXPECT_EQ(report.coincident_faces, 4);
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_NE(report.warnings[0].find("surfaces 'a' and 'b', 4 coincident face(s)"),
+            std::string::npos)
+      << report.warnings[0];
+  // Binary facets have no line: the warning names no line 0.
+  std::vector<Tri> twice = tetrahedron();
+  twice.push_back(twice[0]);
+  LoadReport binary_report;
+  load_stl_bytes(binary(twice), "t.stl", &binary_report);
+  EXPECT_EQ(binary_report.coincident_faces, 1);
+  ASSERT_EQ(binary_report.warnings.size(), 1u);
+  EXPECT_EQ(binary_report.warnings[0].find("line 0"), std::string::npos);
+}
+
 TEST(StlLoader, BadKeywordNamesTheLine) {
   std::string text = ascii({{"a", tetrahedron()}});
   text.replace(text.find("endloop"), 7, "endlop");

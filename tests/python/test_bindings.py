@@ -178,6 +178,13 @@ def test_wrong_arguments_raise_not_crash(cornell_mesh):
         lambert.form_factors(cornell_mesh, estimator="nope")
     with pytest.raises(lambert.UsageError):
         lambert.form_factors(cornell_mesh, estimator="gather", samples=4)
+    # Issue 33, item 8: nan passed `threshold < 0` and dropped nothing; the hemicube never
+    # read samples.
+    for bad in (float("nan"), -0.1, 1.5):
+        with pytest.raises(lambert.UsageError, match="threshold"):
+            lambert.form_factors(cornell_mesh, estimator="hemicube", threshold=bad)
+    with pytest.raises(lambert.UsageError, match="samples does not apply"):
+        lambert.form_factors(cornell_mesh, estimator="hemicube", samples=4)
     with pytest.raises(TypeError):
         lambert.form_factors("not a mesh")
     with pytest.raises(TypeError):
@@ -350,3 +357,25 @@ def test_heat_isothermal_enclosure_has_no_net_flux(tmp_path):
     assert r["status"] == "converged"
     assert np.abs(r["q"]).max() <= bound
     assert np.abs(r["J"] - sigma_t4).max() <= bound
+
+
+def test_ctrl_c_stops_a_long_call_within_seconds(cornell):
+    """Issue 33, item 8: Ctrl-C during a long call waited for its end (Python handles SIGINT
+    only with the GIL back). The call below is minutes of work; SIGINT half a second in must
+    end it with KeyboardInterrupt within a few seconds, and the next call runs normally."""
+    import signal
+    import threading
+    import time
+    mesh = cornell.mesh(patches=3000)
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        lambert.form_factors(mesh, estimator="mc", samples=256)  # ~1e9 rays
+    timer.join()
+    # The parallel loops stop at their next chunk: well under the minutes the call needs
+    # (20 s of slack for a loaded 2-core machine).
+    assert time.monotonic() - start < 20
+    small = cornell.mesh(patches=40)
+    F = lambert.form_factors(small, estimator="hybrid", samples=4)
+    assert F.shape == (len(small), len(small))

@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <memory>
+#include <utility>
 
 #include "core/error.hpp"
 
@@ -79,6 +80,22 @@ TEST(Thermal, ConcentricSpheresMatchTheTwoSurfaceFormula) {
   EXPECT_NEAR(s.Q[0], q1, 1e-12 * q1);
   EXPECT_NEAR(s.Q[1], -q1, 1e-12 * q1);
   EXPECT_NEAR(s.closure, 0.0, 1e-12 * q1);
+}
+
+TEST(Thermal, OverflowingTemperaturesAreErrorsNotInfinity) {
+  // Issue 33, item 6: an emissivity of 1e-320 (e sigma underflows to 0) or a flux of 1e308
+  // wrote T = inf with exit 0 and no undefined temperature counted.
+  for (const auto& [eps, q] : {std::pair{1e-320, 100.0}, std::pair{0.5, 1e308}}) {
+    const auto p =
+        make(plates_and_walls(), Eigen::Vector3d(1.0, 1.0, 2.0), Eigen::Vector3d(0.8, eps, 0.4),
+             {kT, kQ, kQ}, Eigen::Vector3d(300.0, q, 0.0));
+    try {
+      solve_thermal(p, direct());
+      ADD_FAILURE() << "emissivity " << eps << ", flux " << q << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("overflows"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Thermal, ReradiatingWallMatchesTheThreeSurfaceNetwork) {

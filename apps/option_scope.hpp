@@ -1,0 +1,52 @@
+#pragma once
+// Which choices read which options: one table row per option that only some methods,
+// estimators or solvers read (options with no row are read by every choice of the commands
+// that register them). Every command checks the options given on its command line against
+// the table before any work: an option its choices do not read is a usage error (exit 2)
+// naming the option, the choice and what reads it, never a silently ignored setting.
+// (The `--method` rows of apps/method.hpp refuse the other method's options first.)
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace lambert {
+
+/// What a command line chose: the axes an option's use depends on.
+struct Selection {
+  std::string command;  ///< "run", "solve", "render", "compare", "formfactors", "heat"
+  std::string method = "matrix";
+  /// --estimator as given ("auto" included); empty when no F is computed (a loaded --ff,
+  /// --method hierarchical, --radiosity).
+  std::string estimator;
+  /// The solvers that will run: one (--solver; "petsc" with --distributed), several
+  /// (compare's --solvers; all by default), or none (formfactors, --method hierarchical,
+  /// --radiosity).
+  std::vector<std::string> solvers;
+  /// The resolved shading of run and render ("gouraud", "flat", "raytrace"); empty elsewhere.
+  std::string shading;
+  bool medium = false;  ///< a participating medium is given (its exchange is Monte Carlo)
+  /// run and render jitter pixel samples (--antialias above 1) or trace camera paths.
+  bool random_pixels = false;
+};
+
+/// One row: the option, what reads it (for the message), and when it is read.
+struct OptionScope {
+  std::string option;  ///< long name as registered, e.g. "--omega"
+  std::string reader;  ///< "the solver sor"
+  std::function<bool(const Selection&)> reads;
+};
+
+/// The table.
+const std::vector<OptionScope>& option_scopes();
+
+/// Throws UsageError for the first option given on `cmd`'s command line that `selection`
+/// does not read: "--omega does not apply to --solver jacobi (read by the solver sor)".
+void check_option_scopes(const CLI::App& cmd, const Selection& selection);
+
+/// The long names of the options given on `cmd`'s command line that `selection` does not
+/// read, in table order (what check_option_scopes refuses; empty when all apply).
+std::vector<std::string> unread_options(const CLI::App& cmd, const Selection& selection);
+
+}  // namespace lambert
