@@ -34,6 +34,19 @@ bool estimator_may_be(const Selection& s, std::initializer_list<const char*> nam
   return is_one_of(s.estimator, names);
 }
 
+// --reciprocity and --symmetrize: the estimators whose F is not reciprocal by construction
+// (mc, hybrid and analytic compute each pair once; gather averages by default).
+bool averages_pairs(const Selection& s) { return estimator_may_be(s, {"gather", "hemicube"}); }
+
+// --max-iter and --tol: an iterative solver or the hierarchical method runs (direct
+// factorises: no iterations, a residual at rounding level whatever the tolerance). The --tol
+// of formfactors is --ff-tol's alias: unread_options leaves it to that row.
+bool iterates(const Selection& s) {
+  return s.method == "hierarchical" ||
+         std::any_of(s.solvers.begin(), s.solvers.end(),
+                     [](const std::string& v) { return v != "direct"; });
+}
+
 // "run --method matrix --estimator hybrid --solver sor": what the command line chose.
 std::string describe(const Selection& s) {
   std::string out = s.command + " --method " + s.method;
@@ -64,16 +77,8 @@ const std::vector<OptionScope>& option_scopes() {
        [](const Selection& s) { return computes_f(s) && s.estimator == "hemicube"; }},
       // What every estimator's F goes through.
       {"--threshold", "a computed F", computes_f},
-      // mc, hybrid and analytic compute each pair once: their F is reciprocal by
-      // construction and averaging changes nothing. gather averages by default (auto).
-      {"--reciprocity", "the estimators gather and hemicube",
-       [](const Selection& s) {
-         return estimator_may_be(s, {"gather", "hemicube"});
-       }},
-      {"--symmetrize", "the estimators gather and hemicube",
-       [](const Selection& s) {
-         return estimator_may_be(s, {"gather", "hemicube"});
-       }},
+      {"--reciprocity", "the estimators gather and hemicube", averages_pairs},
+      {"--symmetrize", "the estimators gather and hemicube", averages_pairs},
       {"--specular-rays", "a computed F (the extended form factors through mirrors and glass)",
        computes_f},
       {"--specular-depth",
@@ -102,20 +107,8 @@ const std::vector<OptionScope>& option_scopes() {
        }},
       {"--ambient", "the solver southwell",
        [](const Selection& s) { return runs_solver(s, {"southwell"}); }},
-      // direct factorises: no iterations, and its residual is at rounding level whatever the
-      // tolerance (the tolerance of formfactors is --ff-tol's alias, a row above).
-      {"--max-iter", "the iterative solvers and --method hierarchical",
-       [](const Selection& s) {
-         return s.method == "hierarchical" ||
-                std::any_of(s.solvers.begin(), s.solvers.end(),
-                            [](const std::string& v) { return v != "direct"; });
-       }},
-      {"--tol", "the iterative solvers and --method hierarchical",
-       [](const Selection& s) {
-         return s.command == "formfactors" || s.method == "hierarchical" ||
-                std::any_of(s.solvers.begin(), s.solvers.end(),
-                            [](const std::string& v) { return v != "direct"; });
-       }},
+      {"--max-iter", "the iterative solvers and --method hierarchical", iterates},
+      {"--tol", "the iterative solvers and --method hierarchical", iterates},
   };
   return kScopes;
 }
