@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "apps/commands.hpp"
+#include "core/atomic_file.hpp"
 #include "core/error.hpp"
 
 namespace lambert {
@@ -51,7 +52,13 @@ int run_cli(int argc, const char* const* argv) {
   }
   try {
     for (auto& [cmd, run] : commands)
-      if (cmd->parsed()) return run();
+      if (cmd->parsed()) {
+        // A command's files are replaced as one set, when it ends (core/atomic_file.hpp).
+        OutputSet outputs;
+        const int code = run();
+        outputs.commit();
+        return code;
+      }
     return kExitUsage;
   } catch (const UsageError& e) {
     std::cerr << "lambert: " << e.what() << '\n';

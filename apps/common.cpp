@@ -155,6 +155,9 @@ void check_job_files(const std::vector<NamedFile>& inputs, const std::vector<Nam
                        other.path + "': choose another name");
     }
     seen.emplace_back(key, &out);
+    std::error_code ec;
+    if (fs::is_directory(out.path, ec))
+      throw IoError(out.path + ": cannot write " + out.option + ": it is a folder");
   }
   std::vector<fs::path> probed;
   for (const NamedFile& out : outputs) {

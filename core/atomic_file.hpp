@@ -7,6 +7,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace lambert {
 
@@ -30,5 +31,39 @@ void write_atomically(const std::string& path,
 void write_stream_atomically(const std::string& path,
                              const std::function<void(std::ostream& out)>& write,
                              bool binary = false);
+
+/// The files of one command, replaced as a set. While an OutputSet is open on a thread,
+/// write_atomically there writes each file's temporary only. commit() then writes a journal
+/// listing the renames, ".lambert-commit.PID", into every folder the set writes to (the
+/// commit point), renames, and removes the journals. Killed before the commit point, the
+/// previous files all stay (the temporaries go with the next write there, as above); killed
+/// after it, the next write into any of those folders finishes the renames first
+/// (finish_interrupted_commits). Destroyed without commit(), the set's temporaries are removed.
+class OutputSet {
+ public:
+  OutputSet();
+  ~OutputSet();
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+
+  /// Renames every staged temporary to its file. `after_rename(k)` (tests) runs after the
+  /// k-th rename. Throws IoError when a rename fails.
+  void commit(const std::function<void(std::size_t)>& after_rename = {});
+  /// Files staged so far, in order.
+  std::vector<std::string> files() const;
+
+ private:
+  friend void write_atomically(const std::string&, const std::function<void(const std::string&)>&);
+  struct Staged {
+    std::string tmp, path;
+  };
+  std::vector<Staged> staged_;
+  OutputSet* outer_;
+  bool committed_ = false;
+};
+
+/// Finishes the renames of journals in `directory` left by processes that are no longer
+/// running, and removes those journals. Errors are ignored.
+void finish_interrupted_commits(const std::string& directory);
 
 }  // namespace lambert

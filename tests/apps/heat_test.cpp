@@ -321,6 +321,32 @@ TEST(HeatCli, WritesEveryOutputAtomically) {
   EXPECT_NE(slurp(dir.file("h.ply")).find("property float temperature"), std::string::npos);
 }
 
+TEST(HeatCli, AFailedRunLeavesThePreviousSetOfOutputsWhole) {
+  // heat's CSVs, image and JSON are one result: a run that fails to write one of them must
+  // not leave new CSVs beside an old JSON (they used to be renamed one by one as written).
+  const TempDir dir;
+  const std::string stl = dir.write("plates.stl", ascii_stl(plates_box(true)));
+  const auto conditions = [&](int t) {
+    return dir.write("s.json", R"({"hot": {"emissivity": 0.8, "temperature": )" +
+                                   std::to_string(t) +
+                                   R"(}, "*": {"emissivity": 0.5, "heat_flux": 0}})");
+  };
+  const std::vector<std::string> common = {"--patches", "100", "-o", dir.file("out"), "-q"};
+  std::vector<std::string> first = {"heat", stl, "--surfaces", conditions(900)};
+  first.insert(first.end(), common.begin(), common.end());
+  ASSERT_EQ(run(first), kExitOk);
+  const std::string csv = slurp(dir.file("out_surfaces.csv")), json = slurp(dir.file("out.json"));
+  std::filesystem::create_directory(dir.file("t.png"));  // an image path that cannot be written
+  std::vector<std::string> second = {
+      "heat", stl, "--surfaces", conditions(700), "--image", dir.file("t.png"), "--size", "32x24"};
+  second.insert(second.end(), common.begin(), common.end());
+  EXPECT_EQ(testing::run_capturing(second).first, kExitFailure);
+  EXPECT_EQ(slurp(dir.file("out_surfaces.csv")), csv);
+  EXPECT_EQ(slurp(dir.file("out.json")), json);
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir.path()))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
+
 TEST(HeatCli, LengthUnitScalesAreasAndPowers) {
   const TempDir dir;
   std::vector<std::pair<std::string, std::vector<Tri>>> solids = plates_box(true);
