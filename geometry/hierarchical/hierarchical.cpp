@@ -73,6 +73,16 @@ struct State {
   /// Bytes of state per node (for the memory count).
   static constexpr double kBytesPerNode =
       4 * sizeof(Eigen::Vector3d) + sizeof(Eigen::Matrix3d) + sizeof(Field);
+  /// Bytes held (by capacity).
+  double bytes() const { return static_cast<double>(B.capacity()) * kBytesPerNode; }
+  void reserve(std::size_t n) {
+    lo.reserve(n);
+    grad.reserve(n);
+    hi.reserve(n);
+    B.reserve(n);
+    gathered.reserve(n);
+    H.reserve(n);
+  }
   void resize(std::size_t n) {
     lo.resize(n, Eigen::Vector3d::Zero());
     grad.resize(n, Eigen::Matrix3d::Zero());
@@ -274,7 +284,14 @@ struct Refinement {
 /// The child links of refined links (after their nodes were split), in order.
 std::vector<std::pair<std::int32_t, std::int32_t>> expand(const Hierarchy& h,
                                                           const std::vector<Refinement>& r) {
+  std::size_t count = 0;
+  for (const auto& x : r)
+    count += x.action == Action::SplitBoth
+                 ? static_cast<std::size_t>(h.node(x.p).child_count * h.node(x.p).child_count)
+                 : static_cast<std::size_t>(
+                       h.node(x.action == Action::SplitSource ? x.q : x.p).child_count);
   std::vector<std::pair<std::int32_t, std::int32_t>> out;
+  out.reserve(count);
   for (const auto& x : r) {
     const hr::Node& np = h.node(x.p);
     const hr::Node& nq = h.node(x.q);
@@ -315,11 +332,61 @@ void split_nodes(Hierarchy& h, const std::vector<Refinement>& r, State& s) {
     }
 }
 
-double memory_bytes(const Hierarchy& h, const LinkTable& t, std::size_t pending) {
-  return h.bytes() + static_cast<double>(t.links.capacity()) * sizeof(Link) +
-         static_cast<double>(pending) * (sizeof(Link) + sizeof(Refinement)) +
-         static_cast<double>(h.nodes().capacity()) * State::kBytesPerNode +
-         static_cast<double>(h.faces().size()) * 256.0;  // the face BVH, ~2 nodes per face
+/// The refinement's memory: what it holds, and what the next wave or recheck would add at
+/// its peak, so that a hierarchy that would exceed the limit stops before allocating (the
+/// limit bounds the peak, not the state after a wave). Every growing vector is reserved to
+/// the size the estimate assumed, so it is reallocated at most once per wave and the peak is
+/// the old buffer plus the new one.
+struct Budget {
+  const Hierarchy& h;
+  const LinkTable& t;
+  const State& s;
+  double limit;  ///< bytes (0 = none)
+
+  /// Bytes held now: nodes with geometry and state, links and their index, the face BVH.
+  double held() const {
+    return h.bytes() + s.bytes() + static_cast<double>(t.links.capacity()) * sizeof(Link) +
+           static_cast<double>(t.starts.capacity()) * sizeof(std::int64_t) +
+           static_cast<double>(h.faces().size()) * 256.0;  // the face BVH, ~2 nodes per face
+  }
+  /// The capacity a vector of `size` and `capacity` is reserved to before growing by `add`
+  /// (amortised: at least 1.5x, so a long refinement copies O(n) in all).
+  static std::size_t grown(std::size_t size, std::size_t capacity, std::size_t add) {
+    return size + add <= capacity ? capacity : std::max(size + add, capacity + capacity / 2);
+  }
+  /// Throws when the held bytes plus `extra` exceed the limit.
+  void check(double extra, const char* stage) const {
+    const double need = held() + extra;
+    if (limit > 0 && need > limit)
+      throw Error("hierarchical: the hierarchy needs more than " + format_bytes(limit) + " (" +
+                  format_bytes(need) + " at its " + stage + ": " + std::to_string(h.size()) +
+                  " nodes, " + std::to_string(t.links.size()) +
+                  " links so far); raise --epsilon or --min-area, or the memory limit");
+  }
+};
+
+/// Node children and child links a wave over `r` creates: (nodes split, child links).
+std::pair<std::size_t, std::size_t> wave_size(const Hierarchy& h, const std::vector<Refinement>& r,
+                                              std::vector<std::int32_t>& split) {
+  split.clear();
+  std::size_t links = 0;
+  const auto children = [&](std::int32_t i) -> std::size_t {
+    const hr::Node& n = h.node(i);
+    if (n.child_count > 0 || n.cluster) return static_cast<std::size_t>(n.child_count);
+    split.push_back(i);
+    return 4;  // split_element makes 4
+  };
+  for (const auto& x : r) {
+    if (x.action == Action::SplitBoth) {
+      const std::size_t c = children(x.p);
+      links += c * c;
+    } else {
+      links += children(x.action == Action::SplitSource ? x.q : x.p);
+    }
+  }
+  std::sort(split.begin(), split.end());
+  split.erase(std::unique(split.begin(), split.end()), split.end());
+  return {split.size() * 4, links};
 }
 
 /// The leaves as a PatchMesh (vertices shared within a surface by exact position) and B.
@@ -485,6 +552,8 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
   push_pull(h, h.root(), kNoField, s);  // B = E
 
   LinkTable table;
+  const Budget budget{h, table, s, o.memory_limit};
+  std::vector<std::int32_t> to_split;
   std::vector<std::pair<std::int32_t, std::int32_t>> pending;
   if (emitted.maxCoeff() > 0.0) pending.emplace_back(h.root(), h.root());
   Progress progress("hierarchical", o.progress ? o.max_passes : 0, "links");
@@ -493,6 +562,8 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
     Timer refine_timer;
     std::vector<Refinement> refine;
     if (pass > 1) {  // recheck the accepted links against the new B
+      // The verdicts, and at worst every link to refine.
+      budget.check(static_cast<double>(table.links.size()) * (1.0 + sizeof(Refinement)), "recheck");
       std::vector<Action> verdict(table.links.size());
       parallel_for(static_cast<std::int64_t>(verdict.size()), kGatherChunk, threads,
                    [&](std::int64_t b, std::int64_t e) {
@@ -512,9 +583,35 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
     }
     ++st.passes;
     while (!pending.empty() || !refine.empty()) {
+      {  // the wave's peak: new nodes (a reallocation holds old and new buffers), its links
+         // (pending, evaluated, actions, at worst all refined again), the table's growth
+        const auto [new_nodes, new_links] = wave_size(h, refine, to_split);
+        const std::size_t nodes = h.nodes().size(), links = table.links.size();
+        const std::size_t node_cap = Budget::grown(nodes, h.nodes().capacity(), new_nodes);
+        const std::size_t link_cap = Budget::grown(links, table.links.capacity(), new_links);
+        const std::size_t wave = pending.size() + new_links;
+        double extra = static_cast<double>(to_split.capacity()) * sizeof(std::int32_t) +
+                       static_cast<double>(wave) * (2 * sizeof(pending[0]) + sizeof(Link) +
+                                                    sizeof(Action) + sizeof(Refinement));
+        if (node_cap > h.nodes().capacity())
+          extra += static_cast<double>(node_cap) *
+                   (sizeof(hr::Node) + sizeof(ff::PatchGeom) + State::kBytesPerNode);
+        if (link_cap > table.links.capacity())
+          extra += static_cast<double>(link_cap) * sizeof(Link);
+        budget.check(extra, "next refinement wave");
+        if (node_cap > h.nodes().capacity()) {
+          h.reserve(node_cap);
+          s.reserve(node_cap);
+        }
+        if (link_cap > table.links.capacity()) table.links.reserve(link_cap);
+      }
       split_nodes(h, refine, s);
-      const auto children = expand(h, refine);
-      pending.insert(pending.end(), children.begin(), children.end());
+      auto children = expand(h, refine);
+      if (pending.empty())
+        pending.swap(children);
+      else
+        pending.insert(pending.end(), children.begin(), children.end());
+      std::vector<std::pair<std::int32_t, std::int32_t>>().swap(children);
       refine.clear();
       std::vector<Link> evaluated(pending.size());
       std::vector<Action> action(pending.size());
@@ -529,19 +626,17 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
                      chunk_rays[b / kEvalChunk] += r;
                    });
       for (const std::int64_t r : chunk_rays) rays += r;
+      refine.reserve(
+          static_cast<std::size_t>(std::count_if(action.begin(), action.end(), [](Action a) {
+            return a != Action::Accept && a != Action::Drop;
+          })));
       for (std::size_t k = 0; k < pending.size(); ++k) {
         if (action[k] == Action::Accept)
           table.links.push_back(evaluated[k]);
         else if (action[k] != Action::Drop)
           refine.push_back({pending[k].first, pending[k].second, action[k]});
       }
-      pending.clear();
-      const double bytes = memory_bytes(h, table, refine.size() * 4);
-      if (o.memory_limit > 0 && bytes > o.memory_limit)
-        throw Error("hierarchical: the hierarchy needs more than " + format_bytes(o.memory_limit) +
-                    " (" + std::to_string(h.size()) + " nodes, " +
-                    std::to_string(table.links.size()) +
-                    " links so far); raise --epsilon or --min-area, or the memory limit");
+      std::vector<std::pair<std::int32_t, std::int32_t>>().swap(pending);
     }
     table.index();
     st.refine_seconds += refine_timer.seconds();
@@ -570,7 +665,7 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
   for (const Link& l : table.links)
     st.cluster_links += h.node(l.p).cluster || h.node(l.q).cluster;
   st.rays = rays;
-  st.memory_bytes = memory_bytes(h, table, 0);
+  st.memory_bytes = budget.held();
   energy_balance(h, s, st);
   export_leaves(h, s, leaf_irradiance_error(h, table, ctx, s), result);
   st.leaves = result.mesh.size();

@@ -215,6 +215,11 @@ Eigen::Vector3d Hierarchy::sample_point(std::int32_t i, double u, double v, doub
   return a + v * (b - a) + w * (c - a);
 }
 
+void Hierarchy::reserve(std::size_t n) {
+  nodes_.reserve(n);
+  geom_.reserve(n);
+}
+
 double Hierarchy::bytes() const {
   return static_cast<double>(nodes_.capacity()) * sizeof(Node) +
          static_cast<double>(geom_.capacity()) * sizeof(ff::PatchGeom);

@@ -74,6 +74,8 @@ class Hierarchy {
 
   /// Bytes held by nodes and element geometry.
   double bytes() const;
+  /// Makes room for `n` nodes in all (no reallocation while splitting up to there).
+  void reserve(std::size_t n);
 
  private:
   std::int32_t build_clusters(std::vector<std::int32_t>& elements, std::size_t begin,

@@ -3,7 +3,11 @@
 // per-surface averages agree with the matrix method within both methods' estimated errors.
 // Coarse epsilons and small images keep each test to a few seconds on 2 cores.
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -266,6 +270,45 @@ TEST(HierarchicalSolve, MemoryLimitStopsTheSolveWithOneLine) {
   EXPECT_NE(err.find("16.0 KiB"), std::string::npos) << err;
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
   EXPECT_FALSE(std::filesystem::exists(dir.file("B.csv")));
+}
+
+// Peak resident memory (bytes) and exit code of the lambert binary run with `args`.
+std::pair<long, int> peak_of_lambert(const std::vector<std::string>& args) {
+  std::vector<std::string> all = {LAMBERT_BIN};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const pid_t child = ::fork();
+  if (child == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, 1);
+    ::dup2(null, 2);
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  int status = 0;
+  struct rusage use {};
+  ::wait4(child, &status, 0, &use);
+  return {use.ru_maxrss * 1024L, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+}
+
+TEST(HierarchicalSolveSlow, TheMemoryLimitBoundsThePeakNotJustTheStateAfterAWave) {
+  // --epsilon 1e-300 refines until the limit stops it. The limit bounds the hierarchy's
+  // nodes, links and BVH at their peak: the process may use at most the limit beyond what
+  // the same solve uses at the default epsilon (the rest of the process, and a small
+  // hierarchy). It used to check after each wave had been allocated, and a wave of the
+  // Cornell box grows the links ~4x: 100 MiB gave a 243 MB peak (200 MB over that base).
+  testing::TempDir dir;
+  const std::vector<std::string> solve = {"solve", "--method", "hierarchical",
+                                          "-q",    "-o",       dir.file("B.csv")};
+  const auto [base, base_code] = peak_of_lambert(solve);
+  ASSERT_EQ(base_code, kExitOk);
+  std::vector<std::string> fine = solve;
+  for (const char* a : {"--epsilon", "1e-300", "--max-memory", "100M"}) fine.push_back(a);
+  const auto [peak, code] = peak_of_lambert(fine);
+  EXPECT_EQ(code, kExitFailure);
+  EXPECT_LE(peak - base, 100L << 20) << "peak " << peak << " B, base " << base << " B";
 }
 
 TEST(HierarchicalRender, SolvesAndWritesEveryRequestedFile) {
