@@ -8,21 +8,24 @@
 
 namespace lambert {
 namespace {
-constexpr std::size_t kChunkBytes = std::size_t{1} << 16;
+constexpr std::size_t kFirstChunkBytes = std::size_t{1} << 12, kChunkBytes = std::size_t{1} << 16;
 }  // namespace
 
-LineReader::LineReader(std::istream& in, std::string name)
-    : in_(in), name_(std::move(name)), buf_(kChunkBytes) {}
+LineReader::LineReader(std::istream& in, std::string name) : in_(in), name_(std::move(name)) {}
 
 std::string LineReader::where() const { return name_ + ":" + std::to_string(line_); }
 
 bool LineReader::fill() {
   if (eof_) return false;
-  in_.read(buf_.data(), static_cast<std::streamsize>(buf_.size()));
+  if (capacity_ < kChunkBytes && end_ == capacity_) {  // the first read, or the last was full
+    capacity_ = capacity_ == 0 ? kFirstChunkBytes : std::min(kChunkBytes, 4 * capacity_);
+    buf_.reset(new char[capacity_]);
+  }
+  in_.read(buf_.get(), static_cast<std::streamsize>(capacity_));
   end_ = static_cast<std::size_t>(in_.gcount());
   pos_ = 0;
   if (in_.bad()) throw IoError(name_ + ": read error: " + std::strerror(errno));
-  if (end_ < buf_.size()) eof_ = true;
+  if (end_ < capacity_) eof_ = true;
   if (!started_ && end_ > 0) {
     started_ = true;
     const auto u = [&](std::size_t k) { return k < end_ ? static_cast<unsigned char>(buf_[k]) : 0u; };
@@ -47,7 +50,7 @@ bool LineReader::next(std::string_view& line) {
     if (line_buf_.size() + (k - pos_) > kMaxLineBytes)
       throw SceneError(name_ + ":" + std::to_string(line_ + 1) + ": line longer than " +
                        std::to_string(kMaxLineBytes >> 20) + " MiB (not a text file?)");
-    line_buf_.append(buf_.data() + pos_, k - pos_);
+    line_buf_.append(buf_.get() + pos_, k - pos_);
     pos_ = k;
     if (k == end_) continue;
     if (buf_[k] == '\0')

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <istream>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -35,8 +36,10 @@ class LineReader {
   bool fill();  // refills buf_ from the stream; false at its end
   std::istream& in_;
   std::string name_;
-  std::vector<char> buf_;
-  std::size_t pos_ = 0, end_ = 0;
+  /// The chunk read at once: 4 KiB, growing x4 per full read up to 64 KiB (a small file
+  /// costs a small buffer). Not zeroed: only what was read is used.
+  std::unique_ptr<char[]> buf_;
+  std::size_t capacity_ = 0, pos_ = 0, end_ = 0;
   std::string line_buf_;
   bool eof_ = false, started_ = false;
   int line_ = 0;

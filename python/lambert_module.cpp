@@ -40,6 +40,7 @@
 #include "geometry/mesh.hpp"
 #include "geometry/render.hpp"
 #include "geometry/vertex_field.hpp"
+#include "io/array_args.hpp"
 #include "io/exr.hpp"
 #include "io/ff_file.hpp"
 #include "io/heat_surfaces.hpp"
@@ -101,65 +102,25 @@ py::array_t<double> adopt_matrix(const Eigen::MatrixX3d& m) {  // N x 3, row-maj
   return adopt(std::move(v), {m.rows(), 3});
 }
 
-// An (N, 3) float64 array-like as an Eigen matrix; UsageError naming `what` otherwise.
-Eigen::MatrixX3d matrix_n3(const py::array_t<double, py::array::c_style | py::array::forcecast>& a,
-                           std::int64_t n, const std::string& what) {
-  if (a.ndim() != 2 || a.shape(1) != 3 || a.shape(0) != n) {
-    std::ostringstream ss;
-    ss << what << " must have shape (" << n << ", 3), got (";
-    for (py::ssize_t d = 0; d < a.ndim(); ++d) ss << (d ? ", " : "") << a.shape(d);
-    ss << (a.ndim() == 1 ? ",)" : ")");
-    throw UsageError(ss.str());
-  }
-  Eigen::MatrixX3d m(n, 3);
-  const double* p = a.data();
-  for (std::int64_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) {
-      if (!std::isfinite(p[3 * i + c]))
-        throw UsageError(what + " holds a non-finite value at row " + std::to_string(i));
-      m(i, c) = p[3 * i + c];
-    }
-  return m;
-}
-
 using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
 using ValueArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// A numpy array as the library's view of a caller's array (io/array_args.hpp).
+template <typename T, typename A>
+ArrayArg<T> arg(const A& a) {
+  return {a.data(), std::vector<std::int64_t>(a.shape(), a.shape() + a.ndim())};
+}
+
+// An (N, 3) float64 array-like as an Eigen matrix; UsageError naming `what` otherwise.
+Eigen::MatrixX3d matrix_n3(const ValueArray& a, std::int64_t n, const std::string& what) {
+  return rows_of_three(arg<double>(a), n, what);
+}
 
 // A CSR matrix from its arrays, checked entry by entry (UsageError on any inconsistency).
 SparseRowMatrix csr_from_arrays(std::int64_t n, const IndexArray& indptr, const IndexArray& indices,
                                 const ValueArray& data, const std::string& what) {
-  if (indptr.ndim() != 1 || indices.ndim() != 1 || data.ndim() != 1)
-    throw UsageError(what + ": indptr, indices and data must be one-dimensional");
-  if (indptr.shape(0) != n + 1)
-    throw UsageError(what + ": indptr has " + std::to_string(indptr.shape(0)) + " entries, " +
-                     std::to_string(n + 1) + " expected for " + std::to_string(n) + " rows");
-  const std::int64_t nnz = indices.shape(0);
-  if (data.shape(0) != nnz) throw UsageError(what + ": indices and data differ in length");
-  const std::int64_t* p = indptr.data();
-  const std::int64_t* c = indices.data();
-  const double* v = data.data();
-  if (p[0] != 0 || p[n] != nnz) throw UsageError(what + ": indptr must run from 0 to nnz");
-  // indptr whole before any use of it (a reserve or a row's range): a decreasing or
-  // overshooting entry would size rows negative or read past indices and data.
-  for (std::int64_t i = 0; i < n; ++i)
-    if (p[i + 1] < p[i] || p[i + 1] > nnz)
-      throw UsageError(what + ": indptr decreases or passes nnz at row " + std::to_string(i));
-  SparseRowMatrix F(n, n);
-  F.reserve(Eigen::Matrix<std::int64_t, Eigen::Dynamic, 1>::Map(p, n + 1).tail(n) -
-            Eigen::Matrix<std::int64_t, Eigen::Dynamic, 1>::Map(p, n + 1).head(n));
-  for (std::int64_t i = 0; i < n; ++i) {
-    for (std::int64_t k = p[i]; k < p[i + 1]; ++k) {
-      if (c[k] < 0 || c[k] >= n || (k > p[i] && c[k] <= c[k - 1]))
-        throw UsageError(what + ": row " + std::to_string(i) +
-                         " has a column index out of range or out of order");
-      if (!std::isfinite(v[k]))
-        throw UsageError(what + ": entry (" + std::to_string(i) + ", " + std::to_string(c[k]) +
-                         ") is not finite");
-      F.insert(i, c[k]) = v[k];
-    }
-  }
-  F.makeCompressed();
-  return F;
+  return lambert::csr_from_arrays(n, arg<std::int64_t>(indptr), arg<std::int64_t>(indices),
+                                  arg<double>(data), what);
 }
 
 // (data, indices, indptr) of a compressed CSR matrix moved to the heap, zero-copy.

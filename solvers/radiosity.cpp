@@ -146,6 +146,7 @@ void validate_problem(const RadiosityProblem& p) {
                      std::to_string(p.F->size()) + ", " + std::to_string(n) + " areas, " +
                      std::to_string(p.rho.rows()) + " rho rows, " +
                      std::to_string(p.emission.rows()) + " emission rows");
+  if (n == 0) throw UsageError("radiosity problem without patches");
   for (Eigen::Index i = 0; i < n; ++i) {
     if (!(p.area[i] > 0.0) || !std::isfinite(p.area[i]))
       throw UsageError("patch " + std::to_string(i) + " has non-positive area");
@@ -236,10 +237,15 @@ RadiositySolution solve_radiosity(const RadiosityProblem& problem, const SolveOp
   // After the solve: B is finite, and for E >= 0 (an M-matrix K, check_form_factors) B >= 0
   // up to the solve's own error, tol ||E||_2 / (1 - rho_max) per entry (STYLE.md's bound,
   // rho_max < 1; for rho_max = 1 the bound scales with max B instead). Otherwise the result is
-  // a numerical issue, never reported as converged.
-  if (!sol.B.allFinite()) {
-    sol.status = SolveStatus::NumericalIssue;
-  } else if (!problem.signed_emission && n > 0) {
+  // a numerical issue, never reported as converged; a non-finite B is an Error.
+  for (int c = 0; c < 3; ++c)  // never handed on: an error, not a status
+    if (!sol.B.col(c).allFinite())
+      throw Error("solver " + options.solver + ": the radiosity of channel " + std::to_string(c) +
+                  " is not finite (" + to_string(sol.channels[c].status) + " after " +
+                  std::to_string(sol.channels[c].iterations) +
+                  " iterations): the problem's scale is beyond double precision" +
+                  (options.initial_guess.size() > 0 ? ", or the initial guess is" : ""));
+  if (!problem.signed_emission && n > 0) {
     for (int c = 0; c < 3; ++c) {
       const double rho_max = problem.rho.col(c).maxCoeff();
       const double e_norm = problem.emission.col(c).norm();

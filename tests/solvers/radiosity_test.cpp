@@ -179,6 +179,39 @@ TEST(SolveRadiosity, ImpossibleFormFactorsAreRefusedOrNotConverged) {
   }
 }
 
+TEST(SolveRadiosity, ANonFiniteSolutionIsAnErrorNeverAResult) {
+  // Found by python_args_fuzz: lambert.solve on one patch (F = 0, rho = E = 0.5) with the
+  // finite initial guess -1e308 overflowed the residual; southwell returned B = NaN with
+  // status numerical-issue, which callers wrote out (exit 3) or handed to Python.
+  OwnedProblem o;
+  o.F = SparseRowMatrix(1, 1);
+  o.p.F = std::make_shared<CsrOperator>(o.F);
+  o.p.rho = Eigen::MatrixX3d::Constant(1, 3, 0.5);
+  o.p.emission = Eigen::MatrixX3d::Constant(1, 3, 0.5);
+  o.p.area = Eigen::VectorXd::Ones(1);
+  for (const auto& name : solver_names()) {
+    SolveOptions opt = options_for(name, 0.5);
+    opt.initial_guess = Eigen::MatrixX3d::Constant(1, 3, -1e308);
+    try {
+      const RadiositySolution s = solve_radiosity(o.p, opt);
+      EXPECT_TRUE(s.B.allFinite()) << name;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("not finite"), std::string::npos) << name << e.what();
+    }
+  }
+}
+
+TEST(SolveRadiosity, AProblemWithoutPatchesIsRefused) {
+  // Also python_args_fuzz: N = 0 read an empty emission's maximum.
+  OwnedProblem o;
+  o.F = SparseRowMatrix(0, 0);
+  o.p.F = std::make_shared<CsrOperator>(o.F);
+  o.p.rho = Eigen::MatrixX3d(0, 3);
+  o.p.emission = Eigen::MatrixX3d(0, 3);
+  o.p.area = Eigen::VectorXd(0);
+  EXPECT_THROW(solve_radiosity(o.p, options_for("gauss-seidel", 1e-8)), UsageError);
+}
+
 // The furnace: a closed enclosure of n patches, uniform rho and E; returns the largest
 // row-sum defect |sum_j F_ij - 1|.
 double make_furnace(OwnedProblem& o, int n, const Eigen::Vector3d& rho, const Eigen::Vector3d& e) {
