@@ -21,7 +21,7 @@ namespace {
 MPI_Comm comm() { return PETSC_COMM_WORLD; }
 
 // Counts and displacements in units of one element for MPI's int-counted calls; throws
-// when a rank's share exceeds what an int counts (2^31 elements; README "Running on a
+// when a rank's share exceeds what an int counts (2^31 elements; docs/cluster.md "Running on a
 // cluster": more ranks then).
 int count_of(std::int64_t n) {
   if (n > 2147483647) throw Error("a message of more than 2^31 elements: use more ranks");

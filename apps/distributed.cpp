@@ -1,4 +1,4 @@
-// `formfactors --distributed` and `solve --distributed` (README "Running on a cluster"):
+// `formfactors --distributed` and `solve --distributed` (docs/cluster.md):
 // every rank loads and meshes the scene and builds its BVH; the pairs (i, j > i) are split
 // by rows i over the ranks (balanced_pair_rows), each pair computed once with its serial
 // stream; every entry goes to its row's owner (exchange_mirrors), so rank r holds rows
@@ -189,7 +189,7 @@ int run_matrix_distributed(const DistributedArgs& dist, const RunArgs& run_args,
         throw UsageError(
             "--solver and --preconditioner pick a single-process solver: with "
             "--distributed the solve is PETSc's (--petsc-options \"-ksp_type bcgs "
-            "-pc_type jacobi\", README \"Running on a cluster\")");
+            "-pc_type jacobi\", docs/cluster.md)");
       scene = load(run, s.root());
     });
     check_same_mesh(scene);

@@ -9,7 +9,7 @@ void add_distributed_options(CLI::App* cmd, DistributedArgs& args, bool with_sol
       std::string("Run as one rank of an MPI job (mpirun -np K lambert ...): F's rows "
                   "split over the ranks") +
           (with_solver ? ", solved with PETSc" : "") +
-          (distributed_available() ? "" : " (needs the mpi build: README)"));
+          (distributed_available() ? "" : " (needs the mpi build: docs/cluster.md)"));
   if (with_solver)
     cmd->add_option("--petsc-options", args.petsc_options,
                     "With --distributed: PETSc options for the solve, e.g. \"-ksp_type bcgs "

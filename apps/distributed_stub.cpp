@@ -9,7 +9,7 @@ namespace {
 [[noreturn]] void refuse() {
   throw UsageError(
       "--distributed needs a lambert built with MPI and PETSc (scripts/setup.sh "
-      "mpi, then mpirun -np K build-mpi/bin/lambert ...; README \"Running on a "
+      "mpi, then mpirun -np K build-mpi/bin/lambert ...; docs/cluster.md \"Running on a "
       "cluster\")");
 }
 

@@ -243,7 +243,8 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
     log_warn(std::to_string(ff.stats.pairs_unverified) +
              " patch pairs did not reach --ff-tol within their budget of point factors: their "
              "entries carry a larger error estimate (--stderr shows it); many blockers per pair "
-             "or blockers standing on both patches are the likely cause (README \"The analytic "
+             "or blockers standing on both patches are the likely cause (docs/form-factors.md "
+             "\"The analytic "
              "estimator\": hybrid or gather suit such scenes)");
   else if (ff.stats.pairs_unverified > 0)
     log_warn(std::to_string(ff.stats.pairs_unverified) +

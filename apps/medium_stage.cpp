@@ -62,8 +62,9 @@ void add_medium_options(CLI::App* cmd, MediumArgs& args) {
       ->delimiter(',')
       ->expected(3)
       ->check(non_negative);
-  cmd->add_option("--medium-grid", args.grid,
-                  "Heterogeneous medium from a grid file (README: bounds, resolution, voxels)")
+  cmd->add_option(
+         "--medium-grid", args.grid,
+         "Heterogeneous medium from a grid file (docs/media.md: bounds, resolution, voxels)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--voxels", args.voxels,
                   "Medium zones along the box's longest axis (others in proportion)")

@@ -326,6 +326,7 @@ using namespace lambert;
 
 PYBIND11_MODULE(_lambert, m) {
   m.doc() = "lambert's compiled core; use the `lambert` package.";
+  m.attr("__version__") = LAMBERT_VERSION;  // project(VERSION) in CMakeLists.txt
   set_log_level(LogLevel::Normal);
 
   // Never destroyed: the translator may run until the interpreter's last call.

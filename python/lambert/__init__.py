@@ -23,12 +23,13 @@ from . import _lambert
 from ._lambert import Error, InputError, UsageError, Mesh, Scene, VertexField  # noqa: F401
 
 __all__ = [
-    "Error", "InputError", "UsageError", "Scene", "Mesh", "VertexField", "load_scene",
+    "__version__", "Error", "InputError", "UsageError", "Scene", "Mesh", "VertexField", "load_scene",
     "form_factors", "save_form_factors", "load_form_factors", "solve", "solve_hierarchical", "heat",
     "vertex_radiosity",
     "write_vertex_exr", "render", "estimators", "solvers", "set_verbosity",
 ]
 
+__version__ = _lambert.__version__  # the project's one version (CHANGELOG.md, "Version scheme")
 estimators = _lambert.estimators
 solvers = _lambert.solvers
 set_verbosity = _lambert.set_verbosity

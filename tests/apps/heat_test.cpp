@@ -133,7 +133,7 @@ TEST(HeatCliSlow, ConcentricSpheresMatchTheTwoSurfaceFormula) {
   // (F_12 = 1 exactly), up to the non-uniform radiosity of the polyhedral outer surface (its
   // facets differ in size by up to ~1.4x: measured effect < 1e-4) and the
   // estimator's error in the outer's self-view F_22, which enters through A1/A2 only via
-  // reciprocity: hybrid's quadrature bound is 1e-6 per entry (README), its visibility
+  // reciprocity: hybrid's quadrature bound is 1e-6 per entry (docs/form-factors.md), its visibility
   // sampling of the occluded outer-outer pairs ~1e-3 of F_22 per row (32 samples); Q1 depends
   // on F_22 weakly (only the outer's reflections). 2e-3 relative covers both with margin.
   std::printf("spheres: Q1 %.9g, formula %.9g (A1 %.6g, A2 %.6g), relative error %.3e\n", got, q1,

@@ -338,7 +338,8 @@ void check_room(int boxes, double tol) {
   o.with_stderr = true;
   const FormFactors ff = compute_form_factors(mesh, o);
   // Pairs of a box face and a plane it stands on may still spend their boolean budget
-  // (corner identification fails near the contact; README "Where it stops paying"): they
+  // (corner identification fails near the contact; docs/form-factors.md "Where it stops
+  // paying"): they
   // are reported, and the checks below hold them to tol like every other pair.
   std::printf("%d boxes: %lld pairs unverified\n", boxes,
               static_cast<long long>(ff.stats.pairs_unverified));
@@ -373,7 +374,7 @@ void check_room(int boxes, double tol) {
 
 TEST(AnalyticRoomSlow, SymmetricFurnishedRoomsAreSymmetricAndClosed) {
   // Up to kRoomBoxes (3 boxes took 250 s on the CI machine: bench/analytic_bench covers more):
-  // the cost grows steeply with the boxes (README "Where it stops paying":
+  // the cost grows steeply with the boxes (docs/form-factors.md "Where it stops paying":
   // 4 boxes took 70 s, 19 over 25 min before issue 33's fix).
   constexpr int kRoomBoxes = 2;
   for (int boxes = 1; boxes <= kRoomBoxes; ++boxes) {
@@ -399,7 +400,8 @@ TEST(AnalyticEstimatorSlow, ClosedBoxWithTiltedPlateRowsSumToOne) {
   FormFactorOptions o;
   o.estimator = "analytic";
   // 1e-7: the twelve pairs of faces sharing a cube edge converge algebraically at the contact
-  // (isotropic splitting; README "analytic"), about 0.3 s each here; 1e-9 takes 10 s.
+  // (isotropic splitting; docs/form-factors.md "The analytic estimator"), about 0.3 s each
+  // here; 1e-9 takes 10 s.
   o.tol = 1e-7;
   o.progress = false;
   o.with_stderr = true;

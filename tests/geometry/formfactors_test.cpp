@@ -219,7 +219,7 @@ TEST(FormFactors, BitwiseIdenticalForAnyThreadCount) {
   }
 }
 
-// Distributed form factors (README "Running on a cluster") rest on this: the row ranges of
+// Distributed form factors (docs/cluster.md) rest on this: the row ranges of
 // balanced_pair_rows, computed separately, hold every entry of the whole F exactly once and
 // bit for bit (row i's entries come from the range of row i or, mirrored, of row j < i).
 TEST(FormFactors, RowRangesTogetherAreTheWholeFBitForBit) {

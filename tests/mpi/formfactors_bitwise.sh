@@ -1,4 +1,4 @@
-# F from K ranks is bitwise identical to the single-process F (README "Running on a
+# F from K ranks is bitwise identical to the single-process F (docs/cluster.md "Running on a
 # cluster"): the saved binary files are compared byte for byte (same header: mesh hash and
 # settings; same rows, columns and doubles), for several rank counts, estimators and options.
 source "$(dirname "$0")/common.sh"

@@ -1,4 +1,4 @@
-# The PETSc solve (README "Running on a cluster"):
+# The PETSc solve (docs/cluster.md):
 #  1. Cornell box, 2 ranks: B agrees with the single-process `direct` solve on the same F
 #     within tol ||E||_2 / (1 - rho_max) + the same bound for direct's own residual, per
 #     channel. Why: with K = I - diag(rho) F and ||rho F||_inf <= rho_max < 1 (row sums of F

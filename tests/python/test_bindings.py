@@ -10,6 +10,13 @@ import lambert
 from conftest import run_cli, write_obj
 
 
+def test_version_is_the_cli_version():
+    # One version number: `lambert --version` prints "lambert X.Y.Z".
+    out = run_cli("--version").stdout.strip()
+    assert out == "lambert " + lambert.__version__
+    assert all(part.isdigit() for part in lambert.__version__.split("."))
+
+
 def test_scene_and_mesh_arrays(cornell, cornell_mesh):
     assert "floor" in " ".join(cornell.surfaces).lower() or len(cornell.surfaces) >= 5
     assert len(cornell.areas) == len(cornell.surfaces)
