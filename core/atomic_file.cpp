@@ -30,6 +30,15 @@ std::string temporary_name(const std::string& name, const std::string& pid) {
 
 thread_local OutputSet* open_set = nullptr;
 
+// Renames tmp over path; on failure removes tmp and throws IoError naming path.
+void rename_into_place(const std::string& tmp, const std::string& path) {
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string why = std::strerror(errno);
+    std::remove(tmp.c_str());
+    throw IoError(path + ": cannot write: " + why);
+  }
+}
+
 bool process_is_dead(long pid) {
   return pid != ::getpid() && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
 }
@@ -50,11 +59,7 @@ void write_now(const std::string& path, const std::string& content) {
       throw IoError(path + ": cannot write: " + std::strerror(errno));
     }
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string why = std::strerror(errno);
-    std::remove(tmp.c_str());
-    throw IoError(path + ": cannot write: " + why);
-  }
+  rename_into_place(tmp, path);
 }
 
 // Journal: the header, then the count of renames, each as two length-prefixed paths
@@ -151,11 +156,7 @@ void write_atomically(const std::string& path,
     open_set->staged_.push_back({abs_tmp, abs_path});
     return;
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string why = std::strerror(errno);
-    std::remove(tmp.c_str());
-    throw IoError(path + ": cannot write: " + why);
-  }
+  rename_into_place(tmp, path);
 }
 
 void write_stream_atomically(const std::string& path,

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <tuple>
 #include <unordered_map>
 
 #include "core/error.hpp"
@@ -281,15 +282,11 @@ struct Refinement {
   Action action;
 };
 
-/// The child links of refined links (after their nodes were split), in order.
+/// The child links of refined links (after their nodes were split), in order; `count` is
+/// their number (wave_size), reserved up front.
 std::vector<std::pair<std::int32_t, std::int32_t>> expand(const Hierarchy& h,
-                                                          const std::vector<Refinement>& r) {
-  std::size_t count = 0;
-  for (const auto& x : r)
-    count += x.action == Action::SplitBoth
-                 ? static_cast<std::size_t>(h.node(x.p).child_count * h.node(x.p).child_count)
-                 : static_cast<std::size_t>(
-                       h.node(x.action == Action::SplitSource ? x.q : x.p).child_count);
+                                                          const std::vector<Refinement>& r,
+                                                          std::size_t count) {
   std::vector<std::pair<std::int32_t, std::int32_t>> out;
   out.reserve(count);
   for (const auto& x : r) {
@@ -307,26 +304,19 @@ std::vector<std::pair<std::int32_t, std::int32_t>> expand(const Hierarchy& h,
   return out;
 }
 
-/// Gives every element that a refinement splits its children, in increasing node order (so
-/// node numbers do not depend on threads), initialising their B from the parent's.
-void split_nodes(Hierarchy& h, const std::vector<Refinement>& r, State& s) {
-  std::vector<std::int32_t> nodes;
-  for (const auto& x : r) {
-    if (x.action != Action::SplitSource) nodes.push_back(x.p);
-    if (x.action == Action::SplitSource) nodes.push_back(x.q);
-  }
-  std::sort(nodes.begin(), nodes.end());
-  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+/// Gives the unsplit elements a wave refines (`nodes`, sorted and unique: wave_size) their
+/// children, in increasing node order (so node numbers do not depend on threads),
+/// initialising their B from the parent's.
+void split_nodes(Hierarchy& h, const std::vector<std::int32_t>& nodes, State& s) {
   const std::int32_t first_new = h.size();
   for (const std::int32_t i : nodes) {
-    if (h.node(i).cluster || h.node(i).child_count > 0) continue;
     if (h.size() > std::numeric_limits<std::int32_t>::max() - 8)
       throw Error("hierarchical: more than 2^31 nodes; raise --epsilon or --min-area");
     h.split_element(i);
   }
   s.resize(h.nodes().size());
   for (const std::int32_t i : nodes)
-    for (int k = 0; k < h.node(i).child_count && !h.node(i).cluster; ++k) {
+    for (int k = 0; k < h.node(i).child_count; ++k) {
       const std::int32_t c = h.child(i, k);
       if (c >= first_new) s.B[c] = s.lo[c] = s.hi[c] = s.B[i];
     }
@@ -583,9 +573,11 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
     }
     ++st.passes;
     while (!pending.empty() || !refine.empty()) {
+      std::size_t new_links = 0;
       {  // the wave's peak: new nodes (a reallocation holds old and new buffers), its links
          // (pending, evaluated, actions, at worst all refined again), the table's growth
-        const auto [new_nodes, new_links] = wave_size(h, refine, to_split);
+        std::size_t new_nodes = 0;
+        std::tie(new_nodes, new_links) = wave_size(h, refine, to_split);
         const std::size_t nodes = h.nodes().size(), links = table.links.size();
         const std::size_t node_cap = Budget::grown(nodes, h.nodes().capacity(), new_nodes);
         const std::size_t link_cap = Budget::grown(links, table.links.capacity(), new_links);
@@ -605,8 +597,8 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
         }
         if (link_cap > table.links.capacity()) table.links.reserve(link_cap);
       }
-      split_nodes(h, refine, s);
-      auto children = expand(h, refine);
+      split_nodes(h, to_split, s);
+      auto children = expand(h, refine, new_links);
       if (pending.empty())
         pending.swap(children);
       else
