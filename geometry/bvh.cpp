@@ -34,12 +34,22 @@ void check_device(RTCDevice device, const char* what) {
                 std::to_string(static_cast<int>(err)) + ")");
 }
 
+}  // namespace
+
+// Named (not anonymous) because Bvh::Impl holds them: a class with external linkage may not
+// hold a type of an anonymous namespace once this file is compiled inside a unity batch.
+namespace bvh_detail {
 struct DeviceDeleter {
   void operator()(RTCDeviceTy* d) const { rtcReleaseDevice(d); }
 };
 struct SceneDeleter {
   void operator()(RTCSceneTy* s) const { rtcReleaseScene(s); }
 };
+}  // namespace bvh_detail
+using bvh_detail::DeviceDeleter;
+using bvh_detail::SceneDeleter;
+
+namespace {
 
 std::atomic<std::int64_t> g_builds{0};
 

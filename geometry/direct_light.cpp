@@ -12,7 +12,9 @@
 #include "geometry/shadow.hpp"
 
 namespace lambert {
-namespace {
+// Named (not anonymous) because DirectLight::Faces holds it: a class with external linkage may
+// not hold a type of an anonymous namespace once this file is compiled inside a unity batch.
+namespace direct_light_detail {
 
 // A face as a blocker or source: its corners, bounding box and plane.
 struct FaceGeometry {
@@ -23,6 +25,11 @@ struct FaceGeometry {
   double slack = 0.0;      // how far a point on the face may be from that plane
   bool degenerate = false;
 };
+
+}  // namespace direct_light_detail
+using direct_light_detail::FaceGeometry;
+
+namespace {
 
 std::vector<FaceGeometry> face_geometry(const Scene& scene) {
   const auto [blo, bhi] = scene.bounds();

@@ -31,7 +31,7 @@ constexpr double kMinInside = 1e-3;
 // Pieces per wedge line at most (a line crossing the whole scene with the default piece).
 constexpr int kMaxPieces = 256;
 
-struct FaceGeom {
+struct WeldedFace {
   Polygon3 poly;
   std::vector<std::int32_t> ids;  // welded vertex ids of the corners
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
@@ -39,11 +39,11 @@ struct FaceGeom {
   double height(const Eigen::Vector3d& p) const { return (p - poly[0]).dot(normal); }
 };
 
-std::vector<FaceGeom> face_geometry(const Scene& scene) {
+std::vector<WeldedFace> welded_faces(const Scene& scene) {
   std::map<std::array<double, 3>, std::int32_t> weld;
-  std::vector<FaceGeom> out;
+  std::vector<WeldedFace> out;
   for (const auto& f : scene.faces) {
-    FaceGeom g;
+    WeldedFace g;
     for (auto v : f.vertices) {
       const Eigen::Vector3d& p = scene.vertices[v];
       g.poly.push_back(p);
@@ -189,7 +189,7 @@ std::vector<DiscontinuitySegment> discontinuity_segments(const Scene& scene,
                                                          const DiscontinuityOptions& options) {
   std::vector<DiscontinuitySegment> out;
   if (scene.faces.empty()) return out;
-  const std::vector<FaceGeom> faces = face_geometry(scene);
+  const std::vector<WeldedFace> faces = welded_faces(scene);
   const auto [scene_lo, scene_hi] = scene.bounds();
   const double scale = std::max((scene_hi - scene_lo).norm(), 1e-300);
   const double eps = kOnPlane * scale;
@@ -229,13 +229,14 @@ std::vector<DiscontinuitySegment> discontinuity_segments(const Scene& scene,
   // the silhouettes' few edges out of all of them.
   std::map<std::pair<std::int32_t, std::int32_t>, std::vector<std::int32_t>> edge_faces;
   for (size_t f = 0; f < faces.size(); ++f) {
-    const FaceGeom& g = faces[f];
+    const WeldedFace& g = faces[f];
     for (size_t k = 0; k < g.poly.size(); ++k) {
       const std::int32_t a = g.ids[k], b = g.ids[(k + 1) % g.poly.size()];
       if (a != b) edge_faces[{std::min(a, b), std::max(a, b)}].push_back(static_cast<std::int32_t>(f));
     }
   }
-  auto silhouettes = [&](const FaceGeom& S, std::set<std::pair<std::int32_t, std::int32_t>>& keep_edges,
+  auto silhouettes = [&](const WeldedFace& S,
+                         std::set<std::pair<std::int32_t, std::int32_t>>& keep_edges,
                          std::set<std::int32_t>& keep_vertices) {
     auto side = [&](std::int32_t f) {  // +1 / -1 when every source corner is strictly on one side
       int sign = 0;
@@ -267,7 +268,7 @@ std::vector<DiscontinuitySegment> discontinuity_segments(const Scene& scene,
   parallel_for(static_cast<std::int64_t>(faces.size()), 1, options.threads,
                [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t r = begin; r < end; ++r) {
-      const FaceGeom& R = faces[r];
+      const WeldedFace& R = faces[r];
       auto& segs = per_face[r];
       if (R.normal.squaredNorm() == 0) continue;
       // Lines run a margin past the face's bounding box, so that they cross its boundary
@@ -289,7 +290,7 @@ std::vector<DiscontinuitySegment> discontinuity_segments(const Scene& scene,
       // D0: blocker faces touching or piercing the receiver's plane.
       for (size_t b = 0; b < faces.size(); ++b) {
         if (static_cast<std::int64_t>(b) == r) continue;
-        const FaceGeom& B = faces[b];
+        const WeldedFace& B = faces[b];
         std::vector<double> h;
         bool off_plane = false;
         for (const auto& p : B.poly) {
@@ -360,7 +361,7 @@ std::vector<DiscontinuitySegment> discontinuity_segments(const Scene& scene,
       };
       for (std::int32_t sf : sources) {
         if (sf == r) continue;
-        const FaceGeom& S = faces[sf];
+        const WeldedFace& S = faces[sf];
         double hs_max = -INFINITY;
         for (const auto& p : S.poly) hs_max = std::max(hs_max, R.height(p));
         if (hs_max <= eps) continue;  // the source is behind the receiver

@@ -226,15 +226,15 @@ void project_patch(const PatchGeom& g, std::int32_t id, const Eigen::Vector3d& c
   }
 }
 
-struct RowEntry {
+struct HemicubeEntry {
   std::int32_t j;
   double f;
 };
 
 // Row i: render every other patch into the hemicube of i and sum the delta form factors.
 void hemicube_row(const std::vector<PatchGeom>& geom, std::int32_t i, const HemicubeDeltas& dF,
-                  double offset, double edge_eps, std::uint64_t seed, Buffers& buf, std::vector<double>& acc,
-                  std::vector<RowEntry>& row) {
+                  double offset, double edge_eps, std::uint64_t seed, Buffers& buf,
+                  std::vector<double>& acc, std::vector<HemicubeEntry>& row) {
   const PatchGeom& gi = geom[i];
   const Eigen::Vector3d c = gi.centroid + offset * gi.normal;
   Eigen::Vector3d u, v;
@@ -324,7 +324,7 @@ FormFactors compute_hemicube(const PatchMesh& mesh, const FormFactorOptions& opt
   const double offset = kOffset * mesh.scale;
   const double edge_eps = kEdgeOnEps * mesh.scale;
 
-  std::vector<std::vector<RowEntry>> rows(n);
+  std::vector<std::vector<HemicubeEntry>> rows(n);
   std::vector<std::int64_t> tested(n, 0), pixels(n, 0);
   Progress progress("hemicube", options.progress ? n : 0, "px");
   // Chunks of 4 rows: buffers are allocated once per chunk (3·res² pixels), while chunks
@@ -360,11 +360,11 @@ FormFactors compute_hemicube(const PatchMesh& mesh, const FormFactorOptions& opt
   std::int64_t at = 0;
   for (std::int32_t i = 0; i < n; ++i) {
     F.outerIndexPtr()[i] = at;
-    for (const RowEntry& e : rows[i]) {
+    for (const HemicubeEntry& e : rows[i]) {
       F.innerIndexPtr()[at] = e.j;
       F.valuePtr()[at++] = e.f;
     }
-    std::vector<RowEntry>().swap(rows[i]);  // release memory as we go
+    std::vector<HemicubeEntry>().swap(rows[i]);  // release memory as we go
   }
   F.outerIndexPtr()[n] = at;
   out.F.swap(F);  // Eigen 3.4 sparse matrices have no move: std::move would copy

@@ -23,6 +23,7 @@
 namespace lambert {
 namespace {
 
+using testing::read_json;
 using testing::run;
 using testing::slurp;
 using testing::TempDir;
@@ -83,8 +84,6 @@ std::string ascii_stl(const std::vector<std::pair<std::string, std::vector<Tri>>
   }
   return s;
 }
-
-Json read_json(const std::string& path) { return Json::parse(slurp(path)); }
 
 const Json& surface(const Json& j, const std::string& name) {
   for (const auto& s : j["surfaces"])

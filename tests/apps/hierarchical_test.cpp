@@ -28,11 +28,9 @@
 namespace lambert {
 namespace {
 
+using testing::read_json;
 using testing::run;
 using testing::slurp;
-using Json = nlohmann::json;
-
-Json read_json(const std::string& path) { return Json::parse(slurp(path)); }
 
 // Runs the command with stdout captured; returns the exit code and stdout.
 std::pair<int, std::string> run_quietly(const std::vector<std::string>& args) {
@@ -55,7 +53,7 @@ std::vector<std::vector<std::string>> read_csv(const std::string& path) {
 }
 
 // Per-surface average radiosity from a `solve` summary or a `run` report's list.
-std::map<std::string, std::vector<double>> averages(const Json& surfaces) {
+std::map<std::string, std::vector<double>> averages(const nlohmann::json& surfaces) {
   std::map<std::string, std::vector<double>> out;
   for (const auto& s : surfaces)
     out[s.at("name").get<std::string>()] = s.at("average_radiosity").get<std::vector<double>>();
@@ -76,7 +74,7 @@ double rounding_bound(std::int64_t leaves) {
   return 4.0 * static_cast<double>(leaves) * u / (1.0 - kCornellRhoMax);
 }
 
-void expect_balanced(const Json& energy, std::int64_t leaves) {
+void expect_balanced(const nlohmann::json& energy, std::int64_t leaves) {
   ASSERT_EQ(energy.size(), 3u);
   for (const auto& e : energy) {
     // The matrix method's keys that apply; no residual / non-reciprocity split (no F).
@@ -109,10 +107,10 @@ TEST(HierarchicalRun, CornellBoxWritesEveryFileWithABalancedReport) {
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(out),
                           std::filesystem::directory_iterator()),
             5);  // no temporaries left
-  const Json report = read_json(out + "/report.json");
+  const nlohmann::json report = read_json(out + "/report.json");
   EXPECT_EQ(report.at("method"), "hierarchical");
   EXPECT_FALSE(report.contains("form_factors"));
-  const Json& h = report.at("hierarchical");
+  const nlohmann::json& h = report.at("hierarchical");
   EXPECT_EQ(h.at("status"), "converged");
   EXPECT_EQ(h.at("options").at("epsilon").get<double>(), 1e-2);
   EXPECT_EQ(h.at("options").at("link_rays").get<int>(), 16);
@@ -201,13 +199,13 @@ TEST(HierarchicalSolve, WritesOneCsvRowPerLeafAndTheOptionsItWasGiven) {
   const auto rows = read_csv(csv);
   ASSERT_GT(rows.size(), 1u);
   EXPECT_EQ(rows[0], (std::vector<std::string>{"patch", "surface", "area", "R", "G", "B"}));
-  const Json j = read_json(dir.file("B.json"));
+  const nlohmann::json j = read_json(dir.file("B.json"));
   EXPECT_EQ(j.at("method"), "hierarchical");
   EXPECT_EQ(j.at("status"), "converged");
-  const Json& h = j.at("hierarchical");
+  const nlohmann::json& h = j.at("hierarchical");
   EXPECT_EQ(j.at("patches").get<std::size_t>(), rows.size() - 1);
   EXPECT_EQ(h.at("leaves").get<std::size_t>(), rows.size() - 1);
-  const Json& o = h.at("options");
+  const nlohmann::json& o = h.at("options");
   EXPECT_EQ(o.at("epsilon").get<double>(), 2e-2);
   EXPECT_EQ(o.at("min_area").get<double>(), 200.0);
   EXPECT_EQ(h.at("min_area").get<double>(), 200.0);  // given, so used as it is
@@ -230,7 +228,7 @@ TEST(HierarchicalSolve, WritesOneCsvRowPerLeafAndTheOptionsItWasGiven) {
   for (const auto& s : j.at("surfaces")) area += s.at("area").get<double>();
   EXPECT_NEAR(area, csv_area, 1e-12 * csv_area);
   ASSERT_EQ(j.at("channels").size(), 3u);
-  Json energy = Json::array();
+  nlohmann::json energy = nlohmann::json::array();
   for (const auto& c : j.at("channels")) energy.push_back(c.at("energy"));
   expect_balanced(energy, h.at("leaves").get<std::int64_t>());
 }
@@ -255,7 +253,7 @@ TEST(HierarchicalSolve, NonConvergenceExitsWithThreeAndStillWrites) {
   EXPECT_EQ(code, kExitNotConverged) << text;
   EXPECT_NE(err.find("warning:"), std::string::npos) << err;
   EXPECT_TRUE(std::filesystem::exists(csv));
-  const Json j = read_json(dir.file("B.json"));
+  const nlohmann::json j = read_json(dir.file("B.json"));
   EXPECT_EQ(j.at("status"), "max-iterations");
   EXPECT_FALSE(j.at("hierarchical").at("converged").get<bool>());
 }

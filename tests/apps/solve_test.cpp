@@ -27,6 +27,7 @@
 
 namespace lambert {
 
+using testing::read_json;
 using testing::run;
 using testing::slurp;
 namespace {
@@ -38,8 +39,6 @@ std::vector<std::string> read_lines(const std::string& path) {
   for (std::string l; std::getline(in, l);) lines.push_back(l);
   return lines;
 }
-
-nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(slurp(path)); }
 
 const std::vector<std::string> kFast = {"-q", "--patches", "150", "--samples", "4"};
 

@@ -16,13 +16,8 @@
 namespace lambert {
 namespace {
 
+using testing::read_json;
 using testing::run;
-using Json = nlohmann::json;
-
-Json read_json(const std::string& path) {
-  std::ifstream in(path);
-  return Json::parse(in);
-}
 
 // A unit cube open at z = 0 (faces inward), a light on the ceiling, the +x wall a mirror
 // (`mirror_ks`, grey or not).
@@ -66,7 +61,7 @@ TEST(SpecularCli, ExtendedFormFactorsRoundTripThroughABinaryFile) {
             kExitUsage);
   ASSERT_EQ(run(with({"solve", obj, "--ff", dir.file("F.bin"), "-o", dir.file("b.csv")})),
             kExitOk);
-  const Json a = read_json(dir.file("a.json")), b = read_json(dir.file("b.json"));
+  const nlohmann::json a = read_json(dir.file("a.json")), b = read_json(dir.file("b.json"));
   EXPECT_TRUE(a.at("form_factors").at("extended").get<bool>());
   EXPECT_EQ(a.at("form_factors").at("specular_depth").get<int>(), 8);
   EXPECT_TRUE(b.at("form_factors").at("extended").get<bool>());
@@ -74,8 +69,8 @@ TEST(SpecularCli, ExtendedFormFactorsRoundTripThroughABinaryFile) {
   // Same seed, same F: the energy balances agree to the last bit of their sums, and
   // light does not escape more than through the open side (escaped > 0).
   for (int c = 0; c < 3; ++c) {
-    const Json& ea = a.at("channels")[c].at("energy");
-    const Json& eb = b.at("channels")[c].at("energy");
+    const nlohmann::json& ea = a.at("channels")[c].at("energy");
+    const nlohmann::json& eb = b.at("channels")[c].at("energy");
     EXPECT_EQ(ea.at("escaped").get<double>(), eb.at("escaped").get<double>());
     EXPECT_EQ(ea.at("absorbed").get<double>(), eb.at("absorbed").get<double>());
     EXPECT_GT(ea.at("escaped").get<double>(), 0.0);

@@ -14,7 +14,7 @@
 namespace lambert {
 namespace {
 
-const Material kWhite{"white", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
+const Material kGreyWall{"white", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
 
 // A unit-ish open box (5 quads on one surface "box": creases at its edges), a trapezoid and
 // a triangle on their own surfaces. All planar; exercises creases, non-parallelogram quads
@@ -23,13 +23,13 @@ Scene test_scene() {
   Scene s;
   const Eigen::Vector3d p[8] = {{0, 0, 0},   {2, 0, 0},   {2, 1, 0},   {0, 1, 0},
                                 {0, 0, 1.5}, {2, 0, 1.5}, {2, 1, 1.5}, {0, 1, 1.5}};
-  add_polygon(s, "box", kWhite, {p[0], p[3], p[2], p[1]});  // z = 0
-  add_polygon(s, "box", kWhite, {p[0], p[1], p[5], p[4]});  // y = 0
-  add_polygon(s, "box", kWhite, {p[1], p[2], p[6], p[5]});  // x = 2
-  add_polygon(s, "box", kWhite, {p[2], p[3], p[7], p[6]});  // y = 1
-  add_polygon(s, "box", kWhite, {p[3], p[0], p[4], p[7]});  // x = 0
-  add_polygon(s, "trapezoid", kWhite, {{3, 0, 0}, {5, 0, 0}, {4.5, 1, 0.3}, {3.2, 1, 0.3}});
-  add_polygon(s, "triangle", kWhite, {{0, 3, 0}, {2, 3, 0.5}, {0.5, 4.5, 1}});
+  add_polygon(s, "box", kGreyWall, {p[0], p[3], p[2], p[1]});  // z = 0
+  add_polygon(s, "box", kGreyWall, {p[0], p[1], p[5], p[4]});  // y = 0
+  add_polygon(s, "box", kGreyWall, {p[1], p[2], p[6], p[5]});  // x = 2
+  add_polygon(s, "box", kGreyWall, {p[2], p[3], p[7], p[6]});  // y = 1
+  add_polygon(s, "box", kGreyWall, {p[3], p[0], p[4], p[7]});  // x = 0
+  add_polygon(s, "trapezoid", kGreyWall, {{3, 0, 0}, {5, 0, 0}, {4.5, 1, 0.3}, {3.2, 1, 0.3}});
+  add_polygon(s, "triangle", kGreyWall, {{0, 3, 0}, {2, 3, 0.5}, {0.5, 4.5, 1}});
   return s;
 }
 
@@ -97,11 +97,11 @@ TEST(VertexField, LinearFieldIsExactAtInteriorVerticesOfUniformGrids) {
   Scene s;
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  add_polygon(s, "rect", kWhite,
+  add_polygon(s, "rect", kGreyWall,
               {R * Eigen::Vector3d(0, 0, 0), R * Eigen::Vector3d(3, 0, 0),
                R * Eigen::Vector3d(3, 2, 0), R * Eigen::Vector3d(0, 2, 0)});
   add_polygon(
-      s, "tri", kWhite,
+      s, "tri", kGreyWall,
       {R * Eigen::Vector3d(4, 0, 0), R * Eigen::Vector3d(7, 0, 0), R * Eigen::Vector3d(5, 2.5, 0)});
   const PatchMesh mesh = mesh_scene(s, {0.4, 0});
   Eigen::MatrixX3d patch(mesh.size(), 3);
@@ -179,9 +179,9 @@ TEST(VertexField, AreaWeightedConservesPowerOnTrianglesAndParallelograms) {
   // has c corners with hat integrals A_i / c (triangles; parallelogram quads); then
   // ∫ f dA = sum_i A_i b_i exactly (derivation in vertex_field.hpp), for any field.
   Scene s;
-  add_polygon(s, "parallelogram", kWhite, {{0, 0, 0}, {3, 0, 0}, {4, 2, 1}, {1, 2, 1}});
-  add_polygon(s, "triangles", kWhite, {{0, 3, 0}, {2, 3, 0.5}, {0.5, 4.5, 1}});
-  add_polygon(s, "triangles", kWhite, {{2, 3, 0.5}, {2.5, 4.8, 1.2}, {0.5, 4.5, 1}});
+  add_polygon(s, "parallelogram", kGreyWall, {{0, 0, 0}, {3, 0, 0}, {4, 2, 1}, {1, 2, 1}});
+  add_polygon(s, "triangles", kGreyWall, {{0, 3, 0}, {2, 3, 0.5}, {0.5, 4.5, 1}});
+  add_polygon(s, "triangles", kGreyWall, {{2, 3, 0.5}, {2.5, 4.8, 1.2}, {0.5, 4.5, 1}});
   const PatchMesh mesh = mesh_scene(s, {0.2, 0});
   Eigen::MatrixX3d patch(mesh.size(), 3);
   for (std::int32_t i = 0; i < mesh.size(); ++i)

@@ -13,7 +13,7 @@ namespace lambert {
 namespace {
 
 // The message of the SceneError that parsing `text` as file "walls.json" throws ("" if none).
-std::string error_of(const std::string& text) {
+std::string conditions_error(const std::string& text) {
   try {
     parse_surface_conditions(text, "walls.json");
   } catch (const SceneError& e) {
@@ -36,21 +36,21 @@ TEST(HeatSurfaces, ParsesTemperaturesAndFluxes) {
 
 TEST(HeatSurfaces, AKeyGivenTwiceIsRefusedNotTheLastTaken) {
   // Issue 33, item 8: nlohmann keeps the last of two equal keys silently.
-  const std::string surface = error_of(R"({"floor": {"emissivity": 0.9, "temperature": 300},
+  const std::string surface = conditions_error(R"({"floor": {"emissivity": 0.9, "temperature": 300},
                                            "floor": {"emissivity": 0.1, "temperature": 900}})");
   EXPECT_NE(surface.find("walls.json: key \"floor\" given twice"), std::string::npos) << surface;
   const std::string inner =
-      error_of(R"({"floor": {"emissivity": 0.9, "temperature": 300, "temperature": 10}})");
+      conditions_error(R"({"floor": {"emissivity": 0.9, "temperature": 300, "temperature": 10}})");
   EXPECT_NE(inner.find("walls.json: key \"temperature\" given twice"), std::string::npos) << inner;
   // The same key in two different objects is fine.
-  EXPECT_EQ(error_of(R"({"a": {"emissivity": 1, "temperature": 1},
+  EXPECT_EQ(conditions_error(R"({"a": {"emissivity": 1, "temperature": 1},
                          "b": {"emissivity": 1, "temperature": 1}})"),
             "");
 }
 
 TEST(HeatSurfaces, ANumberBeyondDoubleNamesTheFile) {
   // Issue 33, item 8: 1e400 threw nlohmann's out_of_range, whose message names no file.
-  const std::string e = error_of(R"({"floor": {"emissivity": 0.9, "temperature": 1e400}})");
+  const std::string e = conditions_error(R"({"floor": {"emissivity": 0.9, "temperature": 1e400}})");
   EXPECT_EQ(e.rfind("walls.json: not valid JSON", 0), 0u) << e;
   EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 }

@@ -15,7 +15,7 @@ Medium parse(const std::string& text) {
 }
 
 // The message of the SceneError `text` raises ("" when it parses).
-std::string refusal(const std::string& text) {
+std::string grid_refusal(const std::string& text) {
   try {
     parse(text);
   } catch (const SceneError& e) {
@@ -43,20 +43,23 @@ TEST(MediumGridFile, ReadsBoundsResolutionAndVoxelsXFastest) {
 TEST(MediumGridFile, RefusalsNameTheLine) {
   const std::string head = "bounds 0 0 0 1 1 1\nresolution 1 1 2\n";
   const std::string ok = "1 1 1 0 0 0 0 0 0\n";
-  EXPECT_EQ(refusal(head + ok + ok), "");
-  EXPECT_NE(refusal(head + ok + "1 1 1 0 0 0 0 0 -1\n").find("grid.txt:4"), std::string::npos);
-  EXPECT_NE(refusal(head + ok + "1 1 1 0 0 0 0 0 nan\n").find("grid.txt:4"), std::string::npos);
-  EXPECT_NE(refusal(head + ok + "1 1\n").find("grid.txt:4"), std::string::npos);
-  EXPECT_NE(refusal(head + "1 2 1 0 0 0 0 0 0\n").find("grid.txt:3"), std::string::npos);  // colour
-  EXPECT_NE(refusal(head + "0 0 0 0 0 0 1 0 0\n").find("grid.txt:3"), std::string::npos);  // no σt
-  EXPECT_NE(refusal(head + ok).find("1 voxel lines"), std::string::npos);         // too few
-  EXPECT_NE(refusal(head + ok + ok + ok).find("grid.txt:5"), std::string::npos);  // too many
-  EXPECT_NE(refusal(ok).find("grid.txt:1"), std::string::npos);  // before the header
-  EXPECT_NE(refusal("bounds 0 0 0 1 -1 1\n").find("grid.txt:1"), std::string::npos);
-  EXPECT_NE(refusal("bounds 0 0 0 1 1 1\nresolution 1 0 1\n").find("grid.txt:2"),
+  EXPECT_EQ(grid_refusal(head + ok + ok), "");
+  EXPECT_NE(grid_refusal(head + ok + "1 1 1 0 0 0 0 0 -1\n").find("grid.txt:4"), std::string::npos);
+  EXPECT_NE(grid_refusal(head + ok + "1 1 1 0 0 0 0 0 nan\n").find("grid.txt:4"),
             std::string::npos);
-  EXPECT_NE(refusal("").find("missing"), std::string::npos);
-  EXPECT_NE(refusal(head + "resolution 1 1 1\n").find("grid.txt:3"), std::string::npos);
+  EXPECT_NE(grid_refusal(head + ok + "1 1\n").find("grid.txt:4"), std::string::npos);
+  EXPECT_NE(grid_refusal(head + "1 2 1 0 0 0 0 0 0\n").find("grid.txt:3"),
+            std::string::npos);  // colour
+  EXPECT_NE(grid_refusal(head + "0 0 0 0 0 0 1 0 0\n").find("grid.txt:3"),
+            std::string::npos);                                                        // no σt
+  EXPECT_NE(grid_refusal(head + ok).find("1 voxel lines"), std::string::npos);         // too few
+  EXPECT_NE(grid_refusal(head + ok + ok + ok).find("grid.txt:5"), std::string::npos);  // too many
+  EXPECT_NE(grid_refusal(ok).find("grid.txt:1"), std::string::npos);  // before the header
+  EXPECT_NE(grid_refusal("bounds 0 0 0 1 -1 1\n").find("grid.txt:1"), std::string::npos);
+  EXPECT_NE(grid_refusal("bounds 0 0 0 1 1 1\nresolution 1 0 1\n").find("grid.txt:2"),
+            std::string::npos);
+  EXPECT_NE(grid_refusal("").find("missing"), std::string::npos);
+  EXPECT_NE(grid_refusal(head + "resolution 1 1 1\n").find("grid.txt:3"), std::string::npos);
 }
 
 }  // namespace lambert

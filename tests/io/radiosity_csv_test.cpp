@@ -21,7 +21,7 @@ PatchMesh two_patches() {
   return mesh;
 }
 
-std::string refusal(const std::string& text) {
+std::string csv_refusal(const std::string& text) {
   std::istringstream in(text);
   try {
     read_radiosity_csv_stream(in, "B.csv", two_patches());
@@ -65,7 +65,7 @@ TEST(RadiosityCsv, MalformedFilesAreRefusedNamingFileAndLine) {
       {kHeader + row0 + std::string(std::size_t{1} << 21, '1'), "B.csv:3: line longer than 1 MiB"},
   };
   for (const auto& [text, expected] : cases) {
-    const std::string message = refusal(text);
+    const std::string message = csv_refusal(text);
     EXPECT_EQ(message.rfind(expected, 0), 0u) << text.substr(0, 80) << "-> " << message;
   }
 }

@@ -67,7 +67,7 @@ std::string binary(const std::vector<Tri>& tris, const std::string& header = "la
   return s;
 }
 
-std::string error_of(const std::string& bytes, const std::string& name = "t.stl") {
+std::string stl_error(const std::string& bytes, const std::string& name = "t.stl") {
   try {
     load_stl_bytes(bytes, name);
   } catch (const SceneError& e) {
@@ -148,15 +148,15 @@ TEST(StlLoader, ZeroAreaFacetsAreDroppedAndCounted) {
 TEST(StlLoader, TruncatedBinaryNamesTheFacet) {
   std::string bytes = binary(tetrahedron());
   bytes.resize(bytes.size() - 20);  // facet 4 incomplete
-  const std::string e = error_of(bytes);
+  const std::string e = stl_error(bytes);
   EXPECT_NE(e.find("t.stl: facet 4: binary STL truncated"), std::string::npos) << e;
 }
 
 TEST(StlLoader, WrongFacetCountIsRefused) {
-  const std::string e = error_of(binary(tetrahedron(), "x", 3));  // 4 stored, 3 declared
+  const std::string e = stl_error(binary(tetrahedron(), "x", 3));  // 4 stored, 3 declared
   EXPECT_NE(e.find("t.stl: binary STL facet count 3 does not match the size"), std::string::npos)
       << e;
-  const std::string shorter = error_of(binary(tetrahedron(), "x", 9));
+  const std::string shorter = stl_error(binary(tetrahedron(), "x", 9));
   EXPECT_NE(shorter.find("truncated"), std::string::npos) << shorter;
 }
 
@@ -165,12 +165,12 @@ TEST(StlLoader, NonFiniteNumbersAreRefused) {
   // Facet 3's second vertex, y: header 84 + 2 facets of 50 + normal 12 + vertex 12 + x 4.
   const float nan = std::numeric_limits<float>::quiet_NaN();
   std::memcpy(&bytes[84 + 2 * 50 + 12 + 12 + 4], &nan, 4);
-  const std::string e = error_of(bytes);
+  const std::string e = stl_error(bytes);
   EXPECT_NE(e.find("t.stl: facet 3: vertex 2 has a non-finite coordinate"), std::string::npos) << e;
   std::string text = ascii({{"a", tetrahedron()}});
   const auto at = text.find("vertex ") + 7;
   text.replace(at, text.find(' ', at) - at, "inf");
-  const std::string ea = error_of(text);
+  const std::string ea = stl_error(text);
   EXPECT_NE(ea.find("t.stl:4: 'inf'"), std::string::npos) << ea;
 }
 
@@ -179,10 +179,10 @@ TEST(StlLoader, CoordinatesBeyondTheObjLimitAreRefused) {
   std::string text = ascii({{"a", tetrahedron()}});
   const auto at = text.find("vertex ") + 7;
   text.replace(at, text.find(' ', at) - at, "-2e50");
-  const std::string e = error_of(text);
+  const std::string e = stl_error(text);
   EXPECT_NE(e.find("t.stl:4: '-2e50': coordinate beyond +-1e50"), std::string::npos) << e;
   // And a scene below 1e-50 across, where form factors underflow.
-  const std::string tiny = error_of(
+  const std::string tiny = stl_error(
       "solid a\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1e-60 0 0\n"
       "vertex 0 1e-60 0\nendloop\nendfacet\nendsolid\n");
   EXPECT_NE(tiny.find("t.stl: scene extent below 1e-50"), std::string::npos) << tiny;
@@ -213,18 +213,18 @@ TEST(StlLoader, CoincidentFacetsAreWarnedOncePerPairOfSurfaces) {
 TEST(StlLoader, BadKeywordNamesTheLine) {
   std::string text = ascii({{"a", tetrahedron()}});
   text.replace(text.find("endloop"), 7, "endlop");
-  const std::string e = error_of(text);
+  const std::string e = stl_error(text);
   EXPECT_NE(e.find("t.stl:7: expected 'endloop', got 'endlop'"), std::string::npos) << e;
-  const std::string cut = error_of("solid a\n  facet normal 0 0 1\n    outer loop\n");
+  const std::string cut = stl_error("solid a\n  facet normal 0 0 1\n    outer loop\n");
   EXPECT_NE(cut.find("end of file inside a solid"), std::string::npos) << cut;
-  const std::string four = error_of(
+  const std::string four = stl_error(
       "solid a\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
       "vertex 1 1 0\nendloop\nendfacet\nendsolid\n");
   EXPECT_NE(four.find("t.stl:7: a facet has 3 vertices"), std::string::npos) << four;
 }
 
 TEST(StlLoader, EmptySolidIsAnEmptyScene) {
-  const std::string e = error_of("solid nothing\nendsolid nothing\n");
+  const std::string e = stl_error("solid nothing\nendsolid nothing\n");
   EXPECT_NE(e.find("empty scene"), std::string::npos) << e;
 }
 
