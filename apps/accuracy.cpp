@@ -19,8 +19,6 @@
 
 #include "apps/cli.hpp"
 #include "apps/commands.hpp"
-#include "apps/problem.hpp"
-#include "apps/solve_args.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -31,6 +29,8 @@
 #include "geometry/formfactors/analysis.hpp"
 #include "geometry/formfactors/reference.hpp"
 #include "io/plot.hpp"
+#include "pipeline/problem.hpp"
+#include "pipeline/solve_stage.hpp"
 
 namespace lambert {
 namespace {

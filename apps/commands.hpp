@@ -3,14 +3,15 @@
 
 #include <CLI/CLI.hpp>
 
-#include "apps/adapt_stage.hpp"
-#include "apps/common.hpp"
 #include "apps/distributed.hpp"
-#include "apps/ff_args.hpp"
 #include "apps/heat_outputs.hpp"
-#include "apps/medium_stage.hpp"
-#include "apps/method.hpp"
-#include "apps/render_stages.hpp"
+#include "apps/options.hpp"
+#include "pipeline/adapt_stage.hpp"
+#include "pipeline/ff_stage.hpp"
+#include "pipeline/job.hpp"
+#include "pipeline/medium_stage.hpp"
+#include "pipeline/method.hpp"
+#include "pipeline/render_stages.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {

@@ -6,14 +6,14 @@
 
 #include "apps/cli.hpp"
 #include "apps/commands.hpp"
-#include "apps/hierarchical_stage.hpp"
-#include "apps/problem.hpp"
-#include "apps/solve_args.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/timer.hpp"
 #include "io/plot.hpp"
+#include "pipeline/hierarchical_stage.hpp"
+#include "pipeline/problem.hpp"
+#include "pipeline/solve_stage.hpp"
 
 namespace lambert {
 namespace {

@@ -14,12 +14,12 @@
 #include "apps/commands.hpp"
 #include "apps/dist_mpi.hpp"
 #include "apps/dist_petsc.hpp"
-#include "apps/problem.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
 #include "core/timer.hpp"
 #include "io/ff_file.hpp"
+#include "pipeline/problem.hpp"
 
 namespace lambert {
 namespace {

@@ -7,10 +7,10 @@
 #include <functional>
 #include <string>
 
-#include "apps/common.hpp"
-#include "apps/ff_args.hpp"
-#include "apps/render_stages.hpp"
 #include "io/json.hpp"
+#include "pipeline/ff_stage.hpp"
+#include "pipeline/job.hpp"
+#include "pipeline/render_stages.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {

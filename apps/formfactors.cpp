@@ -6,7 +6,6 @@
 #include "apps/command_outputs.hpp"
 #include "apps/commands.hpp"
 #include "apps/distributed.hpp"
-#include "apps/ff_args.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
@@ -14,6 +13,7 @@
 #include "geometry/formfactors/analysis.hpp"
 #include "io/ff_file.hpp"
 #include "io/json.hpp"
+#include "pipeline/ff_stage.hpp"
 
 namespace lambert {
 namespace {

@@ -5,11 +5,11 @@
 #include <limits>
 
 #include "apps/commands.hpp"
-#include "apps/solve_args.hpp"
 #include "core/atomic_file.hpp"
 #include "io/colormap.hpp"
 #include "io/exr.hpp"
 #include "io/ply.hpp"
+#include "pipeline/solve_stage.hpp"
 
 namespace lambert {
 namespace {

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "apps/common.hpp"
-#include "apps/render_stages.hpp"
 #include "io/heat_surfaces.hpp"
 #include "io/json.hpp"
+#include "pipeline/job.hpp"
+#include "pipeline/render_stages.hpp"
 #include "solvers/thermal.hpp"
 
 namespace lambert {

@@ -5,12 +5,12 @@
 
 #include "apps/cli.hpp"
 #include "apps/commands.hpp"
-#include "apps/hierarchical_stage.hpp"
-#include "apps/solve_args.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/timer.hpp"
 #include "io/radiosity_csv.hpp"
+#include "pipeline/hierarchical_stage.hpp"
+#include "pipeline/solve_stage.hpp"
 
 namespace lambert {
 namespace {

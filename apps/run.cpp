@@ -11,9 +11,6 @@
 
 #include "apps/cli.hpp"
 #include "apps/commands.hpp"
-#include "apps/hierarchical_stage.hpp"
-#include "apps/problem.hpp"
-#include "apps/solve_args.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/memory.hpp"
@@ -21,6 +18,9 @@
 #include "core/timer.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "io/json.hpp"
+#include "pipeline/hierarchical_stage.hpp"
+#include "pipeline/problem.hpp"
+#include "pipeline/solve_stage.hpp"
 
 namespace lambert {
 namespace {

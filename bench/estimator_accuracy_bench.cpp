@@ -32,7 +32,6 @@
 #include <string>
 #include <vector>
 
-#include "apps/problem.hpp"
 #include "bench/power_law.hpp"
 #include "core/log.hpp"
 #include "core/parallel.hpp"
@@ -41,6 +40,7 @@
 #include "geometry/formfactors/formfactors.hpp"
 #include "io/obj_loader.hpp"
 #include "io/plot.hpp"
+#include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
 using namespace lambert;

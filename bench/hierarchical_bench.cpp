@@ -51,7 +51,6 @@
 #include <string>
 #include <vector>
 
-#include "apps/problem.hpp"
 #include "bench/child.hpp"
 #include "bench/power_law.hpp"
 #include "bench/scene_generator.hpp"
@@ -64,6 +63,7 @@
 #include "geometry/hierarchical/hierarchical.hpp"
 #include "io/obj_loader.hpp"
 #include "io/plot.hpp"
+#include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
 using namespace lambert;

@@ -27,12 +27,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
-#include <tuple>
 #include <string>
+#include <tuple>
 #include <vector>
 
-#include "apps/adapt_stage.hpp"
-#include "apps/problem.hpp"
 #include "core/timer.hpp"
 #include "geometry/adapt.hpp"
 #include "geometry/analytic.hpp"
@@ -41,6 +39,8 @@
 #include "geometry/vertex_field.hpp"
 #include "io/obj_loader.hpp"
 #include "io/plot.hpp"
+#include "pipeline/adapt_stage.hpp"
+#include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
 using namespace lambert;

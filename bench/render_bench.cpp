@@ -23,7 +23,6 @@
 #include <string>
 #include <vector>
 
-#include "apps/problem.hpp"
 #include "core/timer.hpp"
 #include "geometry/bvh.hpp"
 #include "geometry/direct_light.hpp"
@@ -32,6 +31,7 @@
 #include "geometry/vertex_field.hpp"
 #include "io/obj_loader.hpp"
 #include "io/tonemap.hpp"
+#include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
 using namespace lambert;

@@ -18,7 +18,6 @@
 #include <string>
 #include <vector>
 
-#include "apps/problem.hpp"
 #include "bench/child.hpp"
 #include "bench/raw_rays.hpp"
 #include "core/log.hpp"
@@ -29,6 +28,7 @@
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/formfactors/kernels.hpp"
 #include "io/obj_loader.hpp"
+#include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
 using namespace lambert;

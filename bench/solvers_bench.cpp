@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "apps/common.hpp"
-#include "apps/problem.hpp"
 #include "core/timer.hpp"
 #include "geometry/formfactors/formfactors.hpp"
+#include "pipeline/job.hpp"
+#include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace {

@@ -1,6 +1,6 @@
 // The compiled part of `import lambert` (pybind11): scenes, meshes, form factors, solvers,
 // vertex fields, rendering and the F files, over the library layers (core, geometry,
-// solvers, io) and the radiosity problem of apps/problem. The pure-Python package
+// solvers, io) and the radiosity problem of pipeline/problem. The pure-Python package
 // (python/lambert/__init__.py) wraps these into the public API: scipy.sparse matrices are
 // built there from the (data, indices, indptr) arrays handed out here.
 //
@@ -27,11 +27,6 @@
 #include <utility>
 #include <vector>
 
-#include "apps/common.hpp"
-#include "apps/heat_problem.hpp"
-#include "apps/hierarchical_stage.hpp"
-#include "apps/medium_stage.hpp"
-#include "apps/problem.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/parallel.hpp"
@@ -48,6 +43,11 @@
 #include "io/obj_loader.hpp"
 #include "io/stl_loader.hpp"
 #include "io/tonemap.hpp"
+#include "pipeline/heat_problem.hpp"
+#include "pipeline/hierarchical_stage.hpp"
+#include "pipeline/job.hpp"
+#include "pipeline/medium_stage.hpp"
+#include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace py = pybind11;
@@ -56,7 +56,7 @@ namespace lambert {
 namespace {
 
 // A meshed scene with its BVH (built on first use, shared by form factors and renders).
-// A LoadedScene, as the CLI's stages take it (apps/medium_stage reads one).
+// A LoadedScene, as the CLI's stages take it (pipeline/medium_stage reads one).
 struct MeshHandle {
   LoadedScene loaded;
   const Scene& scene = loaded.scene;
@@ -604,7 +604,7 @@ PYBIND11_MODULE(_lambert, m) {
         o.threads = threads;
         if (initial) o.initial_guess = matrix_n3(*initial, h.mesh.size(), "initial_guess");
         const MediumArgs margs = medium_args(medium_options);
-        if (margs.active()) {  // the extended solve of apps/medium_stage, as `lambert solve`
+        if (margs.active()) {  // the extended solve of pipeline/medium_stage, as `lambert solve`
           if (initial) throw UsageError("initial_guess does not combine with a medium");
           const std::shared_ptr<const Medium> medium = make_medium(margs);
           check_medium_scene(h.mesh, nullptr);

@@ -13,10 +13,10 @@
 #include "apps/cli.hpp"
 #include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
-#include "apps/ff_args.hpp"
-#include "apps/problem.hpp"
 #include "geometry/analytic.hpp"
 #include "geometry/formfactors/formfactors.hpp"
+#include "pipeline/ff_stage.hpp"
+#include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {

@@ -9,12 +9,12 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/cli.hpp"
-#include "apps/problem.hpp"
 #include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
 #include "geometry/analytic.hpp"
 #include "geometry/bvh.hpp"
 #include "geometry/formfactors/media.hpp"
+#include "pipeline/problem.hpp"
 
 namespace lambert {
 namespace {

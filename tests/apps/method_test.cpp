@@ -2,7 +2,7 @@
 // render and compare, and the refusal of every option that only the other method reads.
 // Refusals happen before any work, so these tests are fast.
 
-#include "apps/method.hpp"
+#include "pipeline/method.hpp"
 
 #include <gtest/gtest.h>
 

@@ -6,7 +6,7 @@
 // equal instead. The table of apps/option_scope.cpp decides the refusals; this walk checks
 // it against what the code actually reads.
 
-#include "apps/option_scope.hpp"
+#include "pipeline/option_scope.hpp"
 
 #include <gtest/gtest.h>
 

@@ -8,11 +8,11 @@
 #include <vector>
 
 #include "apps/cli.hpp"
-#include "apps/ff_args.hpp"
 #include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
 #include "geometry/bvh.hpp"
 #include "io/exr.hpp"
+#include "pipeline/ff_stage.hpp"
 
 namespace lambert {
 

@@ -15,14 +15,14 @@
 #include <vector>
 
 #include "apps/cli.hpp"
-#include "apps/common.hpp"
-#include "apps/problem.hpp"
 #include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
 #include "geometry/analytic.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "io/exr.hpp"
 #include "io/ff_file.hpp"
+#include "pipeline/job.hpp"
+#include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {

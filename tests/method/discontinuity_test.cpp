@@ -1,19 +1,20 @@
 // Discontinuity meshing on scenes loaded from files, and its effect on the radiosity.
+#include "geometry/discontinuity.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 
-#include "apps/adapt_stage.hpp"
-#include "apps/problem.hpp"
 #include "common/mesh_checks.hpp"
 #include "geometry/adapt.hpp"
 #include "geometry/analytic.hpp"
-#include "geometry/discontinuity.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/shadow.hpp"
 #include "geometry/vertex_field.hpp"
 #include "io/obj_loader.hpp"
+#include "pipeline/adapt_stage.hpp"
+#include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {

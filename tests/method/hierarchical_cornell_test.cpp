@@ -3,10 +3,10 @@
 
 #include <cstdio>
 
-#include "apps/problem.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/hierarchical/hierarchical.hpp"
 #include "io/obj_loader.hpp"
+#include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {

@@ -9,10 +9,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "apps/problem.hpp"
 #include "core/error.hpp"
 #include "geometry/analytic.hpp"
 #include "geometry/bvh.hpp"
+#include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {

@@ -12,8 +12,8 @@
 
 namespace lambert {
 
-/// RadiosityProblem for `mesh` with a CsrOperator over F (which must outlive it). Throws SceneError if
-/// F's size does not match the mesh.
+/// RadiosityProblem for `mesh` with a CsrOperator over F (which must outlive it). Throws SceneError
+/// if F's size does not match the mesh.
 RadiosityProblem make_problem(const PatchMesh& mesh, const SparseRowMatrix& F);
 /// The problem over the patches and M extra unknowns after them (participating-media zones,
 /// geometry/formfactors/media.hpp): F is (N + M)², and the extra unknowns' reflectance,

@@ -1,4 +1,4 @@
-#include "apps/common.hpp"
+#include "pipeline/job.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -22,9 +22,7 @@
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
-namespace {
 
-// A whole string as a finite number (false for NaN, inf, trailing text).
 bool parse_finite_number(const std::string& text, double& x) {
   std::size_t used = 0;
   try {
@@ -35,10 +33,9 @@ bool parse_finite_number(const std::string& text, double& x) {
   return used == text.size() && std::isfinite(x);
 }
 
-// Reads "R,G,B": three finite numbers >= 0, and <= 1 for a reflectance (`unit`); returns
-// a reason, empty on success.
 std::string parse_rgb(const std::string& text, bool unit, Eigen::Vector3d& out) {
-  const std::string want = unit ? "R,G,B with three numbers in [0, 1]" : "R,G,B with three finite numbers >= 0";
+  const std::string want =
+      unit ? "R,G,B with three numbers in [0, 1]" : "R,G,B with three finite numbers >= 0";
   if (!text.empty() && text.back() == ',') return "'" + text + "' is not " + want;
   std::istringstream in(text);  // (getline drops an empty last field: checked above)
   std::string part;
@@ -52,20 +49,16 @@ std::string parse_rgb(const std::string& text, bool unit, Eigen::Vector3d& out) 
   return n == 3 ? "" : "'" + text + "' is not " + want;
 }
 
-// --emit NAME_OR_GLOB=R,G,B (the last '=' separates: names may hold one).
 std::string parse_emit(const std::string& text, EmitRule& rule) {
   const auto eq = text.rfind('=');
-  if (eq == std::string::npos || eq == 0) return "--emit '" + text + "': expected NAME_OR_GLOB=R,G,B";
+  if (eq == std::string::npos || eq == 0)
+    return "--emit '" + text + "': expected NAME_OR_GLOB=R,G,B";
   rule.pattern = text.substr(0, eq);
   const std::string why = parse_rgb(text.substr(eq + 1), false, rule.emission);
   return why;
 }
 
-std::string shortest(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
+namespace {
 
 // The path as compared for collisions: absolute, with "." and ".." and symbolic links of the
 // existing part resolved.
@@ -77,8 +70,7 @@ std::string canonical_text(const std::string& path) {
 
 // Creates and removes a probe file in `dir`; returns the reason it cannot, empty when it can.
 std::string probe_directory(const std::filesystem::path& dir) {
-  const std::string probe =
-      (dir / (".lambert-probe." + std::to_string(::getpid()))).string();
+  const std::string probe = (dir / (".lambert-probe." + std::to_string(::getpid()))).string();
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
   if (fd < 0) return std::strerror(errno);
   ::close(fd);
@@ -106,30 +98,6 @@ std::optional<MemoryLimit> job_memory_limit(const std::string& option) {
   if (!bytes) throw UsageError(from + ": '" + text + "' is not a size such as 512M or 8G");
   if (*bytes == 0) return std::nullopt;
   return MemoryLimit{*bytes, from + " " + text};
-}
-
-CLI::Validator finite_number(double lo, double hi, bool open_low, bool open_high) {
-  const std::string range = std::isinf(hi)
-                                ? (open_low ? "> " : ">= ") + shortest(lo)
-                                : "in " + std::string(open_low ? "(" : "[") + shortest(lo) + ", " +
-                                      shortest(hi) + (open_high ? ")" : "]");
-  return CLI::Validator(
-      [=](std::string& text) -> std::string {
-        double x = 0;
-        const bool ok = parse_finite_number(text, x) && (open_low ? x > lo : x >= lo) &&
-                        (open_high ? x < hi : x <= hi);
-        return ok ? "" : "'" + text + "' is not a finite number " + range;
-      },
-      "NUMBER " + range);
-}
-
-CLI::Validator any_finite_number() {
-  return CLI::Validator(
-      [](std::string& text) -> std::string {
-        double x = 0;
-        return parse_finite_number(text, x) ? "" : "'" + text + "' is not a finite number";
-      },
-      "NUMBER");
 }
 
 JobPlan job_plan(const RunArgs& run) {
@@ -202,101 +170,12 @@ void check_job_memory(std::int64_t patches, const JobPlan& plan) {
       "peak), or set --max-memory / LAMBERT_MAX_MEMORY (0 = no check)");
 }
 
-void add_scene_options(CLI::App* cmd, SceneArgs& args) {
-  cmd->add_option(
-      "scene", args.scene,
-      "OBJ or STL scene file, told apart by content (default: the built-in Cornell box)");
-  cmd->add_flag("--strict", args.load.strict,
-                "Refuse missing or undefined materials and Kd = 1 instead of defaulting with a warning");
-  cmd->add_option_function<std::string>(
-         "--default-reflectance",
-         [&args](const std::string& s) {
-           parse_rgb(s, true, args.load.default_reflectance);
-           args.default_reflectance_given = true;
-         },
-         "Reflectance R,G,B of the default material (default 0.5,0.5,0.5)")
-      ->check([](const std::string& s) {
-        Eigen::Vector3d c;
-        return parse_rgb(s, true, c);
-      });
-  cmd->add_option("--max-reflectance", args.load.max_reflectance,
-                  "Clamp every Kd channel above R to R (0 < R <= 1), with a warning")
-      ->check([](const std::string& s) {
-        double r = 0;
-        return parse_finite_number(s, r) && r > 0 && r <= 1 ? std::string()
-                                                            : "'" + s + "' is not a number in (0, 1]";
-      });
-  cmd->add_flag("--vertex-colors-as-reflectance", args.load.vertex_colors_as_reflectance,
-                "Each face whose corners all have colours (v x y z r g b) reflects their mean "
-                "instead of its material's Kd");
-  cmd->add_option("--emit", args.emit,
-                  "NAME_OR_GLOB=R,G,B: surfaces (or materials) matching the name or glob emit "
-                  "radiosity R,G,B (repeatable; later rules win)")
-      ->check([](const std::string& s) {
-        EmitRule r;
-        return parse_emit(s, r);
-      });
-  auto* edge = cmd->add_option("--max-edge", args.max_edge, "Longest patch edge, in scene units")
-                   ->check(finite_number(0.0, std::numeric_limits<double>::infinity(), true));
-  cmd->add_option("--patches", args.patches, "Approximate total number of patches")
-      ->check(CLI::Range(std::int64_t{1}, std::int64_t{100000000}))
-      ->excludes(edge);
-  auto* disc = cmd->add_flag(
-      "--discontinuity", args.discontinuity,
-      "Discontinuity meshing: constrained Delaunay triangles whose edges follow the contact "
-      "lines of blockers (D0) and the penumbra and umbra boundaries (D1/D2) of the emitters");
-  cmd->add_option("--discontinuity-sources", args.discontinuity_sources,
-                  "With --discontinuity, also trace the shadows of the N non-emitting surfaces "
-                  "that reflect the most direct light (default 0)")
-      ->check(CLI::Range(0, 1000))
-      ->needs(disc);
-}
-
-void add_run_options(CLI::App* cmd, RunArgs& args) {
-  args.command = cmd;
-  cmd->add_option("-j,--threads", args.threads, "Worker threads (default: all cores)")
-      ->check(CLI::Range(1, 1024));
-  cmd->add_option("--seed", args.seed, "Random seed (results are bitwise reproducible)");
-  cmd->add_flag("-q,--quiet", args.quiet, "No progress or log output on stderr");
-  cmd->add_flag("-v,--verbose", args.verbose, "More log output on stderr");
-  cmd->add_option("--max-memory", args.max_memory,
-                  "Refuse a job whose estimated memory exceeds SIZE (e.g. 512M, 8G; 0 = no "
-                  "check; default: $LAMBERT_MAX_MEMORY, else the available memory)")
-      ->check([](const std::string& s) {
-        return parse_size(s) ? std::string() : "'" + s + "' is not a size such as 512M or 8G";
-      });
-}
-
 void check_options_read(const RunArgs& args, const Selection& selection) {
-  if (args.command != nullptr) check_option_scopes(*args.command, selection);
+  check_option_scopes(args.given, selection);
 }
 
 void apply_run_options(const RunArgs& args) {
-  set_log_level(args.quiet     ? LogLevel::Quiet
-                : args.verbose ? LogLevel::Verbose
-                               : LogLevel::Normal);
-}
-
-CLI::Validator output_file_check() {
-  return CLI::Validator(
-      [](std::string& path) -> std::string {
-        namespace fs = std::filesystem;
-        const fs::path dir = fs::path(path).parent_path();
-        std::error_code ec;
-        if (!dir.empty() && !fs::is_directory(dir, ec))
-          return "cannot write '" + path + "': directory '" + dir.string() + "' does not exist";
-        return "";
-      },
-      "FILE");
-}
-
-CLI::Validator output_prefix_check() {
-  return CLI::Validator(
-      [](std::string& out) -> std::string {
-        if (!out.empty() && out.back() == '/') return "";  // created when writing
-        return output_file_check()(out);
-      },
-      "DIR/|PREFIX");
+  set_log_level(args.quiet ? LogLevel::Quiet : args.verbose ? LogLevel::Verbose : LogLevel::Normal);
 }
 
 std::string output_prefix(const std::string& output, const std::string& name) {

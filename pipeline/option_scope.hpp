@@ -4,14 +4,17 @@
 // that register them). Every command checks the options given on its command line against
 // the table before any work: an option its choices do not read is a usage error (exit 2)
 // naming the option, the choice and what reads it, never a silently ignored setting.
-// (The `--method` rows of apps/method.hpp refuse the other method's options first.)
+// (The `--method` rows of pipeline/method.hpp refuse the other method's options first.)
 
-#include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
 #include <vector>
 
 namespace lambert {
+
+/// Asks whether the front end was given an option, by its long name ("--omega"). The CLI
+/// answers for its command line (apps/options.hpp, option_given_on); empty = none given.
+using OptionGiven = std::function<bool(const std::string& long_name)>;
 
 /// What a command line chose: the axes an option's use depends on.
 struct Selection {
@@ -41,12 +44,12 @@ struct OptionScope {
 /// The table.
 const std::vector<OptionScope>& option_scopes();
 
-/// Throws UsageError for the first option given on `cmd`'s command line that `selection`
-/// does not read: "--omega does not apply to --solver jacobi (read by the solver sor)".
-void check_option_scopes(const CLI::App& cmd, const Selection& selection);
+/// Throws UsageError for the first option `given` that `selection` does not read: "--omega
+/// does not apply to --solver jacobi (read by the solver sor)".
+void check_option_scopes(const OptionGiven& given, const Selection& selection);
 
-/// The long names of the options given on `cmd`'s command line that `selection` does not
-/// read, in table order (what check_option_scopes refuses; empty when all apply).
-std::vector<std::string> unread_options(const CLI::App& cmd, const Selection& selection);
+/// The long names of the options `given` that `selection` does not read, in table order
+/// (what check_option_scopes refuses; empty when all apply).
+std::vector<std::string> unread_options(const OptionGiven& given, const Selection& selection);
 
 }  // namespace lambert

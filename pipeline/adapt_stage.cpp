@@ -1,28 +1,16 @@
-#include "apps/adapt_stage.hpp"
+#include "pipeline/adapt_stage.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
-#include "apps/problem.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/timer.hpp"
 #include "geometry/adapt.hpp"
+#include "pipeline/problem.hpp"
 
 namespace lambert {
-
-void add_adapt_options(CLI::App* cmd, AdaptArgs& args) {
-  cmd->add_option("--adapt", args.rounds,
-                  "Adaptive meshing: ROUNDS rounds of solve, estimate each patch's error, bisect "
-                  "the worst 20 % (conforming longest-edge bisection), update their form "
-                  "factors, re-solve from the previous solution")
-      ->check(CLI::Range(1, 1000));
-  cmd->add_option("--adapt-patches", args.patches,
-                  "Adaptive meshing until the mesh has about N patches (with --adapt: whichever "
-                  "comes first)")
-      ->check(CLI::Range(std::int64_t{1}, std::int64_t{100000000}));
-}
 
 namespace {
 
@@ -49,7 +37,8 @@ std::vector<AdaptRound> adapt_scene(LoadedScene& scene, const FormFactorArgs& ff
   // Bisection needs triangles: quads are split first (the round-0 mesh).
   scene.mesh = triangulate_quads(scene.mesh).mesh;
   scene.bvh.reset();
-  FormFactorOptions fo = resolve_form_factor_options(make_ff_options(ff_args, run), scene.mesh.size());
+  FormFactorOptions fo =
+      resolve_form_factor_options(make_ff_options(ff_args, run), scene.mesh.size());
   SolveOptions so = solver;
   so.threads = run.threads;
   std::vector<AdaptRound> out;
@@ -62,10 +51,10 @@ std::vector<AdaptRound> adapt_scene(LoadedScene& scene, const FormFactorArgs& ff
     // A discontinuity mesh is shaded with exact direct light at its vertices: its error is
     // that field's (interpolation of H_d, jumps of the indirect part), not the constants'.
     const std::vector<double> e =
-        scene.discontinuity
-            ? exact_direct_patch_errors(scene.scene, scene.mesh,
-                                        indirect_irradiance(scene.mesh, ff.F, solution.B), run.threads)
-            : patch_errors(scene.mesh, solution.B);
+        scene.discontinuity ? exact_direct_patch_errors(
+                                  scene.scene, scene.mesh,
+                                  indirect_irradiance(scene.mesh, ff.F, solution.B), run.threads)
+                            : patch_errors(scene.mesh, solution.B);
     AdaptRound r;
     r.round = round;
     r.patches = scene.mesh.size();
@@ -84,8 +73,10 @@ std::vector<AdaptRound> adapt_scene(LoadedScene& scene, const FormFactorArgs& ff
     std::vector<std::int32_t> order(scene.mesh.size());
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(), [&](auto a, auto b) { return e[a] > e[b]; });
-    auto marks = static_cast<std::int64_t>(std::ceil(kAdaptFraction * static_cast<double>(order.size())));
-    if (adapt.patches > 0) marks = std::min(marks, std::max<std::int64_t>(1, (adapt.patches - scene.mesh.size()) / 2));
+    auto marks =
+        static_cast<std::int64_t>(std::ceil(kAdaptFraction * static_cast<double>(order.size())));
+    if (adapt.patches > 0)
+      marks = std::min(marks, std::max<std::int64_t>(1, (adapt.patches - scene.mesh.size()) / 2));
     std::vector<char> marked(scene.mesh.size(), 0);
     std::int64_t count = 0;
     for (std::int64_t k = 0; k < marks && e[order[k]] > 0; ++k, ++count) marked[order[k]] = 1;

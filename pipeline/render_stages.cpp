@@ -1,12 +1,10 @@
-#include "apps/render_stages.hpp"
+#include "pipeline/render_stages.hpp"
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 
-#include "apps/problem.hpp"
-#include "apps/solve_args.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
@@ -15,6 +13,8 @@
 #include "io/exr.hpp"
 #include "io/ply.hpp"
 #include "io/tonemap.hpp"
+#include "pipeline/problem.hpp"
+#include "pipeline/solve_stage.hpp"
 
 namespace lambert {
 namespace {
@@ -22,21 +22,6 @@ namespace {
 Eigen::Vector3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
 
 }  // namespace
-
-void add_camera_options(CLI::App* cmd, CameraArgs& args) {
-  cmd->add_option("--eye", args.eye, "Camera position X Y Z (default: the scene's camera)")
-      ->expected(3)
-      ->check(any_finite_number());
-  cmd->add_option("--look-at", args.look_at, "Point the camera looks at, X Y Z")
-      ->expected(3)
-      ->check(any_finite_number());
-  cmd->add_option("--up", args.up, "Camera up vector X Y Z")
-      ->expected(3)
-      ->check(any_finite_number());
-  cmd->add_option("--fov", args.fov, "Vertical field of view, degrees")
-      ->check(finite_number(0.1, 179.0));
-  cmd->add_option("--size", args.size, "Image size WxH in pixels (default 512x512)");
-}
 
 Camera make_camera(const Scene& scene, const CameraArgs& args) {
   Camera cam = scene.camera;
@@ -77,42 +62,6 @@ Selection render_selection(const std::string& command, const std::string& method
               shading == Shading::Raytrace || shade.antialias > 1};
   if (solves) s.solvers = {solver};
   return s;
-}
-
-void add_shade_options(CLI::App* cmd, ShadeArgs& args) {
-  cmd->add_option("--shading", args.shading,
-                  "gouraud (B/pi interpolated from the vertices), flat (per patch) or raytrace "
-                  "(camera rays followed through mirrors and glass up to --specular-depth "
-                  "bounces, Gouraud or --final-gather at diffuse hits); default gouraud")
-      ->check(CLI::IsMember({"gouraud", "flat", "raytrace"}));
-  cmd->add_flag("--flat", args.flat, "Per-patch (flat) shading: the same as --shading flat");
-  cmd->add_option("--final-gather", args.final_gather,
-                  "N: at diffuse hits, exact direct light plus N cosine rays reading the "
-                  "solution's indirect light (implies --shading raytrace)")
-      ->check(CLI::Range(1, 65536));
-  cmd->add_flag("--wireframe", args.wireframe,
-                "Draw the patch edges (black, about one pixel wide) over the shading");
-  cmd->add_option("--antialias", args.antialias, "K: K x K stratified samples per pixel")
-      ->check(CLI::Range(1, 16))
-      ->capture_default_str();
-  cmd->add_option("--exposure", args.exposure,
-                  "PNG/PLY exposure in stops (pixel x 2^EV), or auto (key value 0.36)")
-      ->check([](const std::string& s) -> std::string {
-        if (s == "auto") return "";
-        char* end = nullptr;
-        const double v = std::strtod(s.c_str(), &end);
-        return !s.empty() && *end == '\0' && std::isfinite(v) && std::abs(v) <= 64
-                   ? ""
-                   : "must be 'auto' or a number of stops in [-64, 64]";
-      })
-      ->capture_default_str();
-  cmd->add_option("--vertex-interp", args.vertex_interp,
-                  "Per-vertex reconstruction: conservative (area-weighted, rescaled per surface "
-                  "to conserve power), area (area-weighted only), exact-direct (exact direct "
-                  "light at each vertex plus the area-weighted indirect light), or auto "
-                  "(exact-direct on a --discontinuity mesh, else conservative)")
-      ->check(CLI::IsMember({"auto", "conservative", "area", "exact-direct"}))
-      ->capture_default_str();
 }
 
 Shading resolve_shading(const ShadeArgs& args) {
@@ -201,11 +150,12 @@ std::string resolve_vertex_interp(const ShadeArgs& args, const LoadedScene& scen
   // Exact direct light sees emitters only directly: light they send through mirrors and
   // glass is in B but would be missing at the vertices.
   if (args.vertex_interp == "exact-direct" && scene.mesh.has_specular())
-    throw UsageError("--vertex-interp exact-direct computes direct light without mirrors and "
-                     "glass, and this scene has specular surfaces: use conservative");
+    throw UsageError(
+        "--vertex-interp exact-direct computes direct light without mirrors and "
+        "glass, and this scene has specular surfaces: use conservative");
   if (args.vertex_interp != "auto") return args.vertex_interp;
   return scene.discontinuity && indirect && !scene.mesh.has_specular() ? "exact-direct"
-                                                                        : "conservative";
+                                                                       : "conservative";
 }
 
 ShadedField shade_vertices(const LoadedScene& scene, const Eigen::MatrixX3d& B,

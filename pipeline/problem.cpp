@@ -1,4 +1,4 @@
-#include "apps/problem.hpp"
+#include "pipeline/problem.hpp"
 
 #include <cmath>
 
@@ -11,7 +11,8 @@ Eigen::MatrixX3d indirect_irradiance(const PatchMesh& mesh, const SparseRowMatri
   LAMBERT_CHECK(F.rows() == mesh.size() && F.cols() == mesh.size() && B.rows() == mesh.size(),
                 "form factors and radiosity do not match the mesh");
   Eigen::MatrixX3d reflected = B;
-  for (std::int32_t i = 0; i < mesh.size(); ++i) reflected.row(i) -= mesh.patches[i].emission.transpose();
+  for (std::int32_t i = 0; i < mesh.size(); ++i)
+    reflected.row(i) -= mesh.patches[i].emission.transpose();
   return F * reflected;
 }
 

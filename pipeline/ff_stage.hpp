@@ -1,13 +1,12 @@
 #pragma once
-// Form-factor options shared by every command that needs F, and the step that computes F
-// or loads a saved one.
+// The form-factor settings of every command that needs F, and the stage that computes F or
+// loads a saved one (with its checks and report pieces).
 
-#include <CLI/CLI.hpp>
 #include <string>
 
-#include "apps/common.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "io/json.hpp"
+#include "pipeline/job.hpp"
 
 namespace lambert {
 
@@ -27,7 +26,7 @@ struct FormFactorArgs {
   bool rays_given = false;     ///< --rays was on the command line
   double tol = 1e-6;           ///< --ff-tol (--tol in formfactors): estimator analytic
   bool tol_given = false;      ///< --ff-tol was on the command line
-  std::string ff_file;  ///< load F from this file instead of computing it
+  std::string ff_file;         ///< load F from this file instead of computing it
   /// --specular-depth: specular bounces followed by the extended form factors and by the
   /// ray-traced view pass (with --ff it steers the view pass only; F keeps its own).
   int specular_depth = 8;
@@ -37,13 +36,6 @@ struct FormFactorArgs {
                                    ///< --specular-depth or --specular-rays was on the command line
 };
 
-/// Adds the form-factor options to a subcommand. `with_load` adds --ff FILE, which excludes
-/// the options that only steer a computation (--estimator, --samples, --rays, --threshold,
-/// --hemicube-res, --reciprocity, --symmetrize): given together, they are a usage error.
-/// `tol_alias` also names --ff-tol --tol (the formfactors command, which has no solver).
-void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load = true,
-                    bool tol_alias = false);
-
 /// Adds F to a job plan: --ff as an input, or the computation's options for the memory
 /// estimate.
 void plan_form_factors(JobPlan& plan, const FormFactorArgs& args, const RunArgs& run,
@@ -52,7 +44,7 @@ void plan_form_factors(JobPlan& plan, const FormFactorArgs& args, const RunArgs&
 /// Builds FormFactorOptions from the arguments ("auto" stays unresolved: it needs the patch
 /// count). Throws UsageError when a named estimator does not read a count that was given
 /// (--rays with a pair estimator or the hemicube, --samples with gather).
-/// The estimator of a selection (apps/option_scope.hpp): --estimator, or "" when F is loaded
+/// The estimator of a selection (pipeline/option_scope.hpp): --estimator, or "" when F is loaded
 /// from --ff.
 std::string selected_estimator(const FormFactorArgs& args);
 
@@ -89,9 +81,10 @@ void check_closed_lossless(const PatchMesh& mesh, const FormFactors& ff, bool so
 
 /// The settings that made F, for reports: {estimator (the resolved one),
 /// estimator_requested ("auto" or null), samples, rays_per_patch (--rays), seed, threshold,
-/// hemicube_resolution, tol (analytic's --ff-tol, else null), reciprocity, symmetrize (reciprocity == average), extended (F holds
-/// specular paths), specular_depth and specular_rays (null unless extended), loaded_from} (""
-/// when computed here), every setting null when unknown (see obtain_form_factors).
+/// hemicube_resolution, tol (analytic's --ff-tol, else null), reciprocity, symmetrize (reciprocity
+/// == average), extended (F holds specular paths), specular_depth and specular_rays (null unless
+/// extended), loaded_from} ("" when computed here), every setting null when unknown (see
+/// obtain_form_factors).
 Json ff_settings_json(const FormFactorOptions& options, const std::string& loaded_from);
 
 /// What reciprocity averaging changed (FormFactorStats' reciprocity_* members): {applied,

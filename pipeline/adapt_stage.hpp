@@ -3,21 +3,20 @@
 // error, bisect the worst patches conformingly, update only the form factors of the
 // changed patches, re-solve from the previous solution, repeat (geometry/adapt.hpp).
 
-#include <CLI/CLI.hpp>
 #include <cstdint>
 #include <vector>
 
-#include "apps/common.hpp"
-#include "apps/ff_args.hpp"
 #include "io/json.hpp"
+#include "pipeline/ff_stage.hpp"
+#include "pipeline/job.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
 
 /// --adapt ROUNDS, --adapt-patches N.
 struct AdaptArgs {
-  int rounds = 0;              ///< --adapt: refinement rounds (0 = none unless a budget)
-  std::int64_t patches = 0;    ///< --adapt-patches: stop once the mesh has this many patches
+  int rounds = 0;            ///< --adapt: refinement rounds (0 = none unless a budget)
+  std::int64_t patches = 0;  ///< --adapt-patches: stop once the mesh has this many patches
   bool active() const { return rounds > 0 || patches > 0; }
 };
 
@@ -26,12 +25,9 @@ constexpr double kAdaptFraction = 0.2;
 /// Rounds at most when only a patch budget is given.
 constexpr int kAdaptMaxRounds = 30;
 
-/// Adds --adapt and --adapt-patches to a subcommand.
-void add_adapt_options(CLI::App* cmd, AdaptArgs& args);
-
 /// One round's report: the mesh solved in it, its estimated error, and its cost.
 struct AdaptRound {
-  int round = 0;                 ///< 0 = the initial mesh
+  int round = 0;  ///< 0 = the initial mesh
   std::int64_t patches = 0;
   std::int64_t changed = 0;      ///< patches whose form factors were (re)computed
   double estimated_error = 0.0;  ///< Σ patch_errors / Σ A (W/m², mean over the area)

@@ -1,19 +1,18 @@
 #pragma once
 // The stages `lambert render` and `lambert run` share after load-and-mesh: radiosity (from a
 // CSV or from F + solve), per-vertex reconstruction, rendering and writing the result files,
-// with the CLI options that steer them (solver options: apps/solve_args.hpp).
+// with the options that steer them (solver options: pipeline/solve_stage.hpp).
 
-#include <CLI/CLI.hpp>
 #include <Eigen/Core>
 #include <string>
 #include <vector>
 
-#include "apps/common.hpp"
-#include "apps/ff_args.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/render.hpp"
 #include "geometry/vertex_field.hpp"
 #include "io/json.hpp"
+#include "pipeline/ff_stage.hpp"
+#include "pipeline/job.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
@@ -24,8 +23,6 @@ struct CameraArgs {
   double fov = 0.0;                      ///< vertical field of view in degrees; 0 = the scene's
   std::string size;                      ///< "WxH"; empty = the scene camera's
 };
-/// Adds the camera options to a subcommand.
-void add_camera_options(CLI::App* cmd, CameraArgs& args);
 /// The scene's camera (or one framing the scene) with the overrides applied.
 /// Throws UsageError for a malformed --size or a degenerate view.
 Camera make_camera(const Scene& scene, const CameraArgs& args);
@@ -42,13 +39,11 @@ struct ShadeArgs {
   /// area or exact-direct (geometry/vertex_field.hpp)
   std::string vertex_interp = "auto";
 };
-/// Adds the shading options to a subcommand.
-void add_shade_options(CLI::App* cmd, ShadeArgs& args);
 /// The shading the options ask for: --shading, else flat with --flat, raytrace with
 /// --final-gather, else Gouraud. Throws UsageError when they contradict each other.
 Shading resolve_shading(const ShadeArgs& args);
 /// The choices of a command that solves and renders (run, render) for the option check
-/// (apps/option_scope.hpp): the estimator and `solver` when it computes F and solves
+/// (pipeline/option_scope.hpp): the estimator and `solver` when it computes F and solves
 /// (`solves`), the shading the options resolve to, and whether pixels draw random numbers.
 Selection render_selection(const std::string& command, const std::string& method, bool solves,
                            const FormFactorArgs& ff, const std::string& solver,
@@ -68,10 +63,10 @@ void check_vertex_interp(const ShadeArgs& args, bool has_form_factors, const std
 
 /// The radiosity B of every patch and how it was obtained.
 struct RadiosityResult {
-  Eigen::MatrixX3d B;          ///< N x 3
-  bool solved = false;         ///< false when read from a CSV
-  RadiositySolution solution;  ///< valid when solved
-  FormFactorStats ff_stats;    ///< valid when solved (rays 0 when F was loaded)
+  Eigen::MatrixX3d B;            ///< N x 3
+  bool solved = false;           ///< false when read from a CSV
+  RadiositySolution solution;    ///< valid when solved
+  FormFactorStats ff_stats;      ///< valid when solved (rays 0 when F was loaded)
   FormFactorOptions ff_options;  ///< valid when solved: the settings that made F (a loaded
                                  ///< file's own; see obtain_form_factors)
   /// I = F (B - E) per patch (N x 3) when solved (problem.hpp), for exact-direct vertices.

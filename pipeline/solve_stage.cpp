@@ -1,43 +1,12 @@
-#include "apps/solve_args.hpp"
+#include "pipeline/solve_stage.hpp"
 
 #include <cstdio>
 #include <sstream>
 
-#include "apps/common.hpp"
 #include "geometry/hierarchical/hierarchical.hpp"
+#include "pipeline/job.hpp"
 
 namespace lambert {
-
-void add_solve_options(CLI::App* cmd, SolveOptions& o, bool with_solver) {
-  if (with_solver)
-    cmd->add_option("--solver", o.solver, "Solver (see `lambert solvers`)")
-        ->check(CLI::IsMember(solver_names()))
-        ->capture_default_str();
-  const HierarchicalOptions hierarchical;
-  std::ostringstream tol_help, iter_help;
-  tol_help << "Stop when ||E - K B||_2 / ||E||_2 <= tol (--method hierarchical: when the largest "
-              "change of a leaf's B over the largest B <= tol; its default "
-           << hierarchical.tol << ")";
-  iter_help << "Iteration limit per channel (--method hierarchical: sweeps per refinement pass; "
-               "its default "
-            << hierarchical.max_iterations << ")";
-  cmd->add_option("--tol", o.tol, tol_help.str())
-      ->check(finite_number(1e-16, 0.5))
-      ->capture_default_str();
-  cmd->add_option("--max-iter", o.max_iterations, iter_help.str())
-      ->check(CLI::Range(1, 100000000))
-      ->capture_default_str();
-  cmd->add_option("--omega", o.omega, "SOR relaxation factor, in (0, 2)")
-      ->check(finite_number(1e-3, 1.999))
-      ->capture_default_str();
-  cmd->add_option("--preconditioner", o.preconditioner, "bicgstab/gmres/cg preconditioner")
-      ->check(CLI::IsMember({"none", "diagonal", "ilut"}))
-      ->capture_default_str();
-  cmd->add_option("--restart", o.restart, "GMRES restart length")
-      ->check(CLI::Range(1, 10000))
-      ->capture_default_str();
-  cmd->add_flag("--ambient", o.ambient, "southwell: add the ambient term (display estimate)");
-}
 
 void set_memory_limit(SolveOptions& o, const std::string& max_memory) {
   const auto limit = job_memory_limit(max_memory);

@@ -6,10 +6,10 @@
 #include <Eigen/Core>
 #include <string>
 
-#include "apps/common.hpp"
-#include "apps/method.hpp"
 #include "geometry/hierarchical/hierarchical.hpp"
 #include "io/json.hpp"
+#include "pipeline/job.hpp"
+#include "pipeline/method.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
@@ -17,8 +17,8 @@ namespace lambert {
 /// A hierarchical solution: the leaves as a LoadedScene (its BVH, built on first use, is the
 /// leaves'), their radiosity and what the solve did.
 struct HierarchicalRun {
-  LoadedScene loaded;  ///< the scene and the leaf mesh (max_edge 0: the mesh is adaptive)
-  Eigen::MatrixX3d B;  ///< leaves x 3
+  LoadedScene loaded;           ///< the scene and the leaf mesh (max_edge 0: the mesh is adaptive)
+  Eigen::MatrixX3d B;           ///< leaves x 3
   Eigen::VectorXd error_bound;  ///< per leaf (HierarchicalResult::error_bound)
   HierarchicalStats stats;
   HierarchicalOptions options;  ///< as used (min_area as requested; stats.min_area as used)

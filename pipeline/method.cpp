@@ -1,10 +1,10 @@
-#include "apps/method.hpp"
+#include "pipeline/method.hpp"
 
 #include <algorithm>
 #include <limits>
 
-#include "apps/medium_stage.hpp"
 #include "core/error.hpp"
+#include "pipeline/medium_stage.hpp"
 
 namespace lambert {
 
@@ -29,7 +29,7 @@ std::vector<Method> base_methods() {
 }
 
 // methods() with the medium's options added to the matrix row (the medium is one of its
-// problem options: apps/medium_stage.hpp owns the list).
+// problem options: pipeline/medium_stage.hpp owns the list).
 std::vector<Method> with_medium_options() {
   std::vector<Method> out = base_methods();
   for (Method& m : out)
@@ -57,41 +57,8 @@ const Method& find_method(const std::string& name) {
   throw UsageError("--method: unknown method '" + name + "'");
 }
 
-void add_method_options(CLI::App* cmd, MethodArgs& args, bool epsilon_list) {
-  args.command = cmd;
-  cmd->add_option("--method", args.name,
-                  "How B is computed: matrix (F + solver) or hierarchical (adaptive links with "
-                  "clustering, no F)")
-      ->check(CLI::IsMember(method_names()))
-      ->capture_default_str();
-  // (0, 1): epsilon is a fraction of the emitted power; at 1 no link would ever refine.
-  const CLI::Validator epsilon_range = finite_number(0.0, 1.0, true, true);
-  const std::string epsilon_help =
-      "hierarchical: refine a link while its power error exceeds EPSILON x the emitted power";
-  if (epsilon_list)
-    cmd->add_option("--epsilon", args.hierarchical.epsilons,
-                    epsilon_help + " (comma-separated: one hierarchical run each)")
-        ->delimiter(',')
-        ->check(epsilon_range)
-        ->capture_default_str();
-  else
-    cmd->add_option("--epsilon", args.hierarchical.epsilon, epsilon_help)
-        ->check(epsilon_range)
-        ->capture_default_str();
-  cmd->add_option("--min-area", args.hierarchical.min_area,
-                  "hierarchical: smallest element area, scene units^2 (0 = total area x 1e-5)")
-      ->check(finite_number(0.0, std::numeric_limits<double>::infinity()))
-      ->capture_default_str();
-  cmd->add_option("--link-rays", args.hierarchical.link_rays,
-                  "hierarchical: visibility rays per element link (samples per cluster link)")
-      ->check(CLI::Range(1, 1024))
-      ->capture_default_str();
-}
-
 bool option_given(const MethodArgs& args, const std::string& option) {
-  if (args.command == nullptr) return false;
-  const CLI::Option* o = args.command->get_option_no_throw(option);
-  return o != nullptr && o->count() > 0;
+  return args.given && args.given(option);
 }
 
 void check_method_options(const MethodArgs& args, const std::string& reference) {

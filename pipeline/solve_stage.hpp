@@ -1,18 +1,14 @@
 #pragma once
-// Solver options shared by `solve` and `compare`, and the report pieces both write.
+// The solver settings' memory limit and the report pieces of a solve (energy balance,
+// surface averages, CSV fields), shared by every command that solves.
 
-#include <CLI/CLI.hpp>
 #include <string>
 
-#include "apps/problem.hpp"
 #include "io/json.hpp"
+#include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
-
-/// Adds --tol, --max-iter, --omega, --preconditioner, --restart, --ambient (and --solver when
-/// `with_solver`) bound to `options`.
-void add_solve_options(CLI::App* cmd, SolveOptions& options, bool with_solver);
 
 /// Sets options.memory_limit / memory_limit_source from the job's limit (job_memory_limit of
 /// --max-memory), so that `direct` refuses a factorisation above it.

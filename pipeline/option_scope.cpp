@@ -1,4 +1,4 @@
-#include "apps/option_scope.hpp"
+#include "pipeline/option_scope.hpp"
 
 #include <algorithm>
 #include <initializer_list>
@@ -113,20 +113,18 @@ const std::vector<OptionScope>& option_scopes() {
   return kScopes;
 }
 
-std::vector<std::string> unread_options(const CLI::App& cmd, const Selection& selection) {
+std::vector<std::string> unread_options(const OptionGiven& given, const Selection& selection) {
   std::vector<std::string> out;
-  for (const OptionScope& row : option_scopes()) {
-    const CLI::Option* o = cmd.get_option_no_throw(row.option);
-    if (o == nullptr || o->count() == 0) continue;
-    // formfactors' --tol is --ff-tol under another name: its row decides.
-    if (row.option == "--tol" && o->check_lname("ff-tol")) continue;
-    if (!row.reads(selection)) out.push_back(row.option);
-  }
+  if (!given) return out;
+  // (formfactors' --ff-tol is also --tol there: `given` answers for first long names only,
+  // so its row is --ff-tol's.)
+  for (const OptionScope& row : option_scopes())
+    if (given(row.option) && !row.reads(selection)) out.push_back(row.option);
   return out;
 }
 
-void check_option_scopes(const CLI::App& cmd, const Selection& selection) {
-  const std::vector<std::string> unread = unread_options(cmd, selection);
+void check_option_scopes(const OptionGiven& given, const Selection& selection) {
+  const std::vector<std::string> unread = unread_options(given, selection);
   if (unread.empty()) return;
   for (const OptionScope& row : option_scopes())
     if (row.option == unread.front())

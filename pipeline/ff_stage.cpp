@@ -1,4 +1,4 @@
-#include "apps/ff_args.hpp"
+#include "pipeline/ff_stage.hpp"
 
 #include <cstdio>
 
@@ -10,73 +10,6 @@
 #include "io/ff_file.hpp"
 
 namespace lambert {
-
-void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load, bool tol_alias) {
-  std::vector<CLI::Option*> compute_only;
-  compute_only.push_back(
-      cmd->add_option("--estimator", args.estimator,
-                      "Form-factor estimator (auto: hybrid below " +
-                          std::to_string(kAutoGatherPatches) + " patches, gather from there)")
-          ->check(CLI::IsMember(form_factor_estimator_choices()))
-          ->capture_default_str());
-  compute_only.push_back(
-      cmd->add_option("--samples", args.samples,
-                      "Sample pairs (rays) per patch pair (pair estimators mc, hybrid)")
-          ->check(CLI::Range(1, 1 << 20))
-          ->each([&args](const std::string&) { args.samples_given = true; })
-          ->capture_default_str());
-  compute_only.push_back(
-      cmd->add_option("--rays", args.rays, "Rays per patch (estimator gather)")
-          ->check(CLI::Range(1, 1 << 24))
-          ->each([&args](const std::string&) { args.rays_given = true; })
-          ->capture_default_str());
-  compute_only.push_back(
-      cmd->add_option(tol_alias ? "--tol,--ff-tol" : "--ff-tol", args.tol,
-                      "Absolute error target of every form factor (estimator analytic)")
-          ->check(finite_number(1e-15, 1.0))
-          ->each([&args](const std::string&) { args.tol_given = true; })
-          ->capture_default_str());
-  compute_only.push_back(
-      cmd->add_option("--threshold", args.threshold, "Drop form factors below this value")
-          ->check(finite_number(0.0, 1.0)));
-  compute_only.push_back(cmd->add_option("--hemicube-res", args.hemicube_resolution,
-                                         "Hemicube top-face resolution (estimator hemicube)")
-                             ->check(CLI::Range(4, 8192))
-                             ->capture_default_str());
-  CLI::Option* reciprocity =
-      cmd->add_option("--reciprocity", args.reciprocity,
-                      "Replace A_i F_ij and A_j F_ji by their mean: none, average, or auto "
-                      "(average for gather, none for the others)")
-          ->check(CLI::IsMember({"auto", "none", "average"}))
-          ->each([&args](const std::string&) { args.reciprocity_given = true; })
-          ->capture_default_str();
-  compute_only.push_back(reciprocity);
-  compute_only.push_back(
-      cmd->add_flag("--symmetrize", args.symmetrize, "Alias of --reciprocity average")
-          ->each([&args](const std::string&) { args.reciprocity_given = true; })
-          ->excludes(reciprocity));
-  cmd->add_option("--specular-depth", args.specular_depth,
-                  "Specular bounces a ray follows through mirrors and glass (extended form "
-                  "factors, ray-traced shading); 0 = specular surfaces only receive and block")
-      ->check(CLI::Range(0, 64))
-      ->each([&args](const std::string&) { args.specular_given = true; })
-      ->capture_default_str();
-  compute_only.push_back(
-      cmd->add_option("--specular-rays", args.specular_rays,
-                      "Rays per patch that trace the specular paths of the extended form "
-                      "factors (scenes with mirrors or glass)")
-          ->check(CLI::Range(1, 1 << 24))
-          ->each([&args](const std::string&) { args.specular_given = true; })
-          ->capture_default_str());
-  if (!with_load) return;
-  CLI::Option* ff = cmd->add_option(
-      "--ff", args.ff_file,
-      "Use a saved form-factor file (from `formfactors -o`) and the settings stored in it; "
-      "excludes the options above");
-  // A loaded F keeps the settings that made it: an option that would change them is refused
-  // rather than silently ignored (and then misreported).
-  for (CLI::Option* o : compute_only) ff->excludes(o);
-}
 
 void plan_form_factors(JobPlan& plan, const FormFactorArgs& args, const RunArgs& run,
                        bool with_stderr) {
@@ -214,7 +147,8 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
       log_warn(args.ff_file + ": records no form-factor settings; reports show them as unknown");
     }
     if (ff.options.extended && ff.specular_continued.size() != ff.F.rows())
-      log_warn(args.ff_file + ": extended form factors without their specular bookkeeping "
+      log_warn(args.ff_file +
+               ": extended form factors without their specular bookkeeping "
                "(a Matrix Market file): the energy balance counts light carried on by mirrors "
                "and glass once more, as negative escaped power (save F as .bin to keep it)");
     check_loaded_medium(ff, medium, args.ff_file);
@@ -264,26 +198,27 @@ void check_closed_lossless(const PatchMesh& mesh, const FormFactors& ff, bool so
   const std::vector<ClosedLossless> sets = find_closed_lossless(mesh, ff);
   if (sets.empty()) return;
   if (solving) throw SceneError(closed_lossless_message(mesh, sets.front()));
-  for (const auto& c : sets) log_warn(closed_lossless_message(mesh, c) + " (a solve with this F is refused)");
+  for (const auto& c : sets)
+    log_warn(closed_lossless_message(mesh, c) + " (a solve with this F is refused)");
 }
 
 Json ff_settings_json(const FormFactorOptions& o, const std::string& loaded_from) {
   const auto known = [&](Json v) { return o.estimator.empty() ? Json() : v; };
-  return {{"estimator", known(o.estimator)},
-          {"estimator_requested",
-           o.estimator_requested.empty() ? Json() : Json(o.estimator_requested)},
-          {"samples", known(o.samples)},
-          {"rays_per_patch", known(o.rays)},  // "rays" is the traced count in reports
-          {"seed", known(o.seed)},
-          {"threshold", known(o.threshold)},
-          {"hemicube_resolution", known(o.hemicube_resolution)},
-          {"tol", o.estimator == "analytic" ? Json(o.tol) : Json()},
-          {"reciprocity", known(o.reciprocity)},
-          {"symmetrize", known(o.reciprocity == "average")},
-          {"extended", known(o.extended)},  // specular paths included (specular.hpp)
-          {"specular_depth", o.extended ? Json(o.specular_depth) : Json()},
-          {"specular_rays", o.extended ? Json(o.specular_rays) : Json()},
-          {"loaded_from", loaded_from}};
+  return {
+      {"estimator", known(o.estimator)},
+      {"estimator_requested", o.estimator_requested.empty() ? Json() : Json(o.estimator_requested)},
+      {"samples", known(o.samples)},
+      {"rays_per_patch", known(o.rays)},  // "rays" is the traced count in reports
+      {"seed", known(o.seed)},
+      {"threshold", known(o.threshold)},
+      {"hemicube_resolution", known(o.hemicube_resolution)},
+      {"tol", o.estimator == "analytic" ? Json(o.tol) : Json()},
+      {"reciprocity", known(o.reciprocity)},
+      {"symmetrize", known(o.reciprocity == "average")},
+      {"extended", known(o.extended)},  // specular paths included (specular.hpp)
+      {"specular_depth", o.extended ? Json(o.specular_depth) : Json()},
+      {"specular_rays", o.extended ? Json(o.specular_rays) : Json()},
+      {"loaded_from", loaded_from}};
 }
 
 Json reciprocity_json(const FormFactors& ff) {

@@ -1,24 +1,22 @@
-#include "apps/medium_stage.hpp"
+#include "pipeline/medium_stage.hpp"
 
 #include <limits>
 #include <sstream>
 
-#include "apps/problem.hpp"
-#include "apps/solve_args.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
 #include "core/timer.hpp"
 #include "geometry/bvh.hpp"
 #include "io/medium_file.hpp"
+#include "pipeline/problem.hpp"
+#include "pipeline/solve_stage.hpp"
 
 namespace lambert {
 namespace {
 
 bool given(const MediumArgs& args, const std::string& option) {
-  if (args.command == nullptr) return false;
-  const CLI::Option* o = args.command->get_option_no_throw(option);
-  return o != nullptr && o->count() > 0;
+  return args.given && args.given(option);
 }
 
 Eigen::Vector3d rgb_or_zero(const std::vector<double>& v) {
@@ -38,48 +36,6 @@ std::string first_medium_option_given(const MediumArgs& args) {
   for (const std::string& o : medium_option_names())
     if (given(args, o)) return o;
   return "";
-}
-
-void add_medium_options(CLI::App* cmd, MediumArgs& args) {
-  args.command = cmd;
-  const CLI::Validator non_negative = finite_number(0.0, std::numeric_limits<double>::infinity());
-  cmd->add_option("--medium-box", args.box,
-                  "Participating medium: homogeneous box X0,Y0,Z0,X1,Y1,Z1 (scene units)")
-      ->delimiter(',')
-      ->expected(6)
-      ->check(any_finite_number());
-  cmd->add_option("--sigma-a", args.sigma_a, "Medium absorption R,G,B (1/scene unit)")
-      ->delimiter(',')
-      ->expected(3)
-      ->check(non_negative);
-  cmd->add_option("--sigma-s", args.sigma_s,
-                  "Medium scattering R,G,B (1/scene unit, isotropic; sigma-a + sigma-s grey)")
-      ->delimiter(',')
-      ->expected(3)
-      ->check(non_negative);
-  cmd->add_option("--medium-emission", args.emission,
-                  "Medium emitted power per volume R,G,B (W/scene unit^3)")
-      ->delimiter(',')
-      ->expected(3)
-      ->check(non_negative);
-  cmd->add_option(
-         "--medium-grid", args.grid,
-         "Heterogeneous medium from a grid file (docs/media.md: bounds, resolution, voxels)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--voxels", args.voxels,
-                  "Medium zones along the box's longest axis (others in proportion)")
-      ->check(CLI::Range(1, 256))
-      ->capture_default_str();
-  cmd->add_option("--voxel-size", args.voxel_size,
-                  "Medium zone edge (scene units) instead of --voxels")
-      ->check(finite_number(0.0, std::numeric_limits<double>::infinity(), true));
-  cmd->add_option("--medium-rays", args.rays, "Medium: rays per patch and per zone")
-      ->check(CLI::Range(1, 1 << 20))
-      ->capture_default_str();
-  cmd->add_option("--transmittance-samples", args.transmittance_samples,
-                  "Medium: point pairs per patch pair for the surface-to-surface transmittance")
-      ->check(CLI::Range(1, 1 << 16))
-      ->capture_default_str();
 }
 
 std::shared_ptr<const Medium> make_medium(const MediumArgs& args) {

@@ -1,19 +1,18 @@
 #pragma once
-// Participating media in a run (README "Participating media"): the CLI options, the medium
-// they describe, and the extended solve over patches and zones (geometry/formfactors/media.hpp).
+// Participating media in a run (docs/media.md): the medium options, the medium they describe,
+// and the extended solve over patches and zones (geometry/formfactors/media.hpp).
 
-#include <CLI/CLI.hpp>
 #include <Eigen/Core>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "apps/common.hpp"
-#include "apps/render_stages.hpp"
 #include "geometry/formfactors/media.hpp"
 #include "geometry/medium.hpp"
 #include "geometry/render.hpp"
 #include "io/json.hpp"
+#include "pipeline/job.hpp"
+#include "pipeline/render_stages.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
@@ -30,21 +29,18 @@ struct MediumArgs {
   double voxel_size = 0.0;         ///< > 0: cubes of about this edge instead of --voxels
   int rays = 256;                  ///< rays per patch and per zone
   int transmittance_samples = 16;  ///< point pairs per patch pair
-  /// The subcommand (set by add_medium_options), asked after parsing what was given.
-  const CLI::App* command = nullptr;
+  /// Which options the front end was given (the CLI sets it; empty = none).
+  OptionGiven given;
   /// True when a medium was asked for (--medium-box or --medium-grid).
   bool active() const { return !box.empty() || !grid.empty(); }
 };
 
 /// The options "--medium-box", ... in the order add_medium_options adds them (the matrix
-/// method's row in apps/method.cpp lists them: the hierarchical method refuses them).
+/// method's row in pipeline/method.cpp lists them: the hierarchical method refuses them).
 const std::vector<std::string>& medium_option_names();
 
 /// The first of medium_option_names() given on the command line, or "" for none.
 std::string first_medium_option_given(const MediumArgs& args);
-
-/// Adds the medium options to a subcommand.
-void add_medium_options(CLI::App* cmd, MediumArgs& args);
 
 /// The medium the options describe (null when none), validated. Throws UsageError for
 /// coefficients without --medium-box, --medium-box with --medium-grid, --voxels or

@@ -8,15 +8,14 @@
 // Each registry row names the options only it reads; an option of another method given on
 // the command line is a usage error naming the option and the method.
 
-#include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "apps/common.hpp"
 #include "core/error.hpp"
 #include "geometry/hierarchical/hierarchical.hpp"
+#include "pipeline/job.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
@@ -54,16 +53,11 @@ struct HierarchicalArgs {
 struct MethodArgs {
   std::string name = "matrix";  ///< --method
   HierarchicalArgs hierarchical;
-  /// The subcommand these options belong to (set by add_method_options; it outlives the
-  /// run), asked after parsing which options were given.
-  const CLI::App* command = nullptr;
+  /// Which options the front end was given (the CLI sets it; empty = none).
+  OptionGiven given;
 };
 
-/// Adds --method, --epsilon (a comma-separated list when `epsilon_list`), --min-area and
-/// --link-rays to a subcommand.
-void add_method_options(CLI::App* cmd, MethodArgs& args, bool epsilon_list = false);
-
-/// True when the option was given on the command line of `args.command`.
+/// True when the option was given (`args.given`).
 bool option_given(const MethodArgs& args, const std::string& option);
 
 /// Refuses (UsageError) an option given on the command line that only another method reads.

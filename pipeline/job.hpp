@@ -1,57 +1,63 @@
 #pragma once
-// Options shared by subcommands and the load-and-mesh step they all start with.
+// A job's settings that every command shares (the scene and how to mesh it; threads, seed,
+// verbosity, memory limit) and the load-and-mesh step they all start with, with the checks
+// of files and memory made before any work. No CLI here: apps/options.hpp registers them.
 
-#include <CLI/CLI.hpp>
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "apps/option_scope.hpp"
 #include "geometry/bvh.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/scene.hpp"
 #include "io/obj_loader.hpp"
+#include "pipeline/option_scope.hpp"
 
 namespace lambert {
 
 struct Medium;
 
+/// Reads a whole string as a finite number (false for NaN, inf and trailing text).
+bool parse_finite_number(const std::string& text, double& x);
+
+/// Reads "R,G,B": three finite numbers >= 0, and <= 1 for a reflectance (`unit`). Returns the
+/// reason it is not one, empty on success.
+std::string parse_rgb(const std::string& text, bool unit, Eigen::Vector3d& out);
+
+/// Reads --emit NAME_OR_GLOB=R,G,B (the last '=' separates: names may hold one). Returns the
+/// reason it is not one, empty on success.
+std::string parse_emit(const std::string& text, EmitRule& rule);
+
 /// Scene file, how to load it and meshing target.
 struct SceneArgs {
-  std::string scene;                 ///< OBJ path; empty = built-in Cornell box
-  LoadOptions load;  ///< --strict, --default-reflectance, --max-reflectance, --vertex-colors-as-reflectance
+  std::string scene;  ///< OBJ path; empty = built-in Cornell box
+  LoadOptions
+      load;  ///< --strict, --default-reflectance, --max-reflectance, --vertex-colors-as-reflectance
   bool default_reflectance_given = false;  ///< --default-reflectance was on the command line
-  std::vector<std::string> emit;     ///< --emit NAME_OR_GLOB=R,G,B, parsed by load_scene
-  double max_edge = 0.0;             ///< --max-edge
-  std::int64_t patches = 0;          ///< --patches
-  std::int64_t default_patches = 0;  ///< used when neither is given
-  bool discontinuity = false;        ///< --discontinuity
-  int discontinuity_sources = 0;     ///< --discontinuity-sources
+  std::vector<std::string> emit;           ///< --emit NAME_OR_GLOB=R,G,B, parsed by load_scene
+  double max_edge = 0.0;                   ///< --max-edge
+  std::int64_t patches = 0;                ///< --patches
+  std::int64_t default_patches = 0;        ///< used when neither is given
+  bool discontinuity = false;              ///< --discontinuity
+  int discontinuity_sources = 0;           ///< --discontinuity-sources
 };
 
 /// Threads, seed and verbosity.
 struct RunArgs {
-  int threads = 0;          ///< -j; 0 = all cores
-  std::uint64_t seed = 1;   ///< --seed
-  bool quiet = false;       ///< -q
-  bool verbose = false;     ///< -v
-  std::string max_memory;   ///< --max-memory SIZE; empty = $LAMBERT_MAX_MEMORY or MemAvailable
-  /// The subcommand these options belong to (set by add_run_options; it outlives the run),
-  /// asked after parsing which options were given (apps/option_scope.hpp).
-  const CLI::App* command = nullptr;
+  int threads = 0;         ///< -j; 0 = all cores
+  std::uint64_t seed = 1;  ///< --seed
+  bool quiet = false;      ///< -q
+  bool verbose = false;    ///< -v
+  std::string max_memory;  ///< --max-memory SIZE; empty = $LAMBERT_MAX_MEMORY or MemAvailable
+  /// Which options the front end was given (the CLI sets it; empty = none).
+  OptionGiven given;
 };
 
-/// Adds the positional SCENE, the loading options (--strict, --default-reflectance,
-/// --max-reflectance, --vertex-colors-as-reflectance, --emit), --max-edge / --patches and
-/// --discontinuity / --discontinuity-sources to a subcommand.
-void add_scene_options(CLI::App* cmd, SceneArgs& args);
-/// Adds -j/--threads, --seed, -q/--quiet, -v/--verbose and --max-memory to a subcommand.
-void add_run_options(CLI::App* cmd, RunArgs& args);
-/// Refuses (UsageError) an option given on the command line of `args.command` that the
-/// choices in `selection` do not read (apps/option_scope.hpp).
+/// Refuses (UsageError) an option given (`args.given`) that the choices in `selection` do not
+/// read (pipeline/option_scope.hpp).
 void check_options_read(const RunArgs& args, const Selection& selection);
 /// Applies --quiet / --verbose to the logger.
 void apply_run_options(const RunArgs& args);
@@ -60,7 +66,7 @@ void apply_run_options(const RunArgs& args);
 struct LoadedScene {
   Scene scene;
   PatchMesh mesh;
-  double max_edge = 0.0;  ///< the --max-edge actually used (0 = one element per face)
+  double max_edge = 0.0;       ///< the --max-edge actually used (0 = one element per face)
   bool discontinuity = false;  ///< meshed with --discontinuity (edges on the shadow lines)
   /// The mesh's BVH, built on first use by scene_bvh and shared by every stage of a run.
   mutable std::shared_ptr<const Bvh> bvh;
@@ -69,25 +75,9 @@ struct LoadedScene {
 /// The BVH of the scene's mesh (built once, with `threads` Embree threads; 0 = all cores).
 const Bvh& scene_bvh(const LoadedScene& scene, int threads);
 
-/// CLI11 check for an output file option: its directory must exist (checked before any
-/// work, so a long computation never ends in a failed write).
-CLI::Validator output_file_check();
-
-/// CLI11 check for an output prefix option (see output_prefix): a name ending in '/' is a
-/// directory to create; otherwise the prefix's directory must exist.
-CLI::Validator output_prefix_check();
-
 /// Where a command writing several files puts them: for -o DIR (an existing directory, or
 /// a name ending in '/', created if needed) the prefix DIR/<name>; otherwise -o is the prefix.
 std::string output_prefix(const std::string& output, const std::string& name);
-
-/// CLI11 check for a floating-point option: a finite number (NaN and inf refused) in
-/// [lo, hi], open at lo when `open_low` and at hi when `open_high`; hi = infinity means no
-/// upper bound. The message states the range.
-CLI::Validator finite_number(double lo, double hi, bool open_low = false, bool open_high = false);
-
-/// CLI11 check for a floating-point value that may be any finite number (NaN, inf refused).
-CLI::Validator any_finite_number();
 
 /// A file a command reads or writes, with the option that names it (for messages).
 struct NamedFile {
@@ -98,10 +88,10 @@ struct NamedFile {
 /// What a command will read, write and hold in memory, checked by load_scene after loading
 /// the scene and before meshing it (so before any work that takes time).
 struct JobPlan {
-  std::vector<NamedFile> inputs;   ///< besides the scene's own files (Scene::files)
-  std::vector<NamedFile> outputs;  ///< every file the command may write
+  std::vector<NamedFile> inputs;        ///< besides the scene's own files (Scene::files)
+  std::vector<NamedFile> outputs;       ///< every file the command may write
   std::optional<FormFactorOptions> ff;  ///< F that will be computed here (none: loaded or unused)
-  std::string max_memory;          ///< RunArgs::max_memory
+  std::string max_memory;               ///< RunArgs::max_memory
   bool direct = false;  ///< the job solves with `direct`: its factorisation is counted (for a
                         ///< computed F, at the all-pairs bound: a dense LU of N patches)
   const Medium* medium = nullptr;  ///< a participating medium whose zones join F here

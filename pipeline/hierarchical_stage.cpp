@@ -1,8 +1,4 @@
-#include "apps/hierarchical_stage.hpp"
-
-#include "apps/problem.hpp"
-
-#include "geometry/formfactors/analysis.hpp"
+#include "pipeline/hierarchical_stage.hpp"
 
 #include <sstream>
 #include <utility>
@@ -11,6 +7,8 @@
 #include "core/memory.hpp"
 #include "core/progress.hpp"
 #include "core/timer.hpp"
+#include "geometry/formfactors/analysis.hpp"
+#include "pipeline/problem.hpp"
 
 namespace lambert {
 namespace {
