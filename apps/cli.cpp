@@ -37,6 +37,8 @@ int run_cli(int argc, const char* const* argv) {
   commands.emplace_back(add_heat_command(app, heat), [&] { return run_heat(heat); });
   AccuracyOptions accuracy;
   commands.emplace_back(add_accuracy_command(app, accuracy), [&] { return run_accuracy(accuracy); });
+  OptionsOptions options;
+  commands.emplace_back(add_options_command(app, options), [&] { return run_options(options); });
 
   try {
     app.parse(argc, argv);

@@ -3,7 +3,7 @@
 
 namespace lambert {
 
-/// Exit codes of the CLI (documented in the README).
+/// Exit codes of the CLI (docs/commands.md, "Exit codes").
 enum ExitCode : int {
   kExitOk = 0,           ///< success (and --help / --version)
   kExitFailure = 1,      ///< runtime or input failure

@@ -90,6 +90,17 @@ CLI::App* add_solvers_command(CLI::App& app, SolversOptions& opts);
 /// Lists the solver names and descriptions.
 int run_solvers(const SolversOptions& opts);
 
+/// Options of `lambert options`.
+struct OptionsOptions {
+  bool markdown = false;          ///< --markdown: the reference table of docs/options.md
+  const CLI::App* app = nullptr;  ///< the whole CLI, whose commands it lists
+};
+/// Registers `options` on the app.
+CLI::App* add_options_command(CLI::App& app, OptionsOptions& opts);
+/// Prints every option of every command: commands, accepted values, default, which choice
+/// reads it, description (pipeline/option_specs.hpp and option_scope.hpp, and the CLI).
+int run_options(const OptionsOptions& opts);
+
 /// Options of `lambert render`.
 struct RenderOptions {
   SceneArgs scene;

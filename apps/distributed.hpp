@@ -1,5 +1,5 @@
 #pragma once
-// `--distributed` (README "Running on a cluster"): formfactors and solve over MPI ranks, the
+// `--distributed` (docs/cluster.md): formfactors and solve over MPI ranks, the
 // solve in PETSc. Declared in every build; defined by apps/distributed.cpp when built with
 // LAMBERT_MPI, else by apps/distributed_stub.cpp, which refuses. No MPI type appears here.
 

@@ -8,14 +8,27 @@
 
 #include "core/error.hpp"
 #include "core/memory.hpp"
+#include "pipeline/option_specs.hpp"
 
 namespace lambert {
 namespace {
 
-std::string shortest(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
+// The CLI11 check of a declared option (pipeline/option_specs.hpp): its range or choices,
+// and what it accepts as the value's name in --help.
+CLI::Validator declared_check(const OptionSpec& spec) {
+  return CLI::Validator([spec](std::string& text) { return option_value_error(spec, text); },
+                        accepted_text(spec));
+}
+
+// Registers a declared option under `names` (its first name is the table's), bound to
+// `field`, with the table's description, check and default.
+template <class T>
+CLI::Option* add_declared(CLI::App* cmd, const std::string& names, T& field) {
+  const std::string first = names.substr(0, names.find(','));
+  const OptionSpec& spec = option_spec(first);
+  return cmd->add_option(names, field, spec.doc)
+      ->check(declared_check(spec))
+      ->capture_default_str();
 }
 
 }  // namespace
@@ -29,9 +42,9 @@ OptionGiven option_given_on(const CLI::App* cmd) {
 
 CLI::Validator finite_number(double lo, double hi, bool open_low, bool open_high) {
   const std::string range = std::isinf(hi)
-                                ? (open_low ? "> " : ">= ") + shortest(lo)
-                                : "in " + std::string(open_low ? "(" : "[") + shortest(lo) + ", " +
-                                      shortest(hi) + (open_high ? ")" : "]");
+                                ? (open_low ? "> " : ">= ") + number_text(lo)
+                                : "in " + std::string(open_low ? "(" : "[") + number_text(lo) +
+                                      ", " + number_text(hi) + (open_high ? ")" : "]");
   return CLI::Validator(
       [=](std::string& text) -> std::string {
         double x = 0;
@@ -172,92 +185,45 @@ void add_method_options(CLI::App* cmd, MethodArgs& args, bool epsilon_list) {
 }
 
 void add_solve_options(CLI::App* cmd, SolveOptions& o, bool with_solver) {
-  if (with_solver)
-    cmd->add_option("--solver", o.solver, "Solver (see `lambert solvers`)")
-        ->check(CLI::IsMember(solver_names()))
-        ->capture_default_str();
-  const HierarchicalOptions hierarchical;
-  std::ostringstream tol_help, iter_help;
-  tol_help << "Stop when ||E - K B||_2 / ||E||_2 <= tol (--method hierarchical: when the largest "
-              "change of a leaf's B over the largest B <= tol; its default "
-           << hierarchical.tol << ")";
-  iter_help << "Iteration limit per channel (--method hierarchical: sweeps per refinement pass; "
-               "its default "
-            << hierarchical.max_iterations << ")";
-  cmd->add_option("--tol", o.tol, tol_help.str())
-      ->check(finite_number(1e-16, 0.5))
-      ->capture_default_str();
-  cmd->add_option("--max-iter", o.max_iterations, iter_help.str())
-      ->check(CLI::Range(1, 100000000))
-      ->capture_default_str();
-  cmd->add_option("--omega", o.omega, "SOR relaxation factor, in (0, 2)")
-      ->check(finite_number(1e-3, 1.999))
-      ->capture_default_str();
-  cmd->add_option("--preconditioner", o.preconditioner, "bicgstab/gmres/cg preconditioner")
-      ->check(CLI::IsMember({"none", "diagonal", "ilut"}))
-      ->capture_default_str();
-  cmd->add_option("--restart", o.restart, "GMRES restart length")
-      ->check(CLI::Range(1, 10000))
-      ->capture_default_str();
+  if (with_solver) add_declared(cmd, "--solver", o.solver);
+  add_declared(cmd, "--tol", o.tol);
+  add_declared(cmd, "--max-iter", o.max_iterations);
+  add_declared(cmd, "--omega", o.omega);
+  add_declared(cmd, "--preconditioner", o.preconditioner);
+  add_declared(cmd, "--restart", o.restart);
   cmd->add_flag("--ambient", o.ambient, "southwell: add the ambient term (display estimate)");
 }
 
 void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load, bool tol_alias) {
   std::vector<CLI::Option*> compute_only;
-  compute_only.push_back(cmd->add_option("--estimator", args.estimator,
-                                         "Form-factor estimator (auto: hybrid below " +
-                                             std::to_string(kAutoGatherPatches) +
-                                             " patches, gather from there)")
-                             ->check(CLI::IsMember(form_factor_estimator_choices()))
-                             ->capture_default_str());
+  compute_only.push_back(add_declared(cmd, "--estimator", args.estimator));
   compute_only.push_back(
-      cmd->add_option("--samples", args.samples,
-                      "Sample pairs (rays) per patch pair (pair estimators mc, hybrid)")
-          ->check(CLI::Range(1, 1 << 20))
-          ->each([&args](const std::string&) { args.samples_given = true; })
-          ->capture_default_str());
-  compute_only.push_back(cmd->add_option("--rays", args.rays, "Rays per patch (estimator gather)")
-                             ->check(CLI::Range(1, 1 << 24))
-                             ->each([&args](const std::string&) { args.rays_given = true; })
-                             ->capture_default_str());
-  compute_only.push_back(
-      cmd->add_option(tol_alias ? "--ff-tol,--tol" : "--ff-tol", args.tol,
-                      "Absolute error target of every form factor (estimator analytic)")
-          ->check(finite_number(1e-15, 1.0))
-          ->each([&args](const std::string&) { args.tol_given = true; })
-          ->capture_default_str());
-  compute_only.push_back(
-      cmd->add_option("--threshold", args.threshold, "Drop form factors below this value")
-          ->check(finite_number(0.0, 1.0)));
-  compute_only.push_back(cmd->add_option("--hemicube-res", args.hemicube_resolution,
-                                         "Hemicube top-face resolution (estimator hemicube)")
-                             ->check(CLI::Range(4, 8192))
-                             ->capture_default_str());
+      add_declared(cmd, "--samples", args.samples)->each([&args](const std::string&) {
+        args.samples_given = true;
+      }));
+  compute_only.push_back(add_declared(cmd, "--rays", args.rays)->each([&args](const std::string&) {
+    args.rays_given = true;
+  }));
+  compute_only.push_back(add_declared(cmd, tol_alias ? "--ff-tol,--tol" : "--ff-tol", args.tol)
+                             ->each([&args](const std::string&) { args.tol_given = true; }));
+  compute_only.push_back(add_declared(cmd, "--threshold", args.threshold));
+  compute_only.push_back(add_declared(cmd, "--hemicube-res", args.hemicube_resolution));
   CLI::Option* reciprocity =
-      cmd->add_option("--reciprocity", args.reciprocity,
-                      "Replace A_i F_ij and A_j F_ji by their mean: none, average, or auto "
-                      "(average for gather, none for the others)")
-          ->check(CLI::IsMember({"auto", "none", "average"}))
-          ->each([&args](const std::string&) { args.reciprocity_given = true; })
-          ->capture_default_str();
+      add_declared(cmd, "--reciprocity", args.reciprocity)->each([&args](const std::string&) {
+        args.reciprocity_given = true;
+      });
   compute_only.push_back(reciprocity);
   compute_only.push_back(
       cmd->add_flag("--symmetrize", args.symmetrize, "Alias of --reciprocity average")
           ->each([&args](const std::string&) { args.reciprocity_given = true; })
           ->excludes(reciprocity));
-  cmd->add_option("--specular-depth", args.specular_depth,
-                  "Specular bounces a ray follows through mirrors and glass (extended form "
-                  "factors, ray-traced shading); 0 = specular surfaces only receive and block")
-      ->check(CLI::Range(0, 64))
-      ->each([&args](const std::string&) { args.specular_given = true; })
-      ->capture_default_str();
+  add_declared(cmd, "--specular-depth", args.specular_depth)->each([&args](const std::string&) {
+    args.specular_given = true;
+  });
   compute_only.push_back(
-      cmd->add_option("--specular-rays", args.specular_rays,
-                      "Rays per patch that trace the specular paths of the extended form "
-                      "factors (scenes with mirrors or glass)")
-          ->check(CLI::Range(1, 1 << 24))
-          ->each([&args](const std::string&) { args.specular_given = true; })
-          ->capture_default_str());
+      add_declared(cmd, "--specular-rays", args.specular_rays)->each([&args](const std::string&) {
+        args.specular_given = true;
+      }));
   if (!with_load) return;
   CLI::Option* ff = cmd->add_option(
       "--ff", args.ff_file,

@@ -26,7 +26,7 @@
 #include "geometry/analytic.hpp"
 #include "geometry/formfactors/analytic.hpp"
 #include "geometry/formfactors/formfactors.hpp"
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 #include "io/obj_loader.hpp"
 
 using namespace lambert;

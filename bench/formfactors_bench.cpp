@@ -24,9 +24,9 @@
 #include "core/parallel.hpp"
 #include "core/sampling.hpp"
 #include "core/timer.hpp"
-#include "geometry/bvh.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/formfactors/kernels.hpp"
+#include "geometry/visibility/bvh.hpp"
 #include "io/obj_loader.hpp"
 
 using namespace lambert;

@@ -32,11 +32,11 @@
 #include <vector>
 
 #include "core/timer.hpp"
-#include "geometry/adapt.hpp"
 #include "geometry/analytic.hpp"
 #include "geometry/formfactors/formfactors.hpp"
-#include "geometry/shadow.hpp"
-#include "geometry/vertex_field.hpp"
+#include "geometry/mesh/adapt.hpp"
+#include "geometry/render/vertex_field.hpp"
+#include "geometry/visibility/shadow.hpp"
 #include "io/obj_loader.hpp"
 #include "io/plot.hpp"
 #include "pipeline/adapt_stage.hpp"

@@ -10,9 +10,9 @@
 #include "core/parallel.hpp"
 #include "core/sampling.hpp"
 #include "core/timer.hpp"
-#include "geometry/bvh.hpp"
 #include "geometry/formfactors/kernels.hpp"
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
+#include "geometry/visibility/bvh.hpp"
 
 struct BenchRay {
   Eigen::Vector3f org, dir;

@@ -24,11 +24,11 @@
 #include <vector>
 
 #include "core/timer.hpp"
-#include "geometry/bvh.hpp"
-#include "geometry/direct_light.hpp"
 #include "geometry/formfactors/formfactors.hpp"
-#include "geometry/render.hpp"
-#include "geometry/vertex_field.hpp"
+#include "geometry/render/render.hpp"
+#include "geometry/render/vertex_field.hpp"
+#include "geometry/visibility/bvh.hpp"
+#include "geometry/visibility/direct_light.hpp"
 #include "io/obj_loader.hpp"
 #include "io/tonemap.hpp"
 #include "pipeline/problem.hpp"

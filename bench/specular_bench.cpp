@@ -20,10 +20,10 @@
 #include "bench/raw_rays.hpp"
 #include "core/timer.hpp"
 #include "geometry/analytic.hpp"
-#include "geometry/bvh.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/formfactors/specular.hpp"
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
+#include "geometry/visibility/bvh.hpp"
 #include "io/obj_loader.hpp"
 
 using namespace lambert;

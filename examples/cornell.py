@@ -29,9 +29,11 @@ mesh = scene.mesh(patches=args.patches)
 print(f"{scene.source}: {len(scene.surfaces)} surfaces, {len(mesh)} patches, "
       f"total area {mesh.areas.sum():.4g}")
 
-# 2. Form factors: a scipy.sparse.csr_matrix (and the per-entry standard errors).
+# 2. Form factors: F (a scipy.sparse.csr_matrix), the per-entry standard errors and the
+#    settings that made them.
 t0 = time.perf_counter()
-F, S = lambert.form_factors(mesh, estimator="hybrid", samples=16, seed=1, stderr=True)
+ff = lambert.form_factors(mesh, estimator="hybrid", samples=16, seed=1, stderr=True)
+F, S = ff.matrix, ff.stderr
 print(f"F: {F.nnz} entries in {time.perf_counter() - t0:.2f} s, row sums "
       f"{F.sum(axis=1).min():.4f}..{F.sum(axis=1).max():.4f}, median standard error "
       f"{np.median(S.data):.2e}")

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "geometry/formfactors/kernels.hpp"
-#include "geometry/shadow.hpp"
+#include "geometry/visibility/shadow.hpp"
 
 namespace lambert {
 namespace {

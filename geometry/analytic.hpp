@@ -8,9 +8,9 @@
 #include <utility>
 #include <vector>
 
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
+#include "geometry/render/vertex_field.hpp"
 #include "geometry/scene.hpp"
-#include "geometry/vertex_field.hpp"
 
 namespace lambert {
 

@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "geometry/camera.hpp"
+#include "geometry/render/camera.hpp"
 
 namespace lambert {
 

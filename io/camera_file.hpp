@@ -5,7 +5,7 @@
 #include <istream>
 #include <string>
 
-#include "geometry/camera.hpp"
+#include "geometry/render/camera.hpp"
 
 namespace lambert {
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string>
 
-#include "geometry/render.hpp"
+#include "geometry/render/render.hpp"
 
 namespace lambert {
 

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "geometry/render.hpp"
-#include "geometry/vertex_field.hpp"
+#include "geometry/render/render.hpp"
+#include "geometry/render/vertex_field.hpp"
 
 namespace lambert {
 

@@ -53,8 +53,8 @@ void write_ff_binary(const std::string& path, const FormFactors& ff, const FormF
 /// the same meshed scene: throws SceneError naming the file if the hash or size differ or
 /// an entry is impossible (negative, non-finite, diagonal, repeated, a row sum above 1 by
 /// more than the stored error), IoError if unreadable, truncated or corrupt. Every message
-/// is one line naming the file and the first offending entry or line (README: "Form-factor
-/// files"). Memory is bounded by the file's size before anything is allocated.
+/// is one line naming the file and the first offending entry or line (docs/file-formats.md:
+/// "Form-factor files"). Memory is bounded by the file's size before anything is allocated.
 FormFactors read_form_factors(const std::string& path, std::uint64_t expected_mesh_hash,
                               std::int32_t expected_n, FormFactorFileInfo* info = nullptr);
 

@@ -1,5 +1,5 @@
 #pragma once
-// The heterogeneous medium format read by --medium-grid (README "Participating media"):
+// The heterogeneous medium format read by --medium-grid (docs/media.md):
 //
 //   # comments and blank lines anywhere
 //   bounds X0 Y0 Z0 X1 Y1 Z1
@@ -7,12 +7,12 @@
 //   then NX*NY*NZ voxel lines, x fastest, then y, then z:
 //   SA_R SA_G SA_B SS_R SS_G SS_B E_R E_G E_B
 //
-// σa, σs in 1/scene unit, e in W per scene unit³ (geometry/medium.hpp); σa + σs must be grey.
+// σa, σs in 1/scene unit, e in W per scene unit³ (geometry/media/medium.hpp); σa + σs must be grey.
 
 #include <istream>
 #include <string>
 
-#include "geometry/medium.hpp"
+#include "geometry/media/medium.hpp"
 
 namespace lambert {
 

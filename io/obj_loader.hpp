@@ -67,7 +67,7 @@ using MtlOpener = std::function<MtlFile(const std::string& library)>;
 /// `<name>.camera` next to the OBJ, if present, gives the default camera. Material
 /// libraries are looked up next to the OBJ. Throws IoError (missing/unreadable file),
 /// SceneError (invalid content, "file:line: what") or UsageError (an --emit rule matching
-/// nothing). README's "Scene files" says what is accepted, defaulted, skipped and refused.
+/// nothing). docs/scenes.md says what is accepted, defaulted, skipped and refused.
 Scene load_obj(const std::string& path, LoadReport* report = nullptr,
                const LoadOptions& options = {});
 

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "geometry/mesh.hpp"
-#include "geometry/vertex_field.hpp"
+#include "geometry/mesh/mesh.hpp"
+#include "geometry/render/vertex_field.hpp"
 
 namespace lambert {
 

@@ -6,7 +6,7 @@
 #include <istream>
 #include <string>
 
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 
 namespace lambert {
 

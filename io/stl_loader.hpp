@@ -1,6 +1,6 @@
 #pragma once
 // STL (stereolithography) scene loading: ASCII and binary, told apart by content, read by
-// lambert's own strict reader (README "STL files" says why no Debian library is used).
+// lambert's own strict reader (docs/scenes.md says why no Debian library is used).
 
 #include <string>
 

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "geometry/render.hpp"
+#include "geometry/render/render.hpp"
 
 namespace lambert {
 

@@ -7,7 +7,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/timer.hpp"
-#include "geometry/adapt.hpp"
+#include "geometry/mesh/adapt.hpp"
 #include "pipeline/problem.hpp"
 
 namespace lambert {

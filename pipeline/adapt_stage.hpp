@@ -1,7 +1,7 @@
 #pragma once
 // Adaptive meshing for `solve` and `run` (--method matrix): solve, estimate each patch's
 // error, bisect the worst patches conformingly, update only the form factors of the
-// changed patches, re-solve from the previous solution, repeat (geometry/adapt.hpp).
+// changed patches, re-solve from the previous solution, repeat (geometry/mesh/adapt.hpp).
 
 #include <cstdint>
 #include <vector>

@@ -6,7 +6,7 @@
 #include "core/log.hpp"
 #include "core/progress.hpp"
 #include "geometry/formfactors/analysis.hpp"
-#include "geometry/medium.hpp"
+#include "geometry/media/medium.hpp"
 #include "io/ff_file.hpp"
 
 namespace lambert {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "geometry/formfactors/formfactors.hpp"
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 #include "io/heat_surfaces.hpp"
 #include "solvers/thermal.hpp"
 

@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "geometry/bvh.hpp"
 #include "geometry/formfactors/formfactors.hpp"
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 #include "geometry/scene.hpp"
+#include "geometry/visibility/bvh.hpp"
 #include "io/obj_loader.hpp"
 #include "pipeline/option_scope.hpp"
 

@@ -7,7 +7,7 @@
 #include "core/log.hpp"
 #include "core/progress.hpp"
 #include "core/timer.hpp"
-#include "geometry/bvh.hpp"
+#include "geometry/visibility/bvh.hpp"
 #include "io/medium_file.hpp"
 #include "pipeline/problem.hpp"
 #include "pipeline/solve_stage.hpp"

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "geometry/formfactors/media.hpp"
-#include "geometry/medium.hpp"
-#include "geometry/render.hpp"
+#include "geometry/media/medium.hpp"
+#include "geometry/render/render.hpp"
 #include "io/json.hpp"
 #include "pipeline/job.hpp"
 #include "pipeline/render_stages.hpp"

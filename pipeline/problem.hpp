@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "geometry/formfactors/formfactors.hpp"
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
@@ -29,7 +29,7 @@ RadiosityProblem make_problem(const PatchMesh& mesh, const FormFactors& ff);
 
 /// The indirect irradiance of every patch, I_i = Σ_j F_ij (B_j - E_j) (N x 3, W/m²): the
 /// light arriving after at least one reflection, for exact_direct_vertex_field
-/// (geometry/vertex_field.hpp). One sparse product, O(nnz).
+/// (geometry/render/vertex_field.hpp). One sparse product, O(nnz).
 Eigen::MatrixX3d indirect_irradiance(const PatchMesh& mesh, const SparseRowMatrix& F,
                                      const Eigen::MatrixX3d& B);
 

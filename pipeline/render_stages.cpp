@@ -9,7 +9,7 @@
 #include "core/log.hpp"
 #include "core/progress.hpp"
 #include "core/timer.hpp"
-#include "geometry/bvh.hpp"
+#include "geometry/visibility/bvh.hpp"
 #include "io/exr.hpp"
 #include "io/ply.hpp"
 #include "io/tonemap.hpp"

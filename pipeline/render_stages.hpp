@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "geometry/formfactors/formfactors.hpp"
-#include "geometry/render.hpp"
-#include "geometry/vertex_field.hpp"
+#include "geometry/render/render.hpp"
+#include "geometry/render/vertex_field.hpp"
 #include "io/json.hpp"
 #include "pipeline/ff_stage.hpp"
 #include "pipeline/job.hpp"
@@ -36,7 +36,7 @@ struct ShadeArgs {
   int antialias = 2;
   std::string exposure = "auto";  ///< "auto" or EV stops
   /// auto (exact-direct on a --discontinuity mesh with F, else conservative), conservative,
-  /// area or exact-direct (geometry/vertex_field.hpp)
+  /// area or exact-direct (geometry/render/vertex_field.hpp)
   std::string vertex_interp = "auto";
 };
 /// The shading the options ask for: --shading, else flat with --flat, raytrace with

@@ -30,11 +30,11 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/parallel.hpp"
-#include "geometry/bvh.hpp"
 #include "geometry/formfactors/formfactors.hpp"
-#include "geometry/mesh.hpp"
-#include "geometry/render.hpp"
-#include "geometry/vertex_field.hpp"
+#include "geometry/mesh/mesh.hpp"
+#include "geometry/render/render.hpp"
+#include "geometry/render/vertex_field.hpp"
+#include "geometry/visibility/bvh.hpp"
 #include "io/array_args.hpp"
 #include "io/exr.hpp"
 #include "io/ff_file.hpp"
@@ -47,6 +47,7 @@
 #include "pipeline/hierarchical_stage.hpp"
 #include "pipeline/job.hpp"
 #include "pipeline/medium_stage.hpp"
+#include "pipeline/option_specs.hpp"
 #include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 
@@ -308,15 +309,32 @@ class Released {
 };
 
 // UsageError for an unknown solver, tol outside (0, 1) or max_iterations < 1.
+// The solver keywords against their declarations (pipeline/option_specs.hpp): the CLI's
+// values and ranges, named as the keyword.
 void check_solver_args(const std::string& solver, double tol, int max_iterations) {
-  const auto names = solver_names();
-  if (std::find(names.begin(), names.end(), solver) == names.end()) {
-    std::string list;
-    for (const auto& s : names) list += (list.empty() ? "" : ", ") + s;
-    throw UsageError("unknown solver \"" + solver + "\" (one of " + list + ")");
+  check_option_choice(option_spec("--solver"), solver, "solver");
+  check_option_value(option_spec("--tol"), tol, "tol");
+  check_option_value(option_spec("--max-iter"), max_iterations, "max_iterations");
+}
+
+// The declarations as Python dicts (lambert.option_specs(): docstrings and references).
+py::list option_spec_list() {
+  py::list out;
+  for (const OptionSpec& spec : option_specs()) {
+    py::dict d;
+    d["name"] = spec.name;
+    d["keyword"] = spec.keyword;
+    d["kind"] = spec.kind == OptionKind::Integer ? "integer"
+                : spec.kind == OptionKind::Real  ? "real"
+                                                 : "choice";
+    d["accepts"] = accepted_text(spec);
+    d["default"] = spec.default_text;
+    d["doc"] = spec.doc;
+    d["choices"] = spec.choices;
+    if (spec.kind != OptionKind::Choice) d["range"] = py::make_tuple(spec.lo, spec.hi);
+    out.append(d);
   }
-  if (!(tol > 0.0 && tol < 1.0)) throw UsageError("tol must be in (0, 1)");
-  if (max_iterations < 1) throw UsageError("max_iterations must be >= 1");
+  return out;
 }
 
 }  // namespace
@@ -362,6 +380,7 @@ PYBIND11_MODULE(_lambert, m) {
     set_log_level(static_cast<LogLevel>(level));
   });
   m.def("estimators", &form_factor_estimator_choices);
+  m.def("option_specs", &option_spec_list);
   m.def("solvers", &solver_names);
   m.def("builtin_cornell_box_path", &builtin_cornell_box_path);
 
@@ -509,9 +528,7 @@ PYBIND11_MODULE(_lambert, m) {
          bool with_stderr) {
         FormFactorOptions o;
         o.estimator = estimator;
-        const auto valid = form_factor_estimator_choices();
-        if (std::find(valid.begin(), valid.end(), estimator) == valid.end())
-          throw UsageError("unknown estimator \"" + estimator + "\"");
+        check_option_choice(option_spec("--estimator"), estimator, "estimator");
         if (estimator != "auto") {
           const std::string used = estimator_count_option(estimator);
           if (samples && used != "samples")
@@ -519,10 +536,16 @@ PYBIND11_MODULE(_lambert, m) {
           if (rays && used != "rays")
             throw UsageError("rays does not apply to estimator " + estimator);
         }
+        if (samples) check_option_value(option_spec("--samples"), *samples, "samples");
+        if (rays) check_option_value(option_spec("--rays"), *rays, "rays");
+        if (tol) check_option_value(option_spec("--ff-tol"), *tol, "tol");
+        check_option_value(option_spec("--threshold"), threshold, "threshold");
+        check_option_choice(option_spec("--reciprocity"), reciprocity, "reciprocity");
+        check_option_value(option_spec("--hemicube-res"), hemicube_resolution,
+                           "hemicube_resolution");
         if (samples) o.samples = *samples;
         if (rays) o.rays = *rays;
         if (tol) o.tol = *tol, o.tol_given = true;
-        if (o.samples < 1 || o.rays < 1) throw UsageError("samples and rays must be >= 1");
         if (threads < 0) throw UsageError("threads must be >= 0 (0 = all cores)");
         o.seed = seed;
         o.threads = threads;
@@ -593,6 +616,9 @@ PYBIND11_MODULE(_lambert, m) {
          double omega, const std::string& preconditioner, int restart, int threads,
          std::optional<ValueArray> initial, const py::dict& medium_options) {
         check_solver_args(solver, tol, max_iterations);
+        check_option_value(option_spec("--omega"), omega, "omega");
+        check_option_choice(option_spec("--preconditioner"), preconditioner, "preconditioner");
+        check_option_value(option_spec("--restart"), restart, "restart");
         const SparseRowMatrix F = csr_from_arrays(h.mesh.size(), indptr, indices, data, "F");
         SolveOptions o;
         o.solver = solver;

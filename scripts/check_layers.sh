@@ -3,7 +3,7 @@
 #   core <- geometry <- io <- pipeline <- apps,  core <- solvers <- pipeline,  pipeline <- python
 #   (the CLI in apps/ and the Python bindings are the two front ends over the pipeline: python/
 #   never includes apps/, nothing includes python/, and CLI11 stays in apps/)
-# and that third-party libraries stay at the edge (Embree in geometry/bvh.cpp, OpenEXR in
+# and that third-party libraries stay at the edge (Embree in geometry/visibility/bvh.cpp, OpenEXR in
 # io/*.cpp only, MPI and PETSc in apps/dist_*.cpp only). Exits 1 listing every violation.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -20,8 +20,8 @@ forbid io "solvers/|pipeline/|apps/" "io sits below the pipeline"
 forbid pipeline "apps/|CLI/" "the pipeline serves every front end: no CLI in it"
 forbid python "apps/|CLI/" "Python is a front end beside the CLI, over the pipeline"
 for m in core geometry solvers io pipeline apps; do forbid $m "python/" "the Python bindings are the top layer"; done
-hits=$(grep -rlE "#include [<\"]embree" core geometry solvers io pipeline apps python | grep -v '^geometry/bvh.cpp$' || true)
-[[ -z "$hits" ]] || { echo "layering: Embree outside geometry/bvh.cpp: $hits"; status=1; }
+hits=$(grep -rlE "#include [<\"]embree" core geometry solvers io pipeline apps python | grep -v '^geometry/visibility/bvh.cpp$' || true)
+[[ -z "$hits" ]] || { echo "layering: Embree outside geometry/visibility/bvh.cpp: $hits"; status=1; }
 hits=$(grep -rlE "#include [<\"](OpenEXR/|Imf)" core geometry solvers io pipeline apps python | grep -vE '^io/.*\.cpp$' || true)
 [[ -z "$hits" ]] || { echo "layering: OpenEXR outside io/*.cpp: $hits"; status=1; }
 hits=$(grep -rlE "#include [<\"](mpi\.h|petsc)" core geometry solvers io pipeline apps tests bench |

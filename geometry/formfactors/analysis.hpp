@@ -65,10 +65,10 @@ struct ClosedLossless {
 std::vector<ClosedLossless> find_closed_lossless(const PatchMesh& mesh, const FormFactors& ff);
 
 /// Row leak below which F cannot tell a closed set from a leaking one, without stderr: the
-/// hybrid estimator's quadrature bound (README: 1e-6 of the unoccluded G per entry, so at
-/// most 1e-6 of a row sum <= 1); rounding of the row sums (~N 1e-16) is far below it.
+/// hybrid estimator's quadrature bound (docs/form-factors.md: 1e-6 of the unoccluded G per entry,
+/// so at most 1e-6 of a row sum <= 1); rounding of the row sums (~N 1e-16) is far below it.
 constexpr double kClosedRowTolerance = 1e-6;
-/// Row standard errors added to it when F has them: README's stderr covers an entry's
+/// Row standard errors added to it when F has them: docs/form-factors.md's stderr covers an entry's
 /// error within +-2 stderr at 97 %; a set of many rows must have none misjudged, and a
 /// normal tail beyond 5 sigma (3e-7 per row) keeps that probable up to ~1e5 rows.
 constexpr double kClosedSigmas = 5.0;

@@ -11,7 +11,7 @@
 
 #include "geometry/formfactors/kernels.hpp"
 #include "geometry/formfactors/pairwise.hpp"
-#include "geometry/shadow.hpp"
+#include "geometry/visibility/shadow.hpp"
 
 namespace lambert::ff {
 namespace {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/sparse.hpp"
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 
 namespace lambert {
 
@@ -37,7 +37,7 @@ struct FormFactorOptions {
   /// estimate, reported as the standard error).
   double tol = 1e-6;
   /// The user asked for `tol` (--ff-tol): "auto" then picks analytic, the one estimator that
-  /// honours an error target (README "Choosing an estimator").
+  /// honours an error target (docs/form-factors.md, "Choosing an estimator").
   bool tol_given = false;
   /// "average": replace A_i F_ij and A_j F_ji by their mean (reciprocity.hpp); "none";
   /// "auto": average for gather, none for the others (the pair estimators are reciprocal by
@@ -65,7 +65,7 @@ struct FormFactorOptions {
   /// pair; gather and hemicube: the flagged rows); everything else is left empty, and
   /// reciprocity averaging and the threshold are not applied (see update_form_factors).
   std::vector<char> only;
-  /// Distributed form factors (README "Running on a cluster"): when row_end > row_begin,
+  /// Distributed form factors (docs/cluster.md): when row_end > row_begin,
   /// a pair estimator computes only the pairs (i, j > i) with i in [row_begin, row_end),
   /// each with the stream it has in a whole computation, and returns both of their entries
   /// (F_ij and F_ji: rows outside the range receive mirrors), the threshold applied per
@@ -140,14 +140,14 @@ std::vector<std::string> form_factor_estimators();
 std::vector<std::string> form_factor_estimator_choices();
 
 /// `--estimator auto` picks "gather" at or above this many patches and "hybrid" below.
-/// Measured on the Cornell box (2 cores, README "Choosing an estimator"): hybrid's O(N²)
+/// Measured on the Cornell box (2 cores, docs/form-factors.md): hybrid's O(N²)
 /// pairs take about a minute at this size, gather's O(N·K) rays about a second.
 constexpr std::int64_t kAutoGatherPatches = 6000;
 
 /// `--estimator auto` with `--ff-tol` picks "analytic" up to this many patches. Its O(N²)
 /// pairs cost 0.1-10 ms each on plates and panels and up to seconds with boxes standing on
-/// the faces (README "The analytic estimator"): 500 patches are 125k pairs, minutes for a
-/// clean enclosure. Above it, auto ignores --ff-tol with a warning (name the estimator to
+/// the faces (docs/form-factors.md, "The analytic estimator"): 500 patches are 125k pairs, minutes
+/// for a clean enclosure. Above it, auto ignores --ff-tol with a warning (name the estimator to
 /// force it).
 constexpr std::int64_t kAutoAnalyticMaxPatches = 500;
 

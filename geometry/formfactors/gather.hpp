@@ -13,8 +13,8 @@
 
 #include <cstdint>
 
-#include "geometry/bvh.hpp"
 #include "geometry/formfactors/formfactors.hpp"
+#include "geometry/visibility/bvh.hpp"
 
 namespace lambert::ff {
 

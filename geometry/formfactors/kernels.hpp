@@ -7,7 +7,7 @@
 #include <array>
 #include <cmath>
 
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 
 namespace lambert::ff {
 

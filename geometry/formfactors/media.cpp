@@ -11,11 +11,11 @@
 #include "core/parallel.hpp"
 #include "core/sampling.hpp"
 #include "core/timer.hpp"
-#include "geometry/bvh.hpp"
 #include "geometry/formfactors/constants.hpp"
 #include "geometry/formfactors/kernels.hpp"
 #include "geometry/formfactors/reciprocity.hpp"
 #include "geometry/formfactors/visibility.hpp"
+#include "geometry/visibility/bvh.hpp"
 
 namespace lambert {
 namespace {

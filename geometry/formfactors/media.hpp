@@ -41,7 +41,7 @@
 #include <vector>
 
 #include "geometry/formfactors/formfactors.hpp"
-#include "geometry/medium.hpp"
+#include "geometry/media/medium.hpp"
 
 namespace lambert {
 

@@ -10,9 +10,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "geometry/bvh.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/formfactors/kernels.hpp"
+#include "geometry/visibility/bvh.hpp"
 
 namespace lambert::ff {
 

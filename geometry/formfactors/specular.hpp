@@ -32,9 +32,9 @@
 
 #include <Eigen/Core>
 
-#include "geometry/bvh.hpp"
 #include "geometry/formfactors/formfactors.hpp"
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
+#include "geometry/visibility/bvh.hpp"
 
 namespace lambert::ff {
 

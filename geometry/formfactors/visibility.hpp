@@ -10,8 +10,8 @@
 // patch shape, size or distance.
 
 #include "core/sampling.hpp"
-#include "geometry/bvh.hpp"
 #include "geometry/formfactors/kernels.hpp"
+#include "geometry/visibility/bvh.hpp"
 
 namespace lambert::ff {
 

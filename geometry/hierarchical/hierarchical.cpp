@@ -12,10 +12,10 @@
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "core/timer.hpp"
-#include "geometry/bvh.hpp"
 #include "geometry/formfactors/constants.hpp"
 #include "geometry/hierarchical/hierarchy.hpp"
 #include "geometry/hierarchical/links.hpp"
+#include "geometry/visibility/bvh.hpp"
 
 namespace lambert {
 namespace {

@@ -34,7 +34,7 @@
 #include <string>
 #include <vector>
 
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 #include "geometry/scene.hpp"
 
 namespace lambert {

@@ -18,7 +18,7 @@
 
 #include "core/sampling.hpp"
 #include "geometry/formfactors/kernels.hpp"
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 
 namespace lambert::hr {
 

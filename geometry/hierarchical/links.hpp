@@ -42,8 +42,8 @@
 
 #include <cstdint>
 
-#include "geometry/bvh.hpp"
 #include "geometry/hierarchical/hierarchy.hpp"
+#include "geometry/visibility/bvh.hpp"
 
 namespace lambert::hr {
 

@@ -3,8 +3,8 @@
     import lambert
     scene = lambert.load_scene()                 # the built-in Cornell box
     mesh = scene.mesh(patches=500)
-    F = lambert.form_factors(mesh, estimator="hybrid", samples=32, seed=1)
-    B, report = lambert.solve(mesh, F, solver="gauss-seidel", tol=1e-8)
+    ff = lambert.form_factors(mesh, estimator="hybrid", samples=32, seed=1)  # ff.matrix: CSR
+    B, report = lambert.solve(mesh, ff, solver="gauss-seidel", tol=1e-8)
 
 Errors: lambert.InputError (a bad scene or F file: SceneError/IoError, the file named in the
 message), lambert.UsageError (a bad argument; also a ValueError), both lambert.Error.
@@ -16,17 +16,26 @@ copy). Results (F's data, B, images) are handed over without a copy; scipy conve
 are copied into lambert's types.
 """
 
+import os as _os
+
 import numpy as _np
 import scipy.sparse as _sparse
 
-from . import _lambert
-from ._lambert import Error, InputError, UsageError, Mesh, Scene, VertexField  # noqa: F401
+# An installed package (`pip install .`) carries the built-in Cornell box: the engine reads it
+# there unless LAMBERT_DATA_DIR names another folder (a build tree reads the source's data/).
+_data = _os.path.join(_os.path.dirname(__file__), "data")
+if _os.path.isdir(_data):
+    _os.environ.setdefault("LAMBERT_DATA_DIR", _data)
+
+from . import _lambert  # noqa: E402
+from ._lambert import Error, InputError, UsageError, Mesh, Scene, VertexField  # noqa: F401,E402
 
 __all__ = [
-    "__version__", "Error", "InputError", "UsageError", "Scene", "Mesh", "VertexField", "load_scene",
+    "__version__", "Error", "InputError", "UsageError", "Scene", "Mesh", "VertexField",
+    "FormFactors", "Solution", "load_scene",
     "form_factors", "save_form_factors", "load_form_factors", "solve", "solve_hierarchical", "heat",
     "vertex_radiosity",
-    "write_vertex_exr", "render", "estimators", "solvers", "set_verbosity",
+    "write_vertex_exr", "render", "estimators", "solvers", "set_verbosity", "option_specs",
 ]
 
 __version__ = _lambert.__version__  # the project's one version (CHANGELOG.md, "Version scheme")
@@ -60,51 +69,138 @@ def _csr(arrays, n):
     return _sparse.csr_matrix((data, indices, indptr), shape=(n, n), copy=False)
 
 
-def _wrap_ff(result, mesh, stderr):
+class FormFactors:
+    """Form factors with what made them: the result of `form_factors` and `load_form_factors`.
+
+    Attributes
+    ----------
+    matrix : scipy.sparse.csr_matrix, shape (N, N)
+        F, row i the fractions of patch i's power that reach each other patch.
+    stderr : scipy.sparse.csr_matrix or None
+        Per-entry standard errors (the Monte Carlo estimators, or a file that kept them), or
+        None.
+    settings : str
+        The settings text a saved F carries (estimator, samples, seed, ...): what made it.
+    stats : dict or None
+        What the computation did (rays, pairs tested and culled, seconds); None when loaded.
+    mesh_hash : int
+        The hash of the mesh F belongs to (`Mesh.hash`): a saved F is refused on another mesh.
+
+    `solve`, `heat` and `save_form_factors` take a FormFactors or a plain scipy matrix. Derived
+    matrices (``ff.matrix * 2``) are plain scipy matrices: they no longer claim the settings.
+    """
+
+    def __init__(self, matrix, stderr, settings, stats, mesh_hash):
+        self.matrix = matrix
+        self.stderr = stderr
+        self.settings = settings
+        self.stats = stats
+        self.mesh_hash = mesh_hash
+
+    @property
+    def shape(self):
+        """(N, N)."""
+        return self.matrix.shape
+
+    def __repr__(self):
+        n = self.matrix.shape[0]
+        return (f"<lambert.FormFactors {n}x{n}, {self.matrix.nnz} entries, "
+                f"stderr={'yes' if self.stderr is not None else 'no'}, settings={self.settings!r}>")
+
+
+class Solution(tuple):
+    """A solve's result, (B, report), which unpacks as a pair.
+
+    Attributes
+    ----------
+    B : numpy.ndarray, shape (N, 3)
+        Radiosity per patch and channel (W/m^2).
+    report : dict
+        status, iterations, residual, seconds, per channel ``channels`` and ``energy``, and the
+        solver settings used (``solver``, ``tol``, ...).
+    """
+
+    def __new__(cls, B, report):
+        return super().__new__(cls, (B, report))
+
+    @property
+    def B(self):
+        return self[0]
+
+    @property
+    def report(self):
+        return self[1]
+
+    def __repr__(self):
+        return (f"<lambert.Solution {self[0].shape[0]} patches, status {self[1].get('status')!r}>")
+
+
+def _wrap_ff(result, mesh, computed):
     n = len(mesh)
-    F = _csr(result["F"], n)
-    F.lambert_settings = result["settings"]
-    F.lambert_stats = result.get("stats")
-    if not stderr:
-        return F
-    S = None if result["stderr"] is None else _csr(result["stderr"], n)
-    return F, S
+    S = None if result.get("stderr") is None else _csr(result["stderr"], n)
+    return FormFactors(_csr(result["F"], n), S, result.get("settings", ""),
+                       result.get("stats") if computed else None, mesh.hash)
 
 
 def form_factors(mesh, estimator="auto", samples=None, rays=None, seed=1, threads=0,
                  threshold=0.0, reciprocity="auto", tol=None, hemicube_resolution=128,
                  stderr=False):
-    """F (scipy.sparse.csr_matrix, N x N) of the mesh; with stderr=True (F, standard errors).
-    The settings mean what the CLI's options of the same names mean; the same settings give
-    the CLI's F bit for bit. F.lambert_settings holds the settings text a saved F carries,
-    F.lambert_stats what the computation did."""
+    """The form factors of the mesh, as a `FormFactors` (matrix, stderr, settings, stats).
+
+    The keywords are the CLI's options (docs/options.md) with the same values, ranges and
+    defaults; the same settings give the CLI's F bit for bit. An option the estimator does
+    not read is refused (UsageError), as on the command line.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The patches (``scene.mesh(...)``).
+@declared --estimator --samples --rays --ff-tol --threshold --reciprocity --hemicube-res
+    seed : int, default 1
+        The random seed: the same seed gives the same F whatever ``threads`` is.
+    threads : int, default 0
+        Worker threads (0: all cores).
+    stderr : bool, default False
+        Keep the per-entry standard errors of the Monte Carlo estimators (``.stderr``).
+
+    Returns
+    -------
+    FormFactors
+    """
     _check_mesh(mesh)
     result = _lambert.form_factors(mesh, str(estimator), _opt_int(samples, "samples"),
                                    _opt_int(rays, "rays"), _int(seed, "seed"),
                                    _int(threads, "threads"), float(threshold), str(reciprocity),
                                    None if tol is None else float(tol),
                                    _int(hemicube_resolution, "hemicube_resolution"), bool(stderr))
-    return _wrap_ff(result, mesh, stderr)
+    return _wrap_ff(result, mesh, computed=True)
 
 
 def save_form_factors(path, mesh, F, stderr=None, precision="double"):
     """Saves F as the CLI does: Matrix Market for a .mtx path, else lambert's binary format
-    (with the standard errors when given), tied to the mesh."""
+    (with the standard errors when known), tied to the mesh. F is a `FormFactors` (its
+    settings, and in the binary format its standard errors, are saved with it) or a scipy
+    matrix (then `stderr` may give the errors, and no settings are recorded)."""
     _check_mesh(mesh)
+    settings = ""
+    if isinstance(F, FormFactors):
+        if stderr is None and not str(path).endswith(".mtx"):  # Matrix Market holds F alone
+            stderr = F.stderr
+        settings = F.settings
     indptr, indices, data = _csr_arrays(F, mesh, "F")
     err = None
     if stderr is not None:
         s_indptr, s_indices, s_data = _csr_arrays(stderr, mesh, "stderr")
         err = (s_data, s_indices, s_indptr)
-    settings = getattr(F, "lambert_settings", "")
     _lambert.save_form_factors(str(path), mesh, indptr, indices, data, err, settings, str(precision))
 
 
-def load_form_factors(path, mesh, stderr=False):
-    """Reads an F saved by the CLI or save_form_factors (binary or Matrix Market); refuses
-    (InputError) one made for another mesh. With stderr=True (F, standard errors or None)."""
+def load_form_factors(path, mesh):
+    """Reads an F saved by the CLI or save_form_factors (binary or Matrix Market) as a
+    `FormFactors` (its standard errors when the file kept them, its settings text); refuses
+    (InputError) one made for another mesh."""
     _check_mesh(mesh)
-    return _wrap_ff(_lambert.load_form_factors(str(path), mesh), mesh, stderr)
+    return _wrap_ff(_lambert.load_form_factors(str(path), mesh), mesh, computed=False)
 
 
 _MEDIUM_KEYS = ("medium_box", "sigma_a", "sigma_s", "medium_emission", "medium_grid", "voxels",
@@ -113,25 +209,41 @@ _MEDIUM_KEYS = ("medium_box", "sigma_a", "sigma_s", "medium_emission", "medium_g
 
 def solve(mesh, F, solver="gauss-seidel", tol=1e-8, max_iterations=10000, omega=1.5,
           preconditioner="diagonal", restart=30, threads=1, initial_guess=None, **medium):
-    """Solves (I - rho F) B = E per channel. Returns (B, report): B an (N, 3) array, report a
-    dict with status, iterations, residual (worst channel), seconds, and per channel
-    `channels` (residual_history, time_history, ...) and `energy` (emitted, absorbed,
-    escaped, relative_imbalance).
+    """Solves (I - rho F) B = E per channel.
 
-    A participating medium (the CLI's solve --medium-box ...): medium_box=(x0, y0, z0, x1, y1,
-    z1) with sigma_a, sigma_s, medium_emission (R, G, B), voxels or voxel_size, or
-    medium_grid=FILE; medium_rays, transmittance_samples and seed steer its exchange factors.
-    F is then the surfaces' F; B holds the patches' rows and report["medium"] the medium's
-    part (zones, absorbed_medium per channel, ...)."""
+    Parameters
+    ----------
+    mesh : Mesh
+    F : FormFactors or scipy.sparse matrix
+@declared --solver --tol --max-iter --omega --preconditioner --restart
+    threads : int, default 1
+        Threads for the products with F (Gauss-Seidel, SOR and Southwell sweep in order).
+    initial_guess : array (N, 3), optional
+        A warm start for the iterative solvers (default: E).
+    **medium
+        A participating medium (the CLI's solve --medium-box ...): medium_box=(x0, y0, z0,
+        x1, y1, z1) with sigma_a, sigma_s, medium_emission (R, G, B), voxels or voxel_size,
+        or medium_grid=FILE; medium_rays, transmittance_samples and seed steer its exchange
+        factors. F is then the surfaces' F; B holds the patches' rows and report["medium"]
+        the medium's part (zones, absorbed_medium per channel, ...).
+
+    Returns
+    -------
+    Solution
+        (B, report), which unpacks as a pair: B an (N, 3) array, report a dict with status,
+        iterations, residual (worst channel), seconds, and per channel ``channels``
+        (residual_history, time_history, ...) and ``energy`` (emitted, absorbed, escaped,
+        relative_imbalance).
+    """
     _check_mesh(mesh)
     unknown = set(medium) - set(_MEDIUM_KEYS)
     if unknown:
         raise TypeError(f"solve() got unexpected keyword arguments {sorted(unknown)}")
     indptr, indices, data = _csr_arrays(F, mesh, "F")
-    return _lambert.solve(mesh, indptr, indices, data, str(solver), float(tol),
-                          _int(max_iterations, "max_iterations"), float(omega),
-                          str(preconditioner), _int(restart, "restart"), _int(threads, "threads"),
-                          initial_guess, medium)
+    return Solution(*_lambert.solve(mesh, indptr, indices, data, str(solver), float(tol),
+                                    _int(max_iterations, "max_iterations"), float(omega),
+                                    str(preconditioner), _int(restart, "restart"),
+                                    _int(threads, "threads"), initial_guess, medium))
 
 
 def heat(mesh, F, surfaces, ambient_temperature=0.0, length_unit="m", solver="gauss-seidel",
@@ -197,6 +309,39 @@ def render(mesh, B, eye=None, look_at=None, up=None, fov=None, width=None, heigh
                            str(png or ""), None if ev is None else float(ev))
 
 
+# --- the declared options' documentation (pipeline/option_specs.hpp) ---------------------------
+
+_SPECS = {spec["name"]: spec for spec in _lambert.option_specs()}
+
+
+def option_specs():
+    """The declared options (name, Python keyword, kind, accepts, range or choices, default,
+    doc): the table the CLI and these keywords are checked and documented from."""
+    return [dict(spec) for spec in _SPECS.values()]
+
+
+def _document_declared(function):
+    """Replaces each ``@declared --name ...`` line of the docstring by numpydoc entries for
+    those options, written from their declarations: keyword, kind, default, what it accepts
+    and the description, the CLI option named."""
+    lines = []
+    for line in function.__doc__.split("\n"):
+        if not line.startswith("@declared "):
+            lines.append(line)
+            continue
+        for name in line.split()[1:]:
+            spec = _SPECS[name]
+            kind = {"integer": "int", "real": "float", "choice": "str"}[spec["kind"]]
+            lines.append(f"    {spec['keyword']} : {kind}, default {spec['default']}")
+            lines.append(f"        {spec['doc']}. Accepts {spec['accepts']} (the CLI's {name}).")
+    function.__doc__ = "\n".join(lines)
+    return function
+
+
+form_factors = _document_declared(form_factors)
+solve = _document_declared(solve)
+
+
 # --- argument checks: wrong types raise TypeError, wrong shapes UsageError -------------------
 
 def _check_mesh(mesh):
@@ -222,6 +367,11 @@ def _vec3(v, name):
 
 
 def _csr_arrays(F, mesh, name):
+    if isinstance(F, FormFactors):
+        if F.mesh_hash != mesh.hash:
+            raise UsageError(f"{name} was made for another mesh (hash {F.mesh_hash:#x}, this "
+                             f"mesh {mesh.hash:#x})")
+        F = F.matrix
     if not _sparse.issparse(F):
         raise TypeError(f"{name} must be a scipy.sparse matrix, got {type(F).__name__}")
     n = len(mesh)

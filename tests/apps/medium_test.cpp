@@ -12,8 +12,8 @@
 #include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
 #include "geometry/analytic.hpp"
-#include "geometry/bvh.hpp"
 #include "geometry/formfactors/media.hpp"
+#include "geometry/visibility/bvh.hpp"
 #include "pipeline/problem.hpp"
 
 namespace lambert {

@@ -10,7 +10,7 @@
 #include "apps/cli.hpp"
 #include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
-#include "geometry/bvh.hpp"
+#include "geometry/visibility/bvh.hpp"
 #include "io/exr.hpp"
 #include "pipeline/ff_stage.hpp"
 

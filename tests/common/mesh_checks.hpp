@@ -7,7 +7,7 @@
 #include <cmath>
 #include <map>
 
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 #include "geometry/polygon.hpp"
 #include "geometry/scene.hpp"
 

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "core/error.hpp"
-#include "geometry/medium.hpp"
+#include "geometry/media/medium.hpp"
 #include "io/medium_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -1,7 +1,5 @@
 // The analytic estimator: exact point factors past polygonal blockers, integrated to a
 // tolerance (geometry/formfactors/analytic.hpp), against closed forms and exact references.
-#include "geometry/formfactors/analytic.hpp"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,8 +8,9 @@
 
 #include "common/occluded_reference.hpp"
 #include "geometry/analytic.hpp"
+#include "geometry/formfactors/analytic.hpp"
 #include "geometry/formfactors/formfactors.hpp"
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 
 namespace lambert {
 namespace {

@@ -1,4 +1,4 @@
-#include "geometry/bvh.hpp"
+#include "geometry/visibility/bvh.hpp"
 
 #include <gtest/gtest.h>
 

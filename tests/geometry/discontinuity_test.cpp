@@ -1,5 +1,5 @@
 // Discontinuity lines and the constrained Delaunay mesh (discontinuity.hpp).
-#include "geometry/discontinuity.hpp"
+#include "geometry/mesh/discontinuity.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 #include <map>
 #include <set>
 
+#include "common/mesh_checks.hpp"
 #include "geometry/analytic.hpp"
 #include "geometry/polygon.hpp"
-#include "common/mesh_checks.hpp"
 
 namespace lambert {
 namespace {

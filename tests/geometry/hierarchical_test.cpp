@@ -6,12 +6,13 @@
 // its area-weighted mean of error_bound bounds its mean error; in a closed box the error is
 // amplified by interreflection by at most 1 / (1 - rho). The Jacobi sweeps stop at a
 // relative change of tol = 1e-12 (of the largest B), far below both.
+#include "geometry/hierarchical/hierarchical.hpp"
+
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
 #include "geometry/analytic.hpp"
-#include "geometry/hierarchical/hierarchical.hpp"
-#include "geometry/vertex_field.hpp"
+#include "geometry/render/vertex_field.hpp"
 
 namespace lambert {
 namespace {

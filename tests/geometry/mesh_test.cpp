@@ -1,4 +1,4 @@
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "geometry/raytrace.hpp"
+#include "geometry/render/raytrace.hpp"
 
 #include <gtest/gtest.h>
 
@@ -7,10 +7,10 @@
 #include <cmath>
 
 #include "core/sampling.hpp"
-#include "geometry/adapt.hpp"
 #include "geometry/analytic.hpp"
 #include "geometry/formfactors/reference.hpp"
-#include "geometry/render.hpp"
+#include "geometry/mesh/adapt.hpp"
+#include "geometry/render/render.hpp"
 
 namespace lambert {
 namespace {

@@ -1,4 +1,6 @@
 // The exact partial-shadow kernel (shadow.hpp) against closed forms and Monte Carlo.
+#include "geometry/visibility/shadow.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -7,7 +9,6 @@
 
 #include "geometry/analytic.hpp"
 #include "geometry/polygon.hpp"
-#include "geometry/shadow.hpp"
 
 namespace lambert {
 namespace {

@@ -1,4 +1,4 @@
-#include "geometry/vertex_field.hpp"
+#include "geometry/render/vertex_field.hpp"
 
 #include <gtest/gtest.h>
 

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "core/error.hpp"
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 #include "io/mtl_parser.hpp"
 #include "io/obj_loader.hpp"
 

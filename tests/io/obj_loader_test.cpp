@@ -4,7 +4,7 @@
 
 #include "common/temp_dir.hpp"
 #include "core/error.hpp"
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 #include "geometry/polygon.hpp"
 
 namespace lambert {

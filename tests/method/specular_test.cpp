@@ -11,7 +11,7 @@
 
 #include "core/error.hpp"
 #include "geometry/analytic.hpp"
-#include "geometry/bvh.hpp"
+#include "geometry/visibility/bvh.hpp"
 #include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
 

@@ -46,30 +46,45 @@ def test_mesh_arrays_are_read_only_views(cornell_mesh):
 def test_form_factors_equal_the_cli_bitwise(tmp_path, cornell, estimator, count):
     mesh = cornell.mesh(patches=300)
     kwargs = {"samples": 8} if estimator == "hybrid" else {"rays": 256}
-    F = lambert.form_factors(mesh, estimator=estimator, seed=7, threads=2, **kwargs)
+    ff = lambert.form_factors(mesh, estimator=estimator, seed=7, threads=2, **kwargs)
+    F = ff.matrix
     assert isinstance(F, sp.csr_matrix) and F.shape == (len(mesh), len(mesh))
     assert not F.data.flags.owndata  # handed over from C++ without a copy
+    # What made it travels with it: the settings, the computation's stats, the mesh.
+    assert f"estimator={estimator}" in ff.settings and "seed=7" in ff.settings
+    assert ff.stats["rays"] > 0 and ff.mesh_hash == mesh.hash and ff.stderr is None
     cli = tmp_path / "F.bin"
     run_cli("formfactors", "--patches", 300, "--estimator", estimator, *count, "--seed", 7,
             "-j", 1, "-q", "-o", cli)
-    G = lambert.load_form_factors(cli, mesh)
+    loaded = lambert.load_form_factors(cli, mesh)
+    G = loaded.matrix
+    assert loaded.settings == ff.settings and loaded.stats is None
     # Bitwise: the same sparsity and the same doubles (not merely close).
     assert np.array_equal(F.indptr, G.indptr) and np.array_equal(F.indices, G.indices)
     assert F.data.tobytes() == G.data.tobytes()
     # Saved from Python, the file is the CLI's byte for byte (same settings text).
     mine = tmp_path / "mine.bin"
-    lambert.save_form_factors(mine, mesh, F)
+    lambert.save_form_factors(mine, mesh, ff)
     assert mine.read_bytes() == cli.read_bytes()
+    # A derived matrix is a plain scipy matrix: saved, it claims no settings. (Half of F: F's
+    # own rows may exceed 1 by their Monte Carlo error, which a file without errors refuses.)
+    lambert.save_form_factors(tmp_path / "derived.bin", mesh, ff.matrix * 0.5)
+    assert lambert.load_form_factors(tmp_path / "derived.bin", mesh).settings == ""
+    # A FormFactors of another mesh is refused before any work.
+    with pytest.raises(lambert.UsageError, match="another mesh"):
+        lambert.solve(cornell.mesh(patches=50), ff)
 
 
 def test_save_load_round_trip_with_stderr(tmp_path, cornell_mesh):
-    F, S = lambert.form_factors(cornell_mesh, estimator="mc", samples=4, stderr=True)
+    ff = lambert.form_factors(cornell_mesh, estimator="mc", samples=4, stderr=True)
+    F, S = ff.matrix, ff.stderr
     assert S is not None and S.shape == F.shape
-    lambert.save_form_factors(tmp_path / "F.bin", cornell_mesh, F, stderr=S)
-    G, T = lambert.load_form_factors(tmp_path / "F.bin", cornell_mesh, stderr=True)
-    assert (G != F).nnz == 0 and (T != S).nnz == 0
-    lambert.save_form_factors(tmp_path / "F.mtx", cornell_mesh, F)
-    assert (lambert.load_form_factors(tmp_path / "F.mtx", cornell_mesh) != F).nnz == 0
+    lambert.save_form_factors(tmp_path / "F.bin", cornell_mesh, ff)  # F, S and the settings
+    loaded = lambert.load_form_factors(tmp_path / "F.bin", cornell_mesh)
+    assert (loaded.matrix != F).nnz == 0 and (loaded.stderr != S).nnz == 0
+    assert loaded.settings == ff.settings
+    lambert.save_form_factors(tmp_path / "F.mtx", cornell_mesh, ff)  # F and its settings
+    assert (lambert.load_form_factors(tmp_path / "F.mtx", cornell_mesh).matrix != F).nnz == 0
 
 
 def cube_faces():
@@ -119,7 +134,8 @@ def test_parallel_squares_within_four_standard_errors(tmp_path):
     top = [(0, 0, 1), (0, 1, 1), (1, 1, 1), (1, 0, 1)]
     path = write_obj(tmp_path / "squares.obj", {"bottom": [bottom], "top": [top]})
     mesh = lambert.load_scene(path).mesh(max_edge=0.25)
-    F, S = lambert.form_factors(mesh, estimator="mc", samples=64, seed=3, stderr=True)
+    ff = lambert.form_factors(mesh, estimator="mc", samples=64, seed=3, stderr=True)
+    F, S = ff.matrix, ff.stderr
     ids, A = mesh.surface_ids, mesh.areas
     b, t = ids == mesh.surface_names.index("bottom"), ids == mesh.surface_names.index("top")
     Ab = A[b].sum()
@@ -135,7 +151,9 @@ def test_parallel_squares_within_four_standard_errors(tmp_path):
 def test_two_solvers_agree_and_report(cornell_mesh):
     F = lambert.form_factors(cornell_mesh, estimator="hybrid", samples=8)
     B1, r1 = lambert.solve(cornell_mesh, F, solver="gauss-seidel", tol=1e-10)
-    B2, r2 = lambert.solve(cornell_mesh, F, solver="cg", tol=1e-10)
+    solution = lambert.solve(cornell_mesh, F.matrix, solver="cg", tol=1e-10)  # a plain matrix too
+    B2, r2 = solution
+    assert solution.B is B2 and solution.report is r2
     assert B1.shape == (len(cornell_mesh), 3) and r1["status"] == r2["status"] == "converged"
     assert len(r1["channels"]) == 3 and r1["channels"][0]["residual_history"]
     assert r1["residual"] <= 1e-10
@@ -385,4 +403,33 @@ def test_ctrl_c_stops_a_long_call_within_seconds(cornell):
     assert time.monotonic() - start < 20
     small = cornell.mesh(patches=40)
     F = lambert.form_factors(small, estimator="hybrid", samples=4)
-    assert F.shape == (len(small), len(small))
+    assert F.shape == F.matrix.shape == (len(small), len(small))
+
+
+def test_keywords_are_checked_and_documented_from_the_declarations(cornell_mesh):
+    """The declared options (pipeline/option_specs.hpp) reach Python: each keyword of
+    form_factors and solve is in help() with its range and default, its signature default is
+    the declared one, and a value outside the range is refused naming the keyword."""
+    import inspect
+    specs = {s["name"]: s for s in lambert.option_specs()}
+    for fn, names in ((lambert.form_factors, ["--estimator", "--samples", "--rays", "--ff-tol",
+                                              "--threshold", "--reciprocity", "--hemicube-res"]),
+                      (lambert.solve, ["--solver", "--tol", "--max-iter", "--omega",
+                                       "--preconditioner", "--restart"])):
+        parameters = inspect.signature(fn).parameters
+        for name in names:
+            s = specs[name]
+            assert s["keyword"] in parameters, (fn.__name__, name)
+            assert f"    {s['keyword']} : " in fn.__doc__ and s["accepts"] in fn.__doc__
+            default = parameters[s["keyword"]].default
+            if default is None:  # None: the declared default applies
+                continue
+            if s["kind"] == "choice":
+                assert default == s["default"], (name, default)
+            else:
+                assert float(default) == float(s["default"]), (name, default)
+    with pytest.raises(lambert.UsageError, match=r"samples: 0 is not an integer in \[1, 1048576\]"):
+        lambert.form_factors(cornell_mesh, estimator="hybrid", samples=0)
+    F = lambert.form_factors(cornell_mesh, estimator="hybrid", samples=2)
+    with pytest.raises(lambert.UsageError, match=r"omega: 2.5 is not a number in \[0.001, 1.999\]"):
+        lambert.solve(cornell_mesh, F, solver="sor", omega=2.5)

@@ -26,7 +26,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "geometry/discontinuity.hpp"
+#include "geometry/mesh/discontinuity.hpp"
 #include "geometry/polygon.hpp"
 
 namespace lambert {
@@ -92,7 +92,8 @@ std::vector<Part> planar_parts(const Scene& scene, std::int32_t surface, double 
     Part* part = nullptr;
     for (auto& p : parts) {
       bool coplanar = p.w.dot(n) > 1.0 - kSameNormal;
-      for (const auto& c : poly) coplanar = coplanar && std::abs((c - p.o).dot(p.w)) <= kSamePlane * scale;
+      for (const auto& c : poly)
+        coplanar = coplanar && std::abs((c - p.o).dot(p.w)) <= kSamePlane * scale;
       if (coplanar) {
         part = &p;
         break;
@@ -136,7 +137,9 @@ std::vector<std::array<Point2, 2>> split_at_crossings(const std::vector<std::arr
     lo[i] = a[i].cwiseMin(b[i]);
     hi[i] = a[i].cwiseMax(b[i]);
   }
-  auto cross2 = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) { return x.x() * y.y() - x.y() * y.x(); };
+  auto cross2 = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+    return x.x() * y.y() - x.y() * y.x();
+  };
   std::vector<std::vector<std::pair<double, Eigen::Vector2d>>> cuts(n);
   for (size_t i = 0; i < n; ++i)
     for (size_t j = i + 1; j < n; ++j) {
@@ -152,7 +155,8 @@ std::vector<std::array<Point2, 2>> split_at_crossings(const std::vector<std::arr
     }
   std::vector<std::array<Point2, 2>> out;
   for (size_t i = 0; i < n; ++i) {
-    std::sort(cuts[i].begin(), cuts[i].end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    std::sort(cuts[i].begin(), cuts[i].end(),
+              [](const auto& x, const auto& y) { return x.first < y.first; });
     Eigen::Vector2d from = a[i];
     cuts[i].push_back({1.0, b[i]});
     for (const auto& c : cuts[i]) {
@@ -163,7 +167,8 @@ std::vector<std::array<Point2, 2>> split_at_crossings(const std::vector<std::arr
   }
   // Merged crossings may make two pieces coincide: keep one of each.
   for (auto& s : out)
-    if (std::make_pair(s[1].x(), s[1].y()) < std::make_pair(s[0].x(), s[0].y())) std::swap(s[0], s[1]);
+    if (std::make_pair(s[1].x(), s[1].y()) < std::make_pair(s[0].x(), s[0].y()))
+      std::swap(s[0], s[1]);
   std::sort(out.begin(), out.end(), [](const auto& x, const auto& y) {
     return std::make_tuple(x[0].x(), x[0].y(), x[1].x(), x[1].y()) <
            std::make_tuple(y[0].x(), y[0].y(), y[1].x(), y[1].y());
@@ -240,7 +245,8 @@ std::vector<std::array<Point2, 2>> clean_segments(const std::vector<std::array<P
           if (it == lines.end()) continue;
           for (size_t j : it->second) {
             if (used[j]) continue;
-            if (std::abs(nrm.dot(segs[j].a - o)) > snap || std::abs(nrm.dot(segs[j].b - o)) > snap) continue;
+            if (std::abs(nrm.dot(segs[j].a - o)) > snap || std::abs(nrm.dot(segs[j].b - o)) > snap)
+              continue;
             used[j] = 1;
             group.push_back(j);
           }
@@ -251,7 +257,8 @@ std::vector<std::array<Point2, 2>> clean_segments(const std::vector<std::array<P
     std::vector<std::pair<double, Eigen::Vector2d>> ends;
     for (size_t j : group)
       for (const auto& p : {segs[j].a, segs[j].b}) ends.push_back({d.dot(p - o), p});
-    std::sort(ends.begin(), ends.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    std::sort(ends.begin(), ends.end(),
+              [](const auto& x, const auto& y) { return x.first < y.first; });
     std::vector<std::pair<double, Eigen::Vector2d>> chain;
     for (const auto& e : ends)
       if (chain.empty() || e.first - chain.back().first > snap) chain.push_back(e);
@@ -292,7 +299,8 @@ std::vector<std::array<Point2, 2>> clean_segments(const std::vector<std::array<P
       if (t <= 0 || t >= 1 || (a + t * d - p).norm() > snap) continue;
       cuts.push_back({t, p});
     }
-    std::sort(cuts.begin(), cuts.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    std::sort(cuts.begin(), cuts.end(),
+              [](const auto& x, const auto& y) { return x.first < y.first; });
     Eigen::Vector2d from = a;
     for (const auto& c : cuts) {
       split.push_back({Point2(from.x(), from.y()), Point2(c.second.x(), c.second.y())});
@@ -316,18 +324,21 @@ std::vector<Triangle> triangulate_part(const Scene& scene, const Part& part, dou
     std::vector<Point2> pts;
     for (const auto& c : poly) {
       pts.push_back(part.to2d(c));
-      corners.emplace(std::make_pair(CGAL::to_double(pts.back().x()), CGAL::to_double(pts.back().y())), c);
+      corners.emplace(
+          std::make_pair(CGAL::to_double(pts.back().x()), CGAL::to_double(pts.back().y())), c);
     }
     for (size_t k = 0; k < pts.size(); ++k) segments.push_back({pts[k], pts[(k + 1) % pts.size()]});
     std::vector<std::array<Point2, 3>> tris;
-    if (poly.size() == 3) tris.push_back({pts[0], pts[1], pts[2]});
+    if (poly.size() == 3)
+      tris.push_back({pts[0], pts[1], pts[2]});
     else
       for (const auto& t : triangulate(poly)) tris.push_back({pts[t[0]], pts[t[1]], pts[t[2]]});
     face_tris.push_back(std::move(tris));
   }
   for (const auto* s : lines) segments.push_back({part.to2d(s->a), part.to2d(s->b)});
   double extent = 0;
-  for (const auto& s : segments) extent = std::max({extent, std::abs(s[0].x()), std::abs(s[0].y())});
+  for (const auto& s : segments)
+    extent = std::max({extent, std::abs(s[0].x()), std::abs(s[0].y())});
   for (const auto& s : clean_segments(segments, kSnap * std::max(extent, 1e-300))) {
     cdt.insert_constraint(s[0], s[1]);
   }
@@ -480,7 +491,8 @@ std::vector<Triangle> mesh_part(const Scene& scene, const Part& part, double max
 // Makes the triangles of a folded surface conforming across its creases: every vertex on a
 // crease edge (one shared by faces of two planar parts) is put on the edge exactly and
 // inserted into the triangles of the other side by fan splits.
-void conform_creases(const Scene& scene, const std::vector<Part>& parts, std::vector<Triangle>& tris) {
+void conform_creases(const Scene& scene, const std::vector<Part>& parts,
+                     std::vector<Triangle>& tris) {
   if (parts.size() < 2) return;
   std::map<std::array<Key3, 2>, int> edge_part;  // an edge -> the first part holding it
   std::vector<std::array<Eigen::Vector3d, 2>> creases;
@@ -507,7 +519,8 @@ void conform_creases(const Scene& scene, const std::vector<Part>& parts, std::ve
   auto param = [&](size_t c, const Eigen::Vector3d& x, double& u) {
     const Eigen::Vector3d d = creases[c][1] - creases[c][0];
     u = (x - creases[c][0]).dot(d) / d.squaredNorm();
-    return (x - creases[c][0] - u * d).norm() <= kOnEdge * d.norm() && u > -kOnEdge && u < 1 + kOnEdge;
+    return (x - creases[c][0] - u * d).norm() <= kOnEdge * d.norm() && u > -kOnEdge &&
+           u < 1 + kOnEdge;
   };
   for (const auto& t : tris) {
     for (const auto& x : t.p) {
@@ -529,9 +542,10 @@ void conform_creases(const Scene& scene, const std::vector<Part>& parts, std::ve
     merged.back() = 1.0;
     u = merged;
     for (double x : u)
-      points[c].push_back(x == 0.0   ? creases[c][0]
-                          : x == 1.0 ? creases[c][1]
-                                     : Eigen::Vector3d(creases[c][0] + x * (creases[c][1] - creases[c][0])));
+      points[c].push_back(
+          x == 0.0   ? creases[c][0]
+          : x == 1.0 ? creases[c][1]
+                     : Eigen::Vector3d(creases[c][0] + x * (creases[c][1] - creases[c][0])));
   }
   // Snap every vertex on a crease to its canonical point and record (crease, index).
   for (auto& t : tris) {
@@ -539,8 +553,10 @@ void conform_creases(const Scene& scene, const std::vector<Part>& parts, std::ve
       for (size_t c = 0; c < creases.size(); ++c) {
         double u;
         if (!param(c, x, u)) continue;
-        const auto it = std::lower_bound(us[c].begin(), us[c].end(), std::clamp(u, 0.0, 1.0) - kOnEdge);
-        const int i = static_cast<int>(std::min<std::ptrdiff_t>(it - us[c].begin(), us[c].size() - 1));
+        const auto it =
+            std::lower_bound(us[c].begin(), us[c].end(), std::clamp(u, 0.0, 1.0) - kOnEdge);
+        const int i =
+            static_cast<int>(std::min<std::ptrdiff_t>(it - us[c].begin(), us[c].size() - 1));
         x = points[c][i];
         on[key(x)].push_back({static_cast<int>(c), static_cast<double>(i)});
       }

@@ -1,4 +1,4 @@
-#include "geometry/bvh.hpp"
+#include "geometry/visibility/bvh.hpp"
 
 #include <embree3/rtcore.h>
 
@@ -162,9 +162,8 @@ Bvh::Bvh(const PatchMesh& mesh, int threads) : impl_(std::make_unique<Impl>()) {
   // equals patch index.
   RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_QUAD);
   check_device(device, "rtcNewGeometry");
-  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                          RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                          mesh.vertices.size()));
+  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+      geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices.size()));
   auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
       geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, 4 * sizeof(unsigned), mesh.patches.size()));
   if (!vb || !ib) {
@@ -214,7 +213,8 @@ bool Bvh::occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& directi
 namespace {
 // Point-query callback: collects the primitive (= patch) ids Embree hands over.
 bool collect_patch(RTCPointQueryFunctionArguments* args) {
-  static_cast<std::vector<std::int32_t>*>(args->userPtr)->push_back(static_cast<std::int32_t>(args->primID));
+  static_cast<std::vector<std::int32_t>*>(args->userPtr)
+      ->push_back(static_cast<std::int32_t>(args->primID));
   return false;  // the query radius is unchanged
 }
 }  // namespace
@@ -234,8 +234,8 @@ void Bvh::patches_near(const Eigen::Vector3d& centre, double radius,
   rtcPointQuery(impl_->scene.get(), &query, &context, collect_patch, &out);
 }
 
-RayHit Bvh::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
-                      float tnear, float tfar) const {
+RayHit Bvh::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, float tnear,
+                      float tfar) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   const FrameRay f = to_bvh_frame(origin, direction, impl_->exponent);

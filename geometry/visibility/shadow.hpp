@@ -15,8 +15,9 @@
 // Each blocker is first clipped to the view pyramid from x through the emitter's convex hull
 // (outside it nothing is hidden), so its projection stays within the hull and its rounding
 // at the emitter's scale. Limits: blocker points within a relative 1e-12 of x's height above
-// the emitter plane or of the plane itself are dropped before the projection. Blockers are planar polygons (any winding, one
-// side as good as the other); non-simple ones are triangulated by ear clipping first.
+// the emitter plane or of the plane itself are dropped before the projection. Blockers are planar
+// polygons (any winding, one side as good as the other); non-simple ones are triangulated by ear
+// clipping first.
 
 #include <Eigen/Core>
 #include <vector>

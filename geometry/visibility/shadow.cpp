@@ -1,4 +1,4 @@
-#include "geometry/shadow.hpp"
+#include "geometry/visibility/shadow.hpp"
 
 #include <CGAL/Boolean_set_operations_2.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
@@ -133,7 +133,8 @@ std::vector<Polygon3> visible_emitter_region(const Eigen::Vector3d& x, const Eig
     centre += q / static_cast<double>(emitter.size());
   }
   for (const auto& p : emitter)
-    extent = std::max(extent, (Eigen::Vector2d((p - f.o).dot(f.u), (p - f.o).dot(f.v)) - centre).norm());
+    extent =
+        std::max(extent, (Eigen::Vector2d((p - f.o).dot(f.u), (p - f.o).dot(f.v)) - centre).norm());
   if (hi_val <= plane_tol) return {};  // behind x's horizon, or on it within rounding
   if (lo_val < -plane_tol) {
     // A rectangle covering the positive side of the line within the emitter's disc.
@@ -143,9 +144,10 @@ std::vector<Polygon3> visible_emitter_region(const Eigen::Vector3d& x, const Eig
     const Eigen::Vector2d dir(-normal.y(), normal.x());
     const double D = 4.0 * extent + (foot - centre).norm();
     std::vector<Point2> box;
-    for (const Eigen::Vector2d& q : {Eigen::Vector2d(foot - D * dir), Eigen::Vector2d(foot + D * dir),
-                                     Eigen::Vector2d(foot + D * dir + D * normal),
-                                     Eigen::Vector2d(foot - D * dir + D * normal)})
+    for (const Eigen::Vector2d& q :
+         {Eigen::Vector2d(foot - D * dir), Eigen::Vector2d(foot + D * dir),
+          Eigen::Vector2d(foot + D * dir + D * normal),
+          Eigen::Vector2d(foot - D * dir + D * normal)})
       box.emplace_back(q.x(), q.y());
     const Polygon2 half = simple_ccw(box);
     if (half.is_empty()) return {};
@@ -165,7 +167,9 @@ std::vector<Polygon3> visible_emitter_region(const Eigen::Vector3d& x, const Eig
   // The pyramid is widened by kPyramidMargin about the hull's centre, so that a blocker that
   // hides the whole emitter projects onto a region containing it strictly (exactly 0 in
   // the umbra, no rounding sliver along the hull's edges).
-  auto widened = [&](const Point2& q) -> Eigen::Vector3d { return inside + (1.0 + kPyramidMargin) * (f.to3d(q) - inside); };
+  auto widened = [&](const Point2& q) -> Eigen::Vector3d {
+    return inside + (1.0 + kPyramidMargin) * (f.to3d(q) - inside);
+  };
   for (size_t k = 0; k < hull.size(); ++k) {
     const Eigen::Vector3d ra = widened(hull[k]) - x, rb = widened(hull[(k + 1) % hull.size()]) - x;
     const Eigen::Vector3d nk = ra.cross(rb);
@@ -185,11 +189,13 @@ std::vector<Polygon3> visible_emitter_region(const Eigen::Vector3d& x, const Eig
     if (blocker.size() == 3 || is_convex(blocker)) {
       pieces.push_back(blocker);
     } else {
-      for (const auto& t : triangulate(blocker)) pieces.push_back({blocker[t[0]], blocker[t[1]], blocker[t[2]]});
+      for (const auto& t : triangulate(blocker))
+        pieces.push_back({blocker[t[0]], blocker[t[1]], blocker[t[2]]});
     }
     for (const auto& tri : pieces) {
       Polygon3 part = clip(tri, [&](const Eigen::Vector3d& p) { return height(p) - lo; });
-      if (part.size() >= 3) part = clip(part, [&](const Eigen::Vector3d& p) { return hi - height(p); });
+      if (part.size() >= 3)
+        part = clip(part, [&](const Eigen::Vector3d& p) { return hi - height(p); });
       for (size_t k = 0; k < side_normals.size() && part.size() >= 3; ++k)
         part = clip(part, [&](const Eigen::Vector3d& p) { return side_normals[k].dot(p - x); });
       if (part.size() < 3) continue;
@@ -213,7 +219,8 @@ std::vector<Polygon3> visible_emitter_region(const Eigen::Vector3d& x, const Eig
   std::vector<Polygon3> loops;
   auto add_loop = [&](const Polygon2& loop) {
     Polygon3 out;
-    for (auto it = loop.vertices_begin(); it != loop.vertices_end(); ++it) out.push_back(f.to3d(*it));
+    for (auto it = loop.vertices_begin(); it != loop.vertices_end(); ++it)
+      out.push_back(f.to3d(*it));
     loops.push_back(std::move(out));
   };
   for (const auto& part : parts) {

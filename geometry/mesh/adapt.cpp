@@ -1,4 +1,4 @@
-#include "geometry/adapt.hpp"
+#include "geometry/mesh/adapt.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,16 +6,10 @@
 #include <unordered_map>
 
 #include "core/error.hpp"
-#include "geometry/direct_light.hpp"
+#include "geometry/visibility/direct_light.hpp"
 
 namespace lambert {
 namespace {
-
-std::uint64_t edge_key(std::int32_t a, std::int32_t b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
-         static_cast<std::uint32_t>(b);
-}
 
 Patch child_of(const PatchMesh& mesh, const Patch& parent, std::array<std::int32_t, 4> v) {
   Patch p = make_patch(mesh, v, 3);
@@ -44,8 +38,10 @@ RefinedMesh triangulate_quads(const PatchMesh& mesh) {
     // The shorter diagonal (a convex quad: both halves have positive area).
     const bool d02 = (x[v[0]] - x[v[2]]).squaredNorm() <= (x[v[1]] - x[v[3]]).squaredNorm();
     const std::array<std::array<std::int32_t, 4>, 2> halves =
-        d02 ? std::array<std::array<std::int32_t, 4>, 2>{{{v[0], v[1], v[2], 0}, {v[0], v[2], v[3], 0}}}
-            : std::array<std::array<std::int32_t, 4>, 2>{{{v[0], v[1], v[3], 0}, {v[1], v[2], v[3], 0}}};
+        d02 ? std::array<std::array<std::int32_t, 4>, 2>{{{v[0], v[1], v[2], 0},
+                                                          {v[0], v[2], v[3], 0}}}
+            : std::array<std::array<std::int32_t, 4>, 2>{
+                  {{v[0], v[1], v[3], 0}, {v[1], v[2], v[3], 0}}};
     for (const auto& h : halves) {
       out.mesh.patches.push_back(child_of(out.mesh, p, h));
       out.origin.push_back(i);
@@ -79,7 +75,8 @@ std::vector<double> patch_errors(const PatchMesh& mesh, const Eigen::MatrixX3d& 
 
 std::vector<double> exact_direct_patch_errors(const Scene& scene, const PatchMesh& mesh,
                                               const Eigen::MatrixX3d& indirect, int threads) {
-  LAMBERT_CHECK(indirect.rows() == mesh.size(), "exact_direct_patch_errors: I does not match the mesh");
+  LAMBERT_CHECK(indirect.rows() == mesh.size(),
+                "exact_direct_patch_errors: I does not match the mesh");
   // Per patch: its corners, then its edge midpoints, at its own normal.
   std::vector<Eigen::Vector3d> points, normals;
   std::vector<std::int64_t> first(mesh.size() + 1, 0);
@@ -88,12 +85,14 @@ std::vector<double> exact_direct_patch_errors(const Scene& scene, const PatchMes
     first[i] = static_cast<std::int64_t>(points.size());
     for (int k = 0; k < p.vertex_count; ++k) points.push_back(mesh.vertices[p.vertices[k]]);
     for (int k = 0; k < p.vertex_count; ++k)
-      points.push_back(0.5 * (mesh.vertices[p.vertices[k]] + mesh.vertices[p.vertices[(k + 1) % p.vertex_count]]));
+      points.push_back(0.5 * (mesh.vertices[p.vertices[k]] +
+                              mesh.vertices[p.vertices[(k + 1) % p.vertex_count]]));
     normals.resize(points.size(), p.normal);
   }
   const Eigen::MatrixX3d H = exact_direct_irradiance(scene, points, normals, threads);
   Eigen::MatrixX3d reflected = indirect;
-  for (std::int32_t i = 0; i < mesh.size(); ++i) reflected.row(i).array() *= mesh.patches[i].rho.transpose().array();
+  for (std::int32_t i = 0; i < mesh.size(); ++i)
+    reflected.row(i).array() *= mesh.patches[i].rho.transpose().array();
   std::vector<double> e = patch_errors(mesh, reflected);
   for (std::int32_t i = 0; i < mesh.size(); ++i) {
     const Patch& p = mesh.patches[i];
@@ -110,7 +109,8 @@ std::vector<double> exact_direct_patch_errors(const Scene& scene, const PatchMes
 }
 
 RefinedMesh refine_marked(const PatchMesh& mesh, const std::vector<char>& marked) {
-  LAMBERT_CHECK(static_cast<std::int32_t>(marked.size()) == mesh.size(), "refine: marks do not match");
+  LAMBERT_CHECK(static_cast<std::int32_t>(marked.size()) == mesh.size(),
+                "refine: marks do not match");
   RefinedMesh out;
   out.mesh = mesh;
   PatchMesh& m = out.mesh;
@@ -138,7 +138,8 @@ RefinedMesh refine_marked(const PatchMesh& mesh, const std::vector<char>& marked
     int best = 0;
     auto len = [&](int k) {
       const auto a = tris[t].vertices[k], b = tris[t].vertices[(k + 1) % 3];
-      return std::make_tuple((m.vertices[a] - m.vertices[b]).squaredNorm(), std::min(a, b), std::max(a, b));
+      return std::make_tuple((m.vertices[a] - m.vertices[b]).squaredNorm(), std::min(a, b),
+                             std::max(a, b));
     };
     for (int k = 1; k < 3; ++k)
       if (len(k) > len(best)) best = k;
@@ -161,7 +162,8 @@ RefinedMesh refine_marked(const PatchMesh& mesh, const std::vector<char>& marked
       while (edge_key(v[k], v[(k + 1) % 3]) != edge_key(a, b)) ++k;
       const auto p = v[k], q = v[(k + 1) % 3], r = v[(k + 2) % 3];
       const Patch parent = tris[t];
-      for (const auto& c : {std::array<std::int32_t, 4>{p, mid, r, 0}, std::array<std::int32_t, 4>{mid, q, r, 0}}) {
+      for (const auto& c :
+           {std::array<std::int32_t, 4>{p, mid, r, 0}, std::array<std::int32_t, 4>{mid, q, r, 0}}) {
         tris.push_back(child_of(m, parent, c));
         alive.push_back(1);
         changed.push_back(1);

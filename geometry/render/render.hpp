@@ -18,13 +18,13 @@
 #include <cstdint>
 #include <vector>
 
-#include "geometry/bvh.hpp"
-#include "geometry/camera.hpp"
-#include "geometry/direct_light.hpp"
-#include "geometry/medium.hpp"
-#include "geometry/mesh.hpp"
-#include "geometry/raytrace.hpp"
-#include "geometry/vertex_field.hpp"
+#include "geometry/media/medium.hpp"
+#include "geometry/mesh/mesh.hpp"
+#include "geometry/render/camera.hpp"
+#include "geometry/render/raytrace.hpp"
+#include "geometry/render/vertex_field.hpp"
+#include "geometry/visibility/bvh.hpp"
+#include "geometry/visibility/direct_light.hpp"
 
 namespace lambert {
 

@@ -1,4 +1,4 @@
-#include "geometry/raytrace.hpp"
+#include "geometry/render/raytrace.hpp"
 
 #include <cmath>
 

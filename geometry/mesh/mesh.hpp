@@ -7,11 +7,19 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "geometry/scene.hpp"
 
 namespace lambert {
+
+/// The key of the undirected edge between vertices a and b (the same for (b, a)).
+inline std::uint64_t edge_key(std::int32_t a, std::int32_t b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
+         static_cast<std::uint32_t>(b);
+}
 
 /// One radiosity element: a planar triangle (vertex_count 3) or quad (4).
 struct Patch {
@@ -20,7 +28,7 @@ struct Patch {
   double area = 0.0;
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();    ///< unit front normal (winding)
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< area centroid
-  Eigen::Vector3d rho = Eigen::Vector3d::Zero();       ///< its face's Face::rho, else its material's
+  Eigen::Vector3d rho = Eigen::Vector3d::Zero();  ///< its face's Face::rho, else its material's
   Eigen::Vector3d emission = Eigen::Vector3d::Zero();  ///< emitted radiosity E (W/m^2)
   std::int32_t surface = 0;                            ///< index into Scene::surfaces
 };
@@ -34,8 +42,8 @@ struct PatchMesh {
   /// Specular part of each surface's material (indexed by surface id); empty when no
   /// surface is specular (every mesh of a purely diffuse scene).
   std::vector<Specular> surface_specular;
-  double scale = 1.0;                      ///< bounding-box diagonal (for relative epsilons)
-  double max_edge = 0.0;                   ///< edge bound used (0 = one element per face)
+  double scale = 1.0;     ///< bounding-box diagonal (for relative epsilons)
+  double max_edge = 0.0;  ///< edge bound used (0 = one element per face)
 
   std::int32_t size() const { return static_cast<std::int32_t>(patches.size()); }
   /// True when some surface is specular (rays continue at it).
@@ -68,8 +76,8 @@ struct MeshOptions {
 
 /// What mesh_scene will build, computed without building it (O(faces) per trial edge).
 struct MeshPlan {
-  double max_edge = 0.0;      ///< the edge bound mesh_scene will use
-  std::int64_t patches = 0;   ///< the exact patch count it will produce
+  double max_edge = 0.0;     ///< the edge bound mesh_scene will use
+  std::int64_t patches = 0;  ///< the exact patch count it will produce
 };
 /// The edge bound and patch count mesh_scene(scene, options) will use and produce.
 MeshPlan plan_mesh(const Scene& scene, const MeshOptions& options);

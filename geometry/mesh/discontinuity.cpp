@@ -1,4 +1,4 @@
-#include "geometry/discontinuity.hpp"
+#include "geometry/mesh/discontinuity.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -7,9 +7,9 @@
 #include <set>
 
 #include "core/parallel.hpp"
-#include "geometry/bvh.hpp"
 #include "geometry/polygon.hpp"
-#include "geometry/shadow.hpp"
+#include "geometry/visibility/bvh.hpp"
+#include "geometry/visibility/shadow.hpp"
 
 namespace lambert {
 namespace {
@@ -90,8 +90,10 @@ bool clip_interval(double fa, double fb, double& t0, double& t1) {
   if (fa >= 0 && fb >= 0) return t0 <= t1;
   if (fa < 0 && fb < 0) return false;
   const double t = fa / (fa - fb);
-  if (fa < 0) t0 = std::max(t0, t);
-  else t1 = std::min(t1, t);
+  if (fa < 0)
+    t0 = std::max(t0, t);
+  else
+    t1 = std::min(t1, t);
   return t0 < t1;
 }
 
@@ -100,14 +102,21 @@ bool clip_interval(double fa, double fb, double& t0, double& t1) {
 // midpoints are inside (crossing number in the plane). Any simple polygon, O(corners).
 double length_inside(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Polygon3& poly,
                      const Eigen::Vector3d& n) {
-  const Eigen::Vector3d u = (std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY()).cross(n).normalized();
+  const Eigen::Vector3d u =
+      (std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY())
+          .cross(n)
+          .normalized();
   const Eigen::Vector3d v = n.cross(u);
-  auto to2 = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d((p - poly[0]).dot(u), (p - poly[0]).dot(v)); };
+  auto to2 = [&](const Eigen::Vector3d& p) {
+    return Eigen::Vector2d((p - poly[0]).dot(u), (p - poly[0]).dot(v));
+  };
   const Eigen::Vector2d A = to2(a), D = to2(b) - A;
   std::vector<Eigen::Vector2d> P;
   for (const auto& p : poly) P.push_back(to2(p));
   std::vector<double> ts = {0.0, 1.0};
-  auto cross2 = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) { return x.x() * y.y() - x.y() * y.x(); };
+  auto cross2 = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+    return x.x() * y.y() - x.y() * y.x();
+  };
   for (size_t k = 0; k < P.size(); ++k) {
     const Eigen::Vector2d E = P[(k + 1) % P.size()] - P[k];
     const double den = cross2(D, E);
@@ -126,7 +135,8 @@ double length_inside(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const P
   };
   double t_inside = 0.0;
   for (size_t k = 0; k + 1 < ts.size(); ++k)
-    if (ts[k + 1] > ts[k] && inside(A + 0.5 * (ts[k] + ts[k + 1]) * D)) t_inside += ts[k + 1] - ts[k];
+    if (ts[k + 1] > ts[k] && inside(A + 0.5 * (ts[k] + ts[k + 1]) * D))
+      t_inside += ts[k + 1] - ts[k];
   return t_inside * (b - a).norm();
 }
 
@@ -208,15 +218,18 @@ std::vector<DiscontinuitySegment> discontinuity_segments(const Scene& scene,
       sources.push_back(static_cast<std::int32_t>(f));
 
   // Unique blocker edges and vertices (welded), each with its position.
-  std::map<std::pair<std::int32_t, std::int32_t>, std::pair<Eigen::Vector3d, Eigen::Vector3d>> edges;
+  std::map<std::pair<std::int32_t, std::int32_t>, std::pair<Eigen::Vector3d, Eigen::Vector3d>>
+      edges;
   std::map<std::int32_t, Eigen::Vector3d> vertices;
   for (const auto& g : faces) {
     for (size_t k = 0; k < g.poly.size(); ++k) {
       const size_t l = (k + 1) % g.poly.size();
       vertices.emplace(g.ids[k], g.poly[k]);
       if (g.ids[k] == g.ids[l]) continue;
-      if (g.ids[k] < g.ids[l]) edges.emplace(std::make_pair(g.ids[k], g.ids[l]), std::make_pair(g.poly[k], g.poly[l]));
-      else edges.emplace(std::make_pair(g.ids[l], g.ids[k]), std::make_pair(g.poly[l], g.poly[k]));
+      if (g.ids[k] < g.ids[l])
+        edges.emplace(std::make_pair(g.ids[k], g.ids[l]), std::make_pair(g.poly[k], g.poly[l]));
+      else
+        edges.emplace(std::make_pair(g.ids[l], g.ids[k]), std::make_pair(g.poly[l], g.poly[k]));
     }
   }
 
@@ -232,7 +245,8 @@ std::vector<DiscontinuitySegment> discontinuity_segments(const Scene& scene,
     const WeldedFace& g = faces[f];
     for (size_t k = 0; k < g.poly.size(); ++k) {
       const std::int32_t a = g.ids[k], b = g.ids[(k + 1) % g.poly.size()];
-      if (a != b) edge_faces[{std::min(a, b), std::max(a, b)}].push_back(static_cast<std::int32_t>(f));
+      if (a != b)
+        edge_faces[{std::min(a, b), std::max(a, b)}].push_back(static_cast<std::int32_t>(f));
     }
   }
   auto silhouettes = [&](const WeldedFace& S,
@@ -265,150 +279,157 @@ std::vector<DiscontinuitySegment> discontinuity_segments(const Scene& scene,
   for (std::int32_t sf : sources) silhouettes(faces[sf], source_edges[sf], source_vertices[sf]);
 
   std::vector<std::vector<DiscontinuitySegment>> per_face(faces.size());
-  parallel_for(static_cast<std::int64_t>(faces.size()), 1, options.threads,
-               [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t r = begin; r < end; ++r) {
-      const WeldedFace& R = faces[r];
-      auto& segs = per_face[r];
-      if (R.normal.squaredNorm() == 0) continue;
-      // Lines run a margin past the face's bounding box, so that they cross its boundary
-      // transversally instead of ending at rounding distance from it (a feature Delaunay
-      // refinement could not resolve); the mesher keeps only what lies inside the faces.
-      // A line with (almost) nothing inside the face polygon is dropped: it is no
-      // discontinuity of the face, and one running just outside an edge at a small angle
-      // (the wedges of a neighbour's edge on a slightly warped wall) made the refinement
-      // chase the sliver between them all along the edge.
-      const double pad = kOverrun * (R.hi - R.lo).norm() + eps;
-      const Eigen::Vector3d lo = R.lo - Eigen::Vector3d::Constant(pad);
-      const Eigen::Vector3d hi = R.hi + Eigen::Vector3d::Constant(pad);
-      auto add = [&](Eigen::Vector3d a, Eigen::Vector3d b, int order) {
-        if (!clip_to_box(a, b, lo, hi) || (b - a).norm() <= eps) return;
-        if (length_inside(a, b, R.poly, R.normal) > kMinInside * (R.hi - R.lo).norm())
-          segs.push_back({a, b, order, static_cast<std::int32_t>(r)});
-      };
+  parallel_for(
+      static_cast<std::int64_t>(faces.size()), 1, options.threads,
+      [&](std::int64_t begin, std::int64_t end) {
+        for (std::int64_t r = begin; r < end; ++r) {
+          const WeldedFace& R = faces[r];
+          auto& segs = per_face[r];
+          if (R.normal.squaredNorm() == 0) continue;
+          // Lines run a margin past the face's bounding box, so that they cross its boundary
+          // transversally instead of ending at rounding distance from it (a feature Delaunay
+          // refinement could not resolve); the mesher keeps only what lies inside the faces.
+          // A line with (almost) nothing inside the face polygon is dropped: it is no
+          // discontinuity of the face, and one running just outside an edge at a small angle
+          // (the wedges of a neighbour's edge on a slightly warped wall) made the refinement
+          // chase the sliver between them all along the edge.
+          const double pad = kOverrun * (R.hi - R.lo).norm() + eps;
+          const Eigen::Vector3d lo = R.lo - Eigen::Vector3d::Constant(pad);
+          const Eigen::Vector3d hi = R.hi + Eigen::Vector3d::Constant(pad);
+          auto add = [&](Eigen::Vector3d a, Eigen::Vector3d b, int order) {
+            if (!clip_to_box(a, b, lo, hi) || (b - a).norm() <= eps) return;
+            if (length_inside(a, b, R.poly, R.normal) > kMinInside * (R.hi - R.lo).norm())
+              segs.push_back({a, b, order, static_cast<std::int32_t>(r)});
+          };
 
-      // D0: blocker faces touching or piercing the receiver's plane.
-      for (size_t b = 0; b < faces.size(); ++b) {
-        if (static_cast<std::int64_t>(b) == r) continue;
-        const WeldedFace& B = faces[b];
-        std::vector<double> h;
-        bool off_plane = false;
-        for (const auto& p : B.poly) {
-          h.push_back(R.height(p));
-          off_plane = off_plane || std::abs(h.back()) > eps;
-        }
-        if (!off_plane) continue;  // coplanar: part of the receiver's plane, not a blocker
-        std::vector<std::array<int, 3>> tris;
-        if (B.poly.size() == 3) tris.push_back({0, 1, 2});
-        else tris = triangulate(B.poly);
-        for (const auto& t : tris) {
-          std::vector<Eigen::Vector3d> on;
-          for (int k = 0; k < 3; ++k) {
-            const int i = t[k], j = t[(k + 1) % 3];
-            if (std::abs(h[i]) <= eps) on.push_back(B.poly[i]);
-            if ((h[i] > eps && h[j] < -eps) || (h[i] < -eps && h[j] > eps))
-              on.push_back(B.poly[i] + (h[i] / (h[i] - h[j])) * (B.poly[j] - B.poly[i]));
+          // D0: blocker faces touching or piercing the receiver's plane.
+          for (size_t b = 0; b < faces.size(); ++b) {
+            if (static_cast<std::int64_t>(b) == r) continue;
+            const WeldedFace& B = faces[b];
+            std::vector<double> h;
+            bool off_plane = false;
+            for (const auto& p : B.poly) {
+              h.push_back(R.height(p));
+              off_plane = off_plane || std::abs(h.back()) > eps;
+            }
+            if (!off_plane) continue;  // coplanar: part of the receiver's plane, not a blocker
+            std::vector<std::array<int, 3>> tris;
+            if (B.poly.size() == 3)
+              tris.push_back({0, 1, 2});
+            else
+              tris = triangulate(B.poly);
+            for (const auto& t : tris) {
+              std::vector<Eigen::Vector3d> on;
+              for (int k = 0; k < 3; ++k) {
+                const int i = t[k], j = t[(k + 1) % 3];
+                if (std::abs(h[i]) <= eps) on.push_back(B.poly[i]);
+                if ((h[i] > eps && h[j] < -eps) || (h[i] < -eps && h[j] > eps))
+                  on.push_back(B.poly[i] + (h[i] / (h[i] - h[j])) * (B.poly[j] - B.poly[i]));
+              }
+              if (on.size() < 2) continue;
+              size_t ia = 0, ib = 1;
+              for (size_t i = 0; i < on.size(); ++i)
+                for (size_t j = i + 1; j < on.size(); ++j)
+                  if ((on[i] - on[j]).squaredNorm() > (on[ia] - on[ib]).squaredNorm())
+                    ia = i, ib = j;
+              add(on[ia] - R.height(on[ia]) * R.normal, on[ib] - R.height(on[ib]) * R.normal, 0);
+            }
           }
-          if (on.size() < 2) continue;
-          size_t ia = 0, ib = 1;
-          for (size_t i = 0; i < on.size(); ++i)
-            for (size_t j = i + 1; j < on.size(); ++j)
-              if ((on[i] - on[j]).squaredNorm() > (on[ia] - on[ib]).squaredNorm()) ia = i, ib = j;
-          add(on[ia] - R.height(on[ia]) * R.normal, on[ib] - R.height(on[ib]) * R.normal, 0);
-        }
-      }
 
-      // D1/D2: VE and EV wedges of each source with every blocker edge and vertex.
-      auto trace = [&](const Wedge& w) {
-        // Receiver point of parameter u: the line s(u) -> m(u) meets the receiver's plane.
-        auto at = [&](double u, Eigen::Vector3d& q, Eigen::Vector3d& s, Eigen::Vector3d& m) {
-          s = (1 - u) * w.s0 + u * w.s1;
-          m = (1 - u) * w.m0 + u * w.m1;
-          const double hs = R.height(s), hm = R.height(m);
-          q = s + (m - s) * (hs / (hs - hm));
-          q -= R.height(q) * R.normal;  // on the plane to rounding
-        };
-        Eigen::Vector3d q0, q1, s, m;
-        at(0, q0, s, m);
-        at(1, q1, s, m);
-        Eigen::Vector3d c0 = q0, c1 = q1;
-        if (!clip_to_box(c0, c1, lo, hi)) return;
-        const int n = std::clamp(static_cast<int>(std::ceil((q1 - q0).norm() / piece)), 1, kMaxPieces);
-        auto free_line = [&](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
-          const Eigen::Vector3d d = to - from;
-          return !bvh.occluded(from.cast<float>(), d.cast<float>(), 0.0f,
-                               static_cast<float>(1.0 - kGrazeStop));
-        };
-        int run_start = -1;
-        for (int k = 0; k <= n; ++k) {
-          bool visible = false;
-          if (k < n) {
-            Eigen::Vector3d q;
-            at((k + 0.5) / n, q, s, m);
-            const bool inside = (q.array() >= lo.array()).all() && (q.array() <= hi.array()).all();
-            visible = inside && free_line(q + offset * R.normal, m) &&
-                      free_line(s + offset * (m - s).normalized(), m);
-          }
-          if (visible && run_start < 0) run_start = k;
-          if (!visible && run_start >= 0) {
-            Eigen::Vector3d a, b;
-            at(static_cast<double>(run_start) / n, a, s, m);
-            at(static_cast<double>(k) / n, b, s, m);
-            add(a, b, 1);
-            run_start = -1;
+          // D1/D2: VE and EV wedges of each source with every blocker edge and vertex.
+          auto trace = [&](const Wedge& w) {
+            // Receiver point of parameter u: the line s(u) -> m(u) meets the receiver's plane.
+            auto at = [&](double u, Eigen::Vector3d& q, Eigen::Vector3d& s, Eigen::Vector3d& m) {
+              s = (1 - u) * w.s0 + u * w.s1;
+              m = (1 - u) * w.m0 + u * w.m1;
+              const double hs = R.height(s), hm = R.height(m);
+              q = s + (m - s) * (hs / (hs - hm));
+              q -= R.height(q) * R.normal;  // on the plane to rounding
+            };
+            Eigen::Vector3d q0, q1, s, m;
+            at(0, q0, s, m);
+            at(1, q1, s, m);
+            Eigen::Vector3d c0 = q0, c1 = q1;
+            if (!clip_to_box(c0, c1, lo, hi)) return;
+            const int n =
+                std::clamp(static_cast<int>(std::ceil((q1 - q0).norm() / piece)), 1, kMaxPieces);
+            auto free_line = [&](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+              const Eigen::Vector3d d = to - from;
+              return !bvh.occluded(from.cast<float>(), d.cast<float>(), 0.0f,
+                                   static_cast<float>(1.0 - kGrazeStop));
+            };
+            int run_start = -1;
+            for (int k = 0; k <= n; ++k) {
+              bool visible = false;
+              if (k < n) {
+                Eigen::Vector3d q;
+                at((k + 0.5) / n, q, s, m);
+                const bool inside =
+                    (q.array() >= lo.array()).all() && (q.array() <= hi.array()).all();
+                visible = inside && free_line(q + offset * R.normal, m) &&
+                          free_line(s + offset * (m - s).normalized(), m);
+              }
+              if (visible && run_start < 0) run_start = k;
+              if (!visible && run_start >= 0) {
+                Eigen::Vector3d a, b;
+                at(static_cast<double>(run_start) / n, a, s, m);
+                at(static_cast<double>(k) / n, b, s, m);
+                add(a, b, 1);
+                run_start = -1;
+              }
+            }
+          };
+          for (std::int32_t sf : sources) {
+            if (sf == r) continue;
+            const WeldedFace& S = faces[sf];
+            double hs_max = -INFINITY;
+            for (const auto& p : S.poly) hs_max = std::max(hs_max, R.height(p));
+            if (hs_max <= eps) continue;  // the source is behind the receiver
+            bool receiver_in_front = false;
+            for (const auto& p : R.poly) receiver_in_front = receiver_in_front || S.height(p) > eps;
+            if (!receiver_in_front) continue;
+            // VE: source vertex, blocker edge (the edge's part between the receiver's plane and
+            // the source vertex's height, in front of the source).
+            for (const auto& sv : S.poly) {
+              const double hs = R.height(sv);
+              if (hs <= eps) continue;
+              for (const auto& [key, e] : edges) {
+                if (!source_edges[sf].count(key)) continue;
+                double t0 = 0, t1 = 1;
+                const double ha = R.height(e.first), hb = R.height(e.second);
+                if (!clip_interval(ha - eps, hb - eps, t0, t1)) continue;
+                const double top = hs * (1 - kVanishing);
+                if (!clip_interval(top - ha, top - hb, t0, t1)) continue;
+                if (!clip_interval(S.height(e.first) - eps, S.height(e.second) - eps, t0, t1))
+                  continue;
+                Wedge w;
+                w.s0 = w.s1 = sv;
+                w.m0 = e.first + t0 * (e.second - e.first);
+                w.m1 = e.first + t1 * (e.second - e.first);
+                trace(w);
+              }
+            }
+            // EV: source edge, blocker vertex (the edge's part above the vertex's height).
+            for (size_t k = 0; k < S.poly.size(); ++k) {
+              const Eigen::Vector3d& a = S.poly[k];
+              const Eigen::Vector3d& b = S.poly[(k + 1) % S.poly.size()];
+              for (const auto& [id, p] : vertices) {
+                if (!source_vertices[sf].count(id)) continue;
+                const double hp = R.height(p);
+                if (hp <= eps || S.height(p) <= eps) continue;
+                double t0 = 0, t1 = 1;
+                const double floor_h = hp + kVanishing * (hs_max - hp) + eps;
+                if (!clip_interval(R.height(a) - floor_h, R.height(b) - floor_h, t0, t1)) continue;
+                Wedge w;
+                w.s0 = a + t0 * (b - a);
+                w.s1 = a + t1 * (b - a);
+                w.m0 = w.m1 = p;
+                trace(w);
+              }
+            }
           }
         }
-      };
-      for (std::int32_t sf : sources) {
-        if (sf == r) continue;
-        const WeldedFace& S = faces[sf];
-        double hs_max = -INFINITY;
-        for (const auto& p : S.poly) hs_max = std::max(hs_max, R.height(p));
-        if (hs_max <= eps) continue;  // the source is behind the receiver
-        bool receiver_in_front = false;
-        for (const auto& p : R.poly) receiver_in_front = receiver_in_front || S.height(p) > eps;
-        if (!receiver_in_front) continue;
-        // VE: source vertex, blocker edge (the edge's part between the receiver's plane and
-        // the source vertex's height, in front of the source).
-        for (const auto& sv : S.poly) {
-          const double hs = R.height(sv);
-          if (hs <= eps) continue;
-          for (const auto& [key, e] : edges) {
-            if (!source_edges[sf].count(key)) continue;
-            double t0 = 0, t1 = 1;
-            const double ha = R.height(e.first), hb = R.height(e.second);
-            if (!clip_interval(ha - eps, hb - eps, t0, t1)) continue;
-            const double top = hs * (1 - kVanishing);
-            if (!clip_interval(top - ha, top - hb, t0, t1)) continue;
-            if (!clip_interval(S.height(e.first) - eps, S.height(e.second) - eps, t0, t1)) continue;
-            Wedge w;
-            w.s0 = w.s1 = sv;
-            w.m0 = e.first + t0 * (e.second - e.first);
-            w.m1 = e.first + t1 * (e.second - e.first);
-            trace(w);
-          }
-        }
-        // EV: source edge, blocker vertex (the edge's part above the vertex's height).
-        for (size_t k = 0; k < S.poly.size(); ++k) {
-          const Eigen::Vector3d& a = S.poly[k];
-          const Eigen::Vector3d& b = S.poly[(k + 1) % S.poly.size()];
-          for (const auto& [id, p] : vertices) {
-            if (!source_vertices[sf].count(id)) continue;
-            const double hp = R.height(p);
-            if (hp <= eps || S.height(p) <= eps) continue;
-            double t0 = 0, t1 = 1;
-            const double floor_h = hp + kVanishing * (hs_max - hp) + eps;
-            if (!clip_interval(R.height(a) - floor_h, R.height(b) - floor_h, t0, t1)) continue;
-            Wedge w;
-            w.s0 = a + t0 * (b - a);
-            w.s1 = a + t1 * (b - a);
-            w.m0 = w.m1 = p;
-            trace(w);
-          }
-        }
-      }
-    }
-  });
+      });
   for (auto& segs : per_face) out.insert(out.end(), segs.begin(), segs.end());
   return out;
 }

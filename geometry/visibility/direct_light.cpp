@@ -1,4 +1,4 @@
-#include "geometry/direct_light.hpp"
+#include "geometry/visibility/direct_light.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -9,7 +9,7 @@
 #include "core/parallel.hpp"
 #include "geometry/formfactors/constants.hpp"
 #include "geometry/polygon.hpp"
-#include "geometry/shadow.hpp"
+#include "geometry/visibility/shadow.hpp"
 
 namespace lambert {
 // Named (not anonymous) because DirectLight::Faces holds it: a class with external linkage may
@@ -114,18 +114,17 @@ Eigen::Vector3d DirectLight::irradiance(const Eigen::Vector3d& x,
 
 Eigen::MatrixX3d exact_direct_irradiance(const Scene& scene,
                                          const std::vector<Eigen::Vector3d>& points,
-                                         const std::vector<Eigen::Vector3d>& normals,
-                                         int threads) {
+                                         const std::vector<Eigen::Vector3d>& normals, int threads) {
   Eigen::MatrixX3d H = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(points.size()), 3);
   LAMBERT_CHECK(points.size() == normals.size(), "exact_direct_irradiance: one normal per point");
   const DirectLight light(scene);
   if (light.empty()) return H;
   parallel_for(static_cast<std::int64_t>(points.size()), 16, threads,
                [&](std::int64_t begin, std::int64_t end) {
-    std::vector<Polygon3> blockers;
-    for (std::int64_t i = begin; i < end; ++i)
-      H.row(i) = light.irradiance(points[i], normals[i], blockers).transpose();
-  });
+                 std::vector<Polygon3> blockers;
+                 for (std::int64_t i = begin; i < end; ++i)
+                   H.row(i) = light.irradiance(points[i], normals[i], blockers).transpose();
+               });
   return H;
 }
 

@@ -1,4 +1,4 @@
-#include "geometry/medium.hpp"
+#include "geometry/media/medium.hpp"
 
 #include <cstring>
 #include <sstream>

@@ -33,7 +33,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 #include "geometry/scene.hpp"
 
 namespace lambert {

@@ -33,10 +33,10 @@
 #include <Eigen/Core>
 #include <cstdint>
 
-#include "geometry/bvh.hpp"
-#include "geometry/direct_light.hpp"
-#include "geometry/mesh.hpp"
-#include "geometry/vertex_field.hpp"
+#include "geometry/mesh/mesh.hpp"
+#include "geometry/render/vertex_field.hpp"
+#include "geometry/visibility/bvh.hpp"
+#include "geometry/visibility/direct_light.hpp"
 
 namespace lambert {
 

@@ -1,4 +1,4 @@
-#include "geometry/vertex_field.hpp"
+#include "geometry/render/vertex_field.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -8,7 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/sampling.hpp"
-#include "geometry/direct_light.hpp"
+#include "geometry/visibility/direct_light.hpp"
 
 namespace lambert {
 namespace {
@@ -361,9 +361,9 @@ VertexField exact_direct_vertex_field(const Scene& scene, const PatchMesh& mesh,
     rho.row(i) = mesh.patches[i].rho.transpose();
   }
   const Eigen::MatrixX3d direct = exact_direct_irradiance(scene, f.positions, f.normals, threads);
-  f.values = area_weighted(mesh, f, E).array() +
-             area_weighted(mesh, f, rho).array() *
-                 (direct + area_weighted(mesh, f, indirect)).array();
+  f.values =
+      area_weighted(mesh, f, E).array() +
+      area_weighted(mesh, f, rho).array() * (direct + area_weighted(mesh, f, indirect)).array();
   anchor_hanging_vertices(find_hanging_vertices(mesh, f), f);
   if (power) *power = surface_power(mesh, patch_values, f);
   return f;

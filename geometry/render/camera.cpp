@@ -1,4 +1,4 @@
-#include "geometry/camera.hpp"
+#include "geometry/render/camera.hpp"
 
 #include <Eigen/Geometry>
 #include <cmath>

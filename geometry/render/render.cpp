@@ -1,4 +1,4 @@
-#include "geometry/render.hpp"
+#include "geometry/render/render.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -10,7 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/sampling.hpp"
-#include "geometry/discontinuity.hpp"
+#include "geometry/mesh/discontinuity.hpp"
 #include "geometry/polygon.hpp"
 
 namespace lambert {
@@ -77,12 +77,6 @@ SurfaceElements collect(const Scene& scene, std::int32_t surface,
     }
   }
   return out;
-}
-
-std::uint64_t edge_key(std::int32_t a, std::int32_t b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
-         static_cast<std::uint32_t>(b);
 }
 
 // The conformity constraints of mesh_scene as classes of edges: a triangle's three edges get
@@ -217,8 +211,8 @@ Patch make_patch(const PatchMesh& mesh, std::array<std::int32_t, 4> v, int n) {
 namespace {
 
 // Emits the patches of one surface into `mesh`.
-void subdivide(const SurfaceElements& s, double max_edge, std::int32_t surface,
-               const Material& mat, PatchMesh& mesh) {
+void subdivide(const SurfaceElements& s, double max_edge, std::int32_t surface, const Material& mat,
+               PatchMesh& mesh) {
   const auto count = edge_counts(s, max_edge);
   auto new_vertex = [&](const Eigen::Vector3d& p) {
     mesh.vertices.push_back(p);
@@ -258,14 +252,21 @@ void subdivide(const SurfaceElements& s, double max_edge, std::int32_t surface,
       const std::int64_t n = count.at(edge_key(e.v[0], e.v[1]));
       // Grid point (a, b), a + b <= n: v0 + a/n (v1 - v0) + b/n (v2 - v0).
       std::vector<std::int32_t> id((n + 1) * (n + 1), -1);
-      auto at = [&](std::int64_t a, std::int64_t b) -> std::int32_t& { return id[a * (n + 1) + b]; };
+      auto at = [&](std::int64_t a, std::int64_t b) -> std::int32_t& {
+        return id[a * (n + 1) + b];
+      };
       for (std::int64_t a = 0; a <= n; ++a) {
         for (std::int64_t b = 0; a + b <= n; ++b) {
-          if (b == 0) at(a, b) = edge_point(e.v[0], e.v[1], a);
-          else if (a == 0) at(a, b) = edge_point(e.v[0], e.v[2], b);
-          else if (a + b == n) at(a, b) = edge_point(e.v[1], e.v[2], b);
-          else at(a, b) = new_vertex(P[e.v[0]] + (static_cast<double>(a) / n) * (P[e.v[1]] - P[e.v[0]]) +
-                                     (static_cast<double>(b) / n) * (P[e.v[2]] - P[e.v[0]]));
+          if (b == 0)
+            at(a, b) = edge_point(e.v[0], e.v[1], a);
+          else if (a == 0)
+            at(a, b) = edge_point(e.v[0], e.v[2], b);
+          else if (a + b == n)
+            at(a, b) = edge_point(e.v[1], e.v[2], b);
+          else
+            at(a, b) =
+                new_vertex(P[e.v[0]] + (static_cast<double>(a) / n) * (P[e.v[1]] - P[e.v[0]]) +
+                           (static_cast<double>(b) / n) * (P[e.v[2]] - P[e.v[0]]));
         }
       }
       for (std::int64_t a = 0; a < n; ++a) {
@@ -279,13 +280,19 @@ void subdivide(const SurfaceElements& s, double max_edge, std::int32_t surface,
       const std::int64_t nv = count.at(edge_key(e.v[1], e.v[2]));
       // Grid point (a, b): bilinear in the quad; a along v0->v1, b along v0->v3.
       std::vector<std::int32_t> id((nu + 1) * (nv + 1), -1);
-      auto at = [&](std::int64_t a, std::int64_t b) -> std::int32_t& { return id[a * (nv + 1) + b]; };
+      auto at = [&](std::int64_t a, std::int64_t b) -> std::int32_t& {
+        return id[a * (nv + 1) + b];
+      };
       for (std::int64_t a = 0; a <= nu; ++a) {
         for (std::int64_t b = 0; b <= nv; ++b) {
-          if (b == 0) at(a, b) = edge_point(e.v[0], e.v[1], a);
-          else if (b == nv) at(a, b) = edge_point(e.v[3], e.v[2], a);
-          else if (a == 0) at(a, b) = edge_point(e.v[0], e.v[3], b);
-          else if (a == nu) at(a, b) = edge_point(e.v[1], e.v[2], b);
+          if (b == 0)
+            at(a, b) = edge_point(e.v[0], e.v[1], a);
+          else if (b == nv)
+            at(a, b) = edge_point(e.v[3], e.v[2], a);
+          else if (a == 0)
+            at(a, b) = edge_point(e.v[0], e.v[3], b);
+          else if (a == nu)
+            at(a, b) = edge_point(e.v[1], e.v[2], b);
           else {
             const double u = static_cast<double>(a) / nu, w = static_cast<double>(b) / nv;
             at(a, b) = new_vertex((1 - u) * (1 - w) * P[e.v[0]] + u * (1 - w) * P[e.v[1]] +
@@ -379,7 +386,8 @@ double mesh_peak_bytes(std::int64_t patches) {
   // Per patch: the Patch itself, about one vertex (position and surface id), 2x capacity
   // while the vectors grow; and the Embree BVH over the quads (float corners and index,
   // about 4 x 16 + 16 bytes per primitive plus nodes, ~128 bytes).
-  const double per_patch = 2.0 * (sizeof(Patch) + sizeof(Eigen::Vector3d) + sizeof(std::int32_t)) + 128.0;
+  const double per_patch =
+      2.0 * (sizeof(Patch) + sizeof(Eigen::Vector3d) + sizeof(std::int32_t)) + 128.0;
   return static_cast<double>(patches) * per_patch;
 }
 

@@ -7,7 +7,7 @@
 #include <memory>
 #include <vector>
 
-#include "geometry/mesh.hpp"
+#include "geometry/mesh/mesh.hpp"
 
 namespace lambert {
 
@@ -37,8 +37,7 @@ class Bvh {
 
   /// Closest hit on origin + t * direction for t in (tnear, tfar).
   RayHit intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
-                   float tnear = 0.0f,
-                   float tfar = std::numeric_limits<float>::infinity()) const;
+                   float tnear = 0.0f, float tfar = std::numeric_limits<float>::infinity()) const;
 
   /// Appends to `out` every patch whose bounds may meet the ball (centre, radius), a
   /// superset of those that do (Embree's point query over the BVH's float boxes, the
