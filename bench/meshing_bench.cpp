@@ -9,7 +9,8 @@
 // of the Gouraud field at 400 points on the line y = 1.75 across umbra and penumbra, with
 // the vertex values `run` uses (exact direct light on discontinuity meshes, conservative
 // otherwise) and, in the last column, with conservative ones for every method. Adaptive runs start
-// from the uniform mesh of a quarter of the target and refine (apps/adapt_stage) until the target.
+// from the uniform mesh of a quarter of the target and refine (pipeline/adapt_stage) until the
+// target.
 //
 // Cornell box (built-in): per-surface average radiosity against a reference (uniform,
 // --ref-patches, gather 4096 rays) for uniform and discontinuity meshing (hybrid, 32

@@ -46,7 +46,8 @@ TEST(Cli, InfoDescribesTheBuiltInCornellBox) {
   EXPECT_NE(out.find("emitters: light"), std::string::npos);
 }
 
-// Loading options are shared by every command that loads a scene (apps/common.cpp).
+// Loading options are shared by every command that loads a scene (apps/options.cpp,
+// pipeline/job.cpp).
 TEST(Cli, SceneLoadingOptionsAreCheckedAndApplied) {
   const std::string room = std::string(LAMBERT_TEST_CORPUS_DIR) + "/obj/blender_room.obj";
   const std::string bare = std::string(LAMBERT_TEST_CORPUS_DIR) + "/obj/no_mtllib.obj";

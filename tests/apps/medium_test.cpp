@@ -1,5 +1,5 @@
 // Participating media: the zonal method's physics (geometry/formfactors/media.hpp) solved
-// through apps/problem.hpp's extended problem, and the CLI's medium options.
+// through pipeline/problem.hpp's extended problem, and the CLI's medium options.
 
 #include <gtest/gtest.h>
 

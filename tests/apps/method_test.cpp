@@ -1,4 +1,4 @@
-// The method level of the CLI (apps/method.*): --method matrix|hierarchical in run, solve,
+// The method level of the CLI (pipeline/method.*): --method matrix|hierarchical in run, solve,
 // render and compare, and the refusal of every option that only the other method reads.
 // Refusals happen before any work, so these tests are fast.
 

@@ -3,7 +3,7 @@
 // the registries, and runs it on a small scene: the command either refuses the option (exit
 // 2) or its result B differs from the same command without it. Options that by design
 // change no result (output paths, logging, threads, memory checks) must leave B bitwise
-// equal instead. The table of apps/option_scope.cpp decides the refusals; this walk checks
+// equal instead. The table of pipeline/option_scope.cpp decides the refusals; this walk checks
 // it against what the code actually reads.
 
 #include "pipeline/option_scope.hpp"
