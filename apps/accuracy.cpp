@@ -378,37 +378,15 @@ CLI::App* add_accuracy_command(CLI::App& app, AccuracyOptions& opts) {
       "accuracy", "Compare form-factor estimators and settings with a reference: table, CSV, plot");
   opts.scene.default_patches = 200;
   add_scene_options(cmd, opts.scene);
-  cmd->add_option("--case", opts.analytic_case, "Built-in analytic case instead of SCENE")
-      ->check(CLI::IsMember({"parallel_squares", "perpendicular_squares", "unit_cube", "coaxial_disks", "partial_shadow"}));
-  cmd->add_option("--estimators", opts.estimators,
-                  "Estimator families to run (default: mc, hybrid, hemicube; gather on request)")
-      ->delimiter(',')
-      ->check(CLI::IsMember(form_factor_estimators()));
-  cmd->add_option("--mc-samples", opts.mc_samples, "Sample counts for mc")
-      ->delimiter(',')
-      ->check(CLI::Range(1, 1 << 20))
-      ->capture_default_str();
-  cmd->add_option("--hybrid-samples", opts.hybrid_samples, "Sample counts for hybrid")
-      ->delimiter(',')
-      ->check(CLI::Range(1, 1 << 20))
-      ->capture_default_str();
-  cmd->add_option("--gather-rays", opts.gather_rays, "Rays per patch for gather")
-      ->delimiter(',')
-      ->check(CLI::Range(1, 1 << 24))
-      ->capture_default_str();
-  cmd->add_option("--hemicube-res", opts.hemicube_res, "Resolutions for hemicube")
-      ->delimiter(',')
-      ->check(CLI::Range(4, 8192))
-      ->capture_default_str();
-  cmd->add_flag("--symmetrize", opts.symmetrize, "Also run each hemicube resolution symmetrized");
-  cmd->add_option("--reference-samples", opts.reference_samples,
-                  "Samples of the hybrid reference (scenes without a closed form)")
-      ->check(CLI::Range(1, 1 << 20))
-      ->capture_default_str();
-  cmd->add_option("-o,--output", opts.output,
-                  "Output directory (existing or ending in /) or file prefix")
-      ->check(output_prefix_check())
-      ->capture_default_str();
+  add_declared(cmd, "--case", opts.analytic_case);
+  add_declared(cmd, "--estimators", opts.estimators);
+  add_declared(cmd, "--mc-samples", opts.mc_samples);
+  add_declared(cmd, "--hybrid-samples", opts.hybrid_samples);
+  add_declared(cmd, "--gather-rays", opts.gather_rays);
+  add_declared(cmd, "--hemicube-res", opts.hemicube_res);
+  add_declared(cmd, "--symmetrize", opts.symmetrize);
+  add_declared(cmd, "--reference-samples", opts.reference_samples);
+  add_declared(cmd, "-o,--output", opts.output);
   add_run_options(cmd, opts.run);
   add_medium_options(cmd, opts.medium);
   return cmd;

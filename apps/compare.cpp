@@ -398,13 +398,8 @@ CLI::App* add_compare_command(CLI::App& app, CompareOptions& opts) {
   add_method_options(cmd, opts.method, true);
   add_ff_options(cmd, opts.ff);
   add_solve_options(cmd, opts.solve, false);
-  cmd->add_option("--solvers", opts.solvers, "Comma-separated solvers (default: all)")
-      ->delimiter(',')
-      ->check(CLI::IsMember(solver_names()));
-  cmd->add_option("-o,--output", opts.output,
-                  "Output directory (existing or ending in /) or file prefix")
-      ->check(output_prefix_check())
-      ->capture_default_str();
+  add_declared(cmd, "--solvers", opts.solvers);
+  add_declared(cmd, "-o,--output", opts.output);
   add_run_options(cmd, opts.run);
   add_medium_options(cmd, opts.medium);
   return cmd;

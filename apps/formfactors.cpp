@@ -172,25 +172,13 @@ CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts) {
   add_scene_options(cmd, opts.scene);
   add_run_options(cmd, opts.run);
   add_ff_options(cmd, opts.ff, false, /*tol_alias=*/true);
-  cmd->add_option("-o,--output", opts.output,
-                  "Output: F.mtx (Matrix Market), F.bin (binary), or JSON with --by-surface/--point")
-      ->check(output_file_check());
-  cmd->add_option("--report", opts.report, "Diagnostics JSON (default: OUTPUT with .report.json)")
-      ->check(output_file_check());
-  cmd->add_flag("--stderr", opts.with_stderr, "Also estimate and save per-entry standard errors (binary format)");
-  cmd->add_option("--ff-precision", opts.precision,
-                  "Saved values: double (exact) or float (half the value bytes, relative "
-                  "rounding <= 6e-8)")
-      ->check(CLI::IsMember({"double", "float"}));
-  auto* by = cmd->add_flag("--by-surface", opts.by_surface, "Write the surface-to-surface view-factor table as JSON");
-  auto* pt = cmd->add_option("--point", opts.point, "Sensor point X,Y,Z (differential area)")
-                 ->delimiter(',')
-                 ->expected(3)
-                 ->check(any_finite_number());
-  auto* nm = cmd->add_option("--normal", opts.normal, "Sensor normal NX,NY,NZ")
-                 ->delimiter(',')
-                 ->expected(3)
-                 ->check(any_finite_number());
+  add_declared(cmd, "-o,--output", opts.output);
+  add_declared(cmd, "--report", opts.report);
+  add_declared(cmd, "--stderr", opts.with_stderr);
+  add_declared(cmd, "--ff-precision", opts.precision);
+  auto* by = add_declared(cmd, "--by-surface", opts.by_surface);
+  auto* pt = add_declared(cmd, "--point", opts.point);
+  auto* nm = add_declared(cmd, "--normal", opts.normal);
   pt->needs(nm);
   nm->needs(pt);
   pt->excludes(by);

@@ -32,25 +32,10 @@ CLI::App* add_heat_command(CLI::App& app, HeatOptions& opts) {
   add_scene_options(cmd, opts.scene);
   add_ff_options(cmd, opts.ff);
   add_solve_options(cmd, opts.solve, true);
-  cmd->add_option("--surfaces", opts.surfaces,
-                  "JSON file: surface name (or \"*\") -> {\"emissivity\": E, \"temperature\": T} "
-                  "or {\"emissivity\": E, \"heat_flux\": Q}")
-      ->required()
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--ambient-temperature", opts.ambient_temperature,
-                  "Temperature (K) of the black environment that receives what escapes an "
-                  "open scene (default 0: escaping radiation is lost)")
-      ->check(finite_number(0.0, std::numeric_limits<double>::infinity()));
-  std::vector<std::string> units;
-  for (const auto& [name, m] : length_units()) units.push_back(name);
-  cmd->add_option("--length-unit", opts.length_unit, "Unit of the scene's coordinates")
-      ->check(CLI::IsMember(units))
-      ->capture_default_str();
-  cmd->add_option("-o,--output", opts.output,
-                  "Output prefix: PREFIX_surfaces.csv, PREFIX_patches.csv, PREFIX.json (a "
-                  "folder DIR/ gives DIR/heat_*)")
-      ->check(output_prefix_check())
-      ->capture_default_str();
+  add_declared(cmd, "--surfaces", opts.surfaces)->required();
+  add_declared(cmd, "--ambient-temperature", opts.ambient_temperature);
+  add_declared(cmd, "--length-unit", opts.length_unit);
+  add_declared(cmd, "-o,--output", opts.output);
   add_heat_output_options(cmd, opts.images);
   add_run_options(cmd, opts.run);
   return cmd;

@@ -53,17 +53,10 @@ double unit_position(double v, std::pair<double, double> range) {
 }  // namespace
 
 void add_heat_output_options(CLI::App* cmd, HeatImageArgs& args) {
-  cmd->add_option("--vertex-exr", args.vertex_exr,
-                  "Per-vertex EXR with channels temperature (K), heat_flux (W/m^2), radiosity")
-      ->check(output_file_check());
-  cmd->add_option("--ply", args.ply,
-                  "PLY mesh coloured by --image-quantity, with temperature, heat_flux, radiosity")
-      ->check(output_file_check());
-  cmd->add_option("--image", args.image, "Colour-mapped rendering (PNG) with a legend")
-      ->check(output_file_check());
-  cmd->add_option("--image-quantity", args.quantity, "What --image and --ply colour")
-      ->check(CLI::IsMember({"temperature", "flux"}))
-      ->capture_default_str();
+  add_declared(cmd, "--vertex-exr", args.vertex_exr);
+  add_declared(cmd, "--ply", args.ply);
+  add_declared(cmd, "--image", args.image);
+  add_declared(cmd, "--image-quantity", args.quantity);
   add_camera_options(cmd, args.camera);
 }
 

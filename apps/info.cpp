@@ -11,9 +11,7 @@ CLI::App* add_info_command(CLI::App& app, InfoOptions& opts) {
   opts.scene.default_patches = 2000;
   add_scene_options(cmd, opts.scene);
   add_run_options(cmd, opts.run);
-  cmd->add_flag("--list-surfaces", opts.list_surfaces,
-                "Print one line per surface (name, tab, material, tab, emits yes/no) and stop "
-                "(the names --emit matches)");
+  add_declared(cmd, "--list-surfaces", opts.list_surfaces);
   return cmd;
 }
 

@@ -1,21 +1,50 @@
 #pragma once
-// The command line's options: every CLI11 registration and check lives here, bound to the
-// pipeline's option structs (pipeline/), which know nothing of CLI11. After parsing, a struct's
-// `given` asks CLI11 which options were on the command line (option_given_on).
+// The command line's options: every option is registered with add_declared, which binds it to
+// a field of the pipeline's option structs (pipeline/, which know nothing of CLI11) and takes
+// its description, check, value count and default from its row in pipeline/option_specs.cpp.
+// After parsing, a struct's `given` asks CLI11 which options were on the command line
+// (option_given_on).
 
 #include <CLI/CLI.hpp>
+#include <functional>
 #include <string>
+#include <type_traits>
 
 #include "pipeline/adapt_stage.hpp"
 #include "pipeline/ff_stage.hpp"
 #include "pipeline/job.hpp"
 #include "pipeline/medium_stage.hpp"
 #include "pipeline/method.hpp"
+#include "pipeline/option_specs.hpp"
 #include "pipeline/render_stages.hpp"
 #include "pipeline/solve_stage.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
+
+/// The declaration (pipeline/option_specs.hpp) of the option `names` ("-j,--threads": keyed
+/// by the first long name) on the subcommand `cmd`; a missing row is a bug.
+const OptionSpec& declaration(const CLI::App* cmd, const std::string& names);
+
+/// Applies a declaration to a registered option: its check (each value against the row),
+/// value count, delimiter and the default --help shows.
+CLI::Option* apply_declaration(CLI::Option* o, const OptionSpec& spec);
+
+/// Registers the declared option `names` on `cmd`, bound to `field` (a flag for bool), with
+/// the row's description, check and default: every option of every command is registered
+/// this way, so the table is the one place an option is described and checked.
+template <class T>
+CLI::Option* add_declared(CLI::App* cmd, const std::string& names, T& field) {
+  const OptionSpec& spec = declaration(cmd, names);
+  if constexpr (std::is_same_v<T, bool>)
+    return apply_declaration(cmd->add_flag(names, field, spec.doc), spec);
+  else
+    return apply_declaration(cmd->add_option(names, field, spec.doc), spec);
+}
+
+/// add_declared for an option whose value goes through `set`.
+CLI::Option* add_declared_function(CLI::App* cmd, const std::string& names,
+                                   std::function<void(const std::string&)> set);
 
 /// The OptionGiven of a subcommand (it must outlive the run): true for a long name
 /// ("--omega") when the option whose first long name that is was on its command line.
@@ -28,22 +57,6 @@ void add_scene_options(CLI::App* cmd, SceneArgs& args);
 
 /// Adds -j/--threads, --seed, -q/--quiet, -v/--verbose and --max-memory to a subcommand.
 void add_run_options(CLI::App* cmd, RunArgs& args);
-
-/// CLI11 check for an output file option: its directory must exist (checked before any
-/// work, so a long computation never ends in a failed write).
-CLI::Validator output_file_check();
-
-/// CLI11 check for an output prefix option (see output_prefix): a name ending in '/' is a
-/// directory to create; otherwise the prefix's directory must exist.
-CLI::Validator output_prefix_check();
-
-/// CLI11 check for a floating-point option: a finite number (NaN and inf refused) in
-/// [lo, hi], open at lo when `open_low` and at hi when `open_high`; hi = infinity means no
-/// upper bound. The message states the range.
-CLI::Validator finite_number(double lo, double hi, bool open_low = false, bool open_high = false);
-
-/// CLI11 check for a floating-point value that may be any finite number (NaN, inf refused).
-CLI::Validator any_finite_number();
 
 /// Adds --method, --epsilon (a comma-separated list when `epsilon_list`), --min-area and
 /// --link-rays to a subcommand.

@@ -1,8 +1,8 @@
-// `lambert options`: every option of every command from the CLI's own registrations, the
-// declarations (pipeline/option_specs.hpp) and the table of which choice reads what
-// (pipeline/option_scope.hpp). `--markdown` prints the reference of docs/options.md, which
-// scripts/check_docs_options.sh keeps current.
+// `lambert options`: every option of every command, from the declarations
+// (pipeline/option_specs.hpp) of the options each command registers. `--markdown` prints the
+// reference of docs/options.md, which scripts/check_docs_options.sh keeps current.
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <string>
@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "apps/commands.hpp"
-#include "pipeline/option_scope.hpp"
 #include "pipeline/option_specs.hpp"
 
 namespace lambert {
@@ -26,21 +25,6 @@ struct OptionRow {
   std::vector<std::string> commands;
 };
 
-std::string accepts_of(const CLI::Option& o, const std::string& name) {
-  for (const OptionSpec& s : option_specs())
-    if (s.name == name) return accepted_text(s);
-  std::string t = o.get_type_name();  // "INT:INT in [1 - 1024]", "TEXT", "" for a flag
-  const auto colon = t.find(':');
-  if (colon != std::string::npos) t = t.substr(colon + 1);
-  return t.empty() ? "flag" : t;
-}
-
-std::string read_by(const std::string& name) {
-  for (const OptionScope& row : option_scopes())
-    if (row.option == name) return row.reader;
-  return "";
-}
-
 std::string cell(std::string text) {  // a Markdown table cell
   std::string out;
   for (char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
@@ -52,16 +36,19 @@ std::string cell(std::string text) {  // a Markdown table cell
 CLI::App* add_options_command(CLI::App& app, OptionsOptions& opts) {
   auto* cmd = app.add_subcommand(
       "options", "List every option of every command: values, default, what reads it");
-  cmd->add_flag("--markdown", opts.markdown,
-                "Print the reference table of docs/options.md (Markdown)");
+  add_declared(cmd, "--markdown", opts.markdown);
   opts.app = &app;
   return cmd;
 }
 
 int run_options(const OptionsOptions& opts) {
-  // Rows keyed by option and by everything a reader sees, so that an option registered alike
-  // by several commands is one row listing them.
-  std::map<std::tuple<std::string, std::string, std::string, std::string>, OptionRow> rows;
+  // Rows keyed by the option's group (in table order), then by option and everything a reader
+  // sees, so that an option registered alike by several commands is one row listing them.
+  std::vector<std::string> groups;
+  for (const OptionSpec& s : option_specs())
+    if (std::find(groups.begin(), groups.end(), s.group) == groups.end()) groups.push_back(s.group);
+  std::map<std::tuple<std::size_t, std::string, std::string, std::string, std::string>, OptionRow>
+      rows;
   for (const CLI::App* cmd : opts.app->get_subcommands([](const CLI::App*) { return true; })) {
     if (cmd->get_name() == "options") continue;
     for (const CLI::Option* o : cmd->get_options()) {
@@ -71,31 +58,39 @@ int run_options(const OptionsOptions& opts) {
       for (const auto& s : o->get_snames()) names += "-" + s + ", ";
       for (const auto& l : o->get_lnames()) names += "--" + l + ", ";
       names.resize(names.size() - 2);
-      const std::string accepts = accepts_of(*o, name);
-      const auto key =
-          std::make_tuple(name, names + accepts, o->get_default_str(), o->get_description());
+      const OptionSpec& spec = declaration(cmd, name);
+      const std::string accepts = accepted_text(spec);
+      const std::size_t group =
+          std::find(groups.begin(), groups.end(), spec.group) - groups.begin();
+      const auto key = std::make_tuple(group, name, names + accepts, spec.default_text, spec.doc);
       OptionRow& row = rows[key];
       if (row.commands.empty())
-        row = {names, accepts, o->get_default_str(), read_by(name), o->get_description(), {}};
+        row = {names, accepts, spec.default_text, reader_text(spec), spec.doc, {}};
       row.commands.push_back(cmd->get_name());
     }
   }
-  if (opts.markdown) {
-    std::printf("| option | commands | accepts | default | read by | description |\n");
-    std::printf("|---|---|---|---|---|---|\n");
-  }
+  std::size_t group = groups.size();
   for (const auto& [key, r] : rows) {
+    if (std::get<0>(key) != group) {  // a new group: its heading (and table head)
+      group = std::get<0>(key);
+      if (opts.markdown)
+        std::printf(
+            "%s### %s\n\n| option | commands | accepts | default | read by | "
+            "description |\n|---|---|---|---|---|---|\n",
+            group == 0 ? "" : "\n", groups[group].c_str());
+      else
+        std::printf("%s%s:\n", group == 0 ? "" : "\n", groups[group].c_str());
+    }
     std::string commands;
     for (const auto& c : r.commands) commands += (commands.empty() ? "" : ", ") + c;
     if (opts.markdown)
       std::printf("| `%s` | %s | %s | %s | %s | %s |\n", r.names.c_str(), cell(commands).c_str(),
-                  cell(r.accepts).c_str(), cell(r.default_text).c_str(),
-                  cell(r.read_by.empty() ? "every choice" : r.read_by).c_str(),
+                  cell(r.accepts).c_str(), cell(r.default_text).c_str(), cell(r.read_by).c_str(),
                   cell(r.description).c_str());
     else
       std::printf("%s (%s): %s; default %s; read by %s. %s\n", r.names.c_str(), commands.c_str(),
                   r.accepts.c_str(), r.default_text.empty() ? "none" : r.default_text.c_str(),
-                  r.read_by.empty() ? "every choice" : r.read_by.c_str(), r.description.c_str());
+                  r.read_by.c_str(), r.description.c_str());
   }
   return 0;
 }

@@ -152,18 +152,11 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opts) {
   add_camera_options(cmd, opts.camera);
   add_shade_options(cmd, opts.shade);
   add_medium_options(cmd, opts.medium);
-  cmd->add_option(
-      "--radiosity", opts.radiosity,
-      "Per-patch radiosity CSV from `lambert solve` (instead of computing F and solving)");
-  cmd->add_option("-o,--output", opts.output, "Rendered linear HDR image (OpenEXR)")
-      ->check(output_file_check())
-      ->capture_default_str();
-  cmd->add_option("--png", opts.png, "Tone-mapped sRGB preview (default: --output with .png)")
-      ->check(output_file_check());
-  cmd->add_option("--vertex-exr", opts.vertex_exr, "Also write the per-vertex radiosity EXR")
-      ->check(output_file_check());
-  cmd->add_option("--ply", opts.ply, "Also write the coloured patch mesh as PLY")
-      ->check(output_file_check());
+  add_declared(cmd, "--radiosity", opts.radiosity);
+  add_declared(cmd, "-o,--output", opts.output);
+  add_declared(cmd, "--png", opts.png);
+  add_declared(cmd, "--vertex-exr", opts.vertex_exr);
+  add_declared(cmd, "--ply", opts.ply);
   return cmd;
 }
 

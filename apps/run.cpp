@@ -510,7 +510,7 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& opts) {
   auto* cmd = app.add_subcommand(
       "run", "The main job: load, mesh, form factors, solve, render; writes every output");
   opts.scene.default_patches = 1600;
-  opts.ff.samples = 16;
+  opts.ff.samples = kRunDefaultSamples;
   add_scene_options(cmd, opts.scene);
   add_run_options(cmd, opts.run);
   add_method_options(cmd, opts.method);
@@ -520,11 +520,8 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& opts) {
   add_camera_options(cmd, opts.camera);
   add_shade_options(cmd, opts.shade);
   add_medium_options(cmd, opts.medium);
-  cmd->add_option("-o,--output", opts.output_dir, "Output directory (created if needed)")
-      ->capture_default_str();
-  cmd->add_option(
-      "--name", opts.name,
-      "File name prefix (default: the scene file's stem; cornell for the built-in box)");
+  add_declared(cmd, "-o,--output", opts.output_dir);
+  add_declared(cmd, "--name", opts.name);
   add_distributed_options(cmd, opts.dist, true);
   return cmd;
 }

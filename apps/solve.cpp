@@ -241,11 +241,7 @@ CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts) {
   add_solve_options(cmd, opts.solve, true);
   add_adapt_options(cmd, opts.adapt);
   add_medium_options(cmd, opts.medium);
-  cmd->add_option("-o,--output", opts.output,
-                  "Per-patch radiosity CSV (patch,surface,area,R,G,B); the summary goes to the "
-                  "same name with .json")
-      ->check(output_file_check())
-      ->capture_default_str();
+  add_declared(cmd, "-o,--output", opts.output);
   add_run_options(cmd, opts.run);
   add_distributed_options(cmd, opts.dist, true);
   return cmd;

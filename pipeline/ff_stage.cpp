@@ -67,6 +67,14 @@ void check_auto_pick(const FormFactorArgs& args, std::int64_t patches) {
                      "--rays gather, --ff-tol analytic)");
 }
 
+void check_ff_args_for_mesh(const FormFactorArgs& args, const PatchMesh& mesh) {
+  check_auto_pick(args, mesh.size());
+  if (args.specular_given && !mesh.has_specular())
+    throw UsageError(
+        "--specular-depth and --specular-rays do not apply: the scene has no mirror or glass "
+        "surface (MTL illum 3 to 9)");
+}
+
 std::vector<std::string> unused_count_options(const FormFactorArgs& args,
                                               const std::string& estimator) {
   const std::string used = estimator_count_option(estimator);
@@ -156,11 +164,7 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
              " entries, " + ff_settings_text(ff.options, "") + ")");
     return ff;
   }
-  check_auto_pick(args, scene.mesh.size());
-  if (args.specular_given && !scene.mesh.has_specular())
-    throw UsageError(
-        "--specular-depth and --specular-rays do not apply: the scene has no mirror or glass "
-        "surface (MTL illum 3 to 9)");
+  check_ff_args_for_mesh(args, scene.mesh);
   FormFactorOptions o = make_ff_options(args, run);
   o.with_stderr = with_stderr;
   FormFactors ff = compute_form_factors(scene.mesh, o, &scene_bvh(scene, run.threads));

@@ -12,6 +12,10 @@ namespace lambert {
 
 struct Medium;
 
+/// `run`'s --samples default: cheaper than the other commands' (FormFactorArgs::samples), for
+/// a quick first picture.
+constexpr int kRunDefaultSamples = 16;
+
 /// --estimator, --samples, --rays, --threshold, --hemicube-res, --reciprocity,
 /// --symmetrize, --ff.
 struct FormFactorArgs {
@@ -41,9 +45,6 @@ struct FormFactorArgs {
 void plan_form_factors(JobPlan& plan, const FormFactorArgs& args, const RunArgs& run,
                        bool with_stderr = false);
 
-/// Builds FormFactorOptions from the arguments ("auto" stays unresolved: it needs the patch
-/// count). Throws UsageError when a named estimator does not read a count that was given
-/// (--rays with a pair estimator or the hemicube, --samples with gather).
 /// The estimator of a selection (pipeline/option_scope.hpp): --estimator, or "" when F is loaded
 /// from --ff.
 std::string selected_estimator(const FormFactorArgs& args);
@@ -52,7 +53,14 @@ std::string selected_estimator(const FormFactorArgs& args);
 /// --estimator auto picks for `patches` patches does not read; nothing for a named estimator.
 void check_auto_pick(const FormFactorArgs& args, std::int64_t patches);
 
+/// Builds FormFactorOptions from the arguments ("auto" stays unresolved: it needs the patch
+/// count). Throws UsageError when a named estimator does not read a count that was given
+/// (--rays with a pair estimator or the hemicube, --samples with gather).
 FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run);
+
+/// The checks of the arguments against the meshed scene, before any work: check_auto_pick,
+/// and the specular options refused on a mesh without mirror or glass (UsageError).
+void check_ff_args_for_mesh(const FormFactorArgs& args, const PatchMesh& mesh);
 
 /// The count options given on the command line that `estimator` (resolved) ignores, as
 /// option names ("--rays", "--samples", "--ff-tol"); empty when none.

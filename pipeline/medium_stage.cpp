@@ -9,6 +9,7 @@
 #include "core/timer.hpp"
 #include "geometry/visibility/bvh.hpp"
 #include "io/medium_file.hpp"
+#include "pipeline/option_specs.hpp"
 #include "pipeline/problem.hpp"
 #include "pipeline/solve_stage.hpp"
 
@@ -26,9 +27,7 @@ Eigen::Vector3d rgb_or_zero(const std::vector<double>& v) {
 }  // namespace
 
 const std::vector<std::string>& medium_option_names() {
-  static const std::vector<std::string> kNames = {
-      "--medium-box", "--sigma-a",    "--sigma-s",     "--medium-emission",      "--medium-grid",
-      "--voxels",     "--voxel-size", "--medium-rays", "--transmittance-samples"};
+  static const std::vector<std::string> kNames = option_group("medium");
   return kNames;
 }
 

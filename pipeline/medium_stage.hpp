@@ -35,8 +35,7 @@ struct MediumArgs {
   bool active() const { return !box.empty() || !grid.empty(); }
 };
 
-/// The options "--medium-box", ... in the order add_medium_options adds them (the matrix
-/// method's row in pipeline/method.cpp lists them: the hierarchical method refuses them).
+/// The options "--medium-box", ...: the rows of group "medium" in pipeline/option_specs.cpp.
 const std::vector<std::string>& medium_option_names();
 
 /// The first of medium_option_names() given on the command line, or "" for none.

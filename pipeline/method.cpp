@@ -4,50 +4,48 @@
 #include <limits>
 
 #include "core/error.hpp"
-#include "pipeline/medium_stage.hpp"
+#include "pipeline/option_specs.hpp"
 
 namespace lambert {
 
 namespace {
+// The registry; each method's options are the rows of pipeline/option_specs.cpp that name it.
 std::vector<Method> base_methods() {
   return {
       {"matrix",
        "mesh the scene, compute F, solve (I - rho F) B = E",
-       {"--patches", "--max-edge", "--discontinuity", "--discontinuity-sources", "--adapt",
-        "--adapt-patches", "--estimator", "--samples", "--rays", "--threshold", "--hemicube-res",
-        "--reciprocity", "--symmetrize", "--ff"},
-       {"--solver", "--solvers", "--omega", "--preconditioner", "--restart", "--ambient",
-        "--radiosity"},
+       {},
+       {},
        "matrix meshes with --patches or --max-edge and computes F"},
       {"hierarchical",
        "hierarchical radiosity with clustering: adaptive links, no F",
-       {"--epsilon", "--min-area", "--link-rays"},
+       {},
        {},
        "hierarchical meshes adaptively and computes no F: it takes --epsilon, --min-area "
        "(the smallest element), --link-rays, --tol and --max-iter"},
   };
 }
 
-// methods() with the medium's options added to the matrix row (the medium is one of its
-// problem options: pipeline/medium_stage.hpp owns the list).
-std::vector<Method> with_medium_options() {
+std::vector<Method> with_options() {
   std::vector<Method> out = base_methods();
   for (Method& m : out)
-    if (m.name == "matrix")
-      m.problem_options.insert(m.problem_options.end(), medium_option_names().begin(),
-                               medium_option_names().end());
+    for (const OptionSpec& s : option_specs()) {
+      if (s.method != m.name) continue;
+      std::vector<std::string>& list = s.method_solver ? m.solver_options : m.problem_options;
+      if (std::find(list.begin(), list.end(), s.name) == list.end()) list.push_back(s.name);
+    }
   return out;
 }
 }  // namespace
 
 const std::vector<Method>& methods() {
-  static const std::vector<Method> kMethods = with_medium_options();
+  static const std::vector<Method> kMethods = with_options();
   return kMethods;
 }
 
 std::vector<std::string> method_names() {
-  std::vector<std::string> names;
-  for (const Method& m : methods()) names.push_back(m.name);
+  std::vector<std::string> names;  // (not from methods(), which reads the option table)
+  for (const Method& m : base_methods()) names.push_back(m.name);
   return names;
 }
 

@@ -5,8 +5,9 @@
 //                 (I - rho F) B = E (--solver ...);
 //   hierarchical  link elements of a face and cluster hierarchy adaptively (--epsilon,
 //                 --min-area, --link-rays) and solve over the links (geometry/hierarchical).
-// Each registry row names the options only it reads; an option of another method given on
-// the command line is a usage error naming the option and the method.
+// The option table (pipeline/option_specs.cpp) names the method of each option only one
+// method reads; an option of another method given on the command line is a usage error
+// naming the option and the method.
 
 #include <functional>
 #include <string>
@@ -24,9 +25,10 @@ namespace lambert {
 struct Method {
   std::string name;
   std::string description;
-  /// Options that define the problem this method solves (meshing, F, element bounds).
+  /// Options that define the problem this method solves (meshing, F, element bounds), and
+  /// those that steer how it solves (solver choice and parameters, a precomputed B): the
+  /// rows of pipeline/option_specs.cpp whose `method` is this one.
   std::vector<std::string> problem_options;
-  /// Options that steer how it solves (solver choice and parameters, a precomputed B).
   std::vector<std::string> solver_options;
   /// Appended to a refusal of another method's option: what this method uses instead.
   std::string instead;

@@ -1,10 +1,10 @@
 #pragma once
-// Which choices read which options: one table row per option that only some methods,
-// estimators or solvers read (options with no row are read by every choice of the commands
-// that register them). Every command checks the options given on its command line against
-// the table before any work: an option its choices do not read is a usage error (exit 2)
-// naming the option, the choice and what reads it, never a silently ignored setting.
-// (The `--method` rows of pipeline/method.hpp refuse the other method's options first.)
+// Which choices read which options: the rows of pipeline/option_specs.cpp say what reads
+// each option (`reads`; none: every choice of the commands that take it). Every command
+// checks the options given on its command line against them before any work: an option its
+// choices do not read is a usage error (exit 2) naming the option, the choice and what reads
+// it, never a silently ignored setting. (pipeline/method.hpp refuses the options of the other
+// method first, from the rows' `method`.)
 
 #include <functional>
 #include <string>
@@ -33,16 +33,6 @@ struct Selection {
   /// run and render jitter pixel samples (--antialias above 1) or trace camera paths.
   bool random_pixels = false;
 };
-
-/// One row: the option, what reads it (for the message), and when it is read.
-struct OptionScope {
-  std::string option;  ///< long name as registered, e.g. "--omega"
-  std::string reader;  ///< "the solver sor"
-  std::function<bool(const Selection&)> reads;
-};
-
-/// The table.
-const std::vector<OptionScope>& option_scopes();
 
 /// Throws UsageError for the first option `given` that `selection` does not read: "--omega
 /// does not apply to --solver jacobi (read by the solver sor)".

@@ -317,6 +317,67 @@ void check_solver_args(const std::string& solver, double tol, int max_iterations
   check_option_value(option_spec("--max-iter"), max_iterations, "max_iterations");
 }
 
+// The form-factor keywords given (those whose value is not the declared default: the
+// Python wrapper drops those), checked by their rows and set as the CLI sets its options.
+FormFactorArgs ff_args_from_keywords(const py::dict& settings) {
+  FormFactorArgs args;
+  for (const auto& [key, value] : settings) {
+    const std::string keyword = py::cast<std::string>(key);
+    const OptionSpec* row = nullptr;
+    for (const OptionSpec& s : option_specs())
+      if (s.group == "form factors" && s.keyword == keyword && s.commands.empty()) row = &s;
+    if (row == nullptr) throw UsageError("form_factors: unknown keyword '" + keyword + "'");
+    if (row->kind == OptionKind::Choice) {
+      const std::string text = py::cast<std::string>(value);
+      check_option_choice(*row, text, keyword);
+      (row->name == "--estimator" ? args.estimator : args.reciprocity) = text;
+      args.reciprocity_given |= row->name == "--reciprocity";
+      continue;
+    }
+    const double x = py::cast<double>(value);
+    check_option_value(*row, x, keyword);
+    const int n = static_cast<int>(x);  // Integer rows: whole, in an int's range
+    if (row->name == "--samples") {
+      args.samples = n;
+      args.samples_given = true;
+    } else if (row->name == "--rays") {
+      args.rays = n;
+      args.rays_given = true;
+    } else if (row->name == "--ff-tol") {
+      args.tol = x;
+      args.tol_given = true;
+    } else if (row->name == "--threshold") {
+      args.threshold = x;
+    } else if (row->name == "--hemicube-res") {
+      args.hemicube_resolution = n;
+    } else if (row->name == "--specular-depth") {
+      args.specular_depth = n;
+      args.specular_given = true;
+    } else if (row->name == "--specular-rays") {
+      args.specular_rays = n;
+      args.specular_given = true;
+    } else {
+      LAMBERT_CHECK(false, "form_factors: no binding for " + row->name);
+    }
+  }
+  return args;
+}
+
+// A message of the shared checks with the CLI's option names written as the Python keywords
+// ("--samples does not apply" -> "samples does not apply").
+std::string with_keywords(std::string message) {
+  std::vector<const OptionSpec*> rows;
+  for (const OptionSpec& s : option_specs())
+    if (!s.keyword.empty() && s.commands.empty()) rows.push_back(&s);
+  std::sort(rows.begin(), rows.end(), [](const OptionSpec* a, const OptionSpec* b) {
+    return a->name.size() > b->name.size();  // --ff-tol before --ff
+  });
+  for (const OptionSpec* s : rows)
+    for (std::size_t at; (at = message.find(s->name)) != std::string::npos;)
+      message.replace(at, s->name.size(), s->keyword);
+  return message;
+}
+
 // The declarations as Python dicts (lambert.option_specs(): docstrings and references).
 py::list option_spec_list() {
   py::list out;
@@ -326,12 +387,18 @@ py::list option_spec_list() {
     d["keyword"] = spec.keyword;
     d["kind"] = spec.kind == OptionKind::Integer ? "integer"
                 : spec.kind == OptionKind::Real  ? "real"
+                : spec.kind == OptionKind::Flag  ? "flag"
+                : spec.kind == OptionKind::Text  ? "text"
                                                  : "choice";
+    d["commands"] = spec.commands;
+    d["group"] = spec.group;
+    d["read_by"] = reader_text(spec);
     d["accepts"] = accepted_text(spec);
     d["default"] = spec.default_text;
     d["doc"] = spec.doc;
     d["choices"] = spec.choices;
-    if (spec.kind != OptionKind::Choice) d["range"] = py::make_tuple(spec.lo, spec.hi);
+    if (spec.kind == OptionKind::Integer || spec.kind == OptionKind::Real)
+      d["range"] = py::make_tuple(spec.lo, spec.hi);
     out.append(d);
   }
   return out;
@@ -522,38 +589,36 @@ PYBIND11_MODULE(_lambert, m) {
 
   m.def(
       "form_factors",
-      [](const MeshHandle& h, const std::string& estimator, std::optional<int> samples,
-         std::optional<int> rays, std::uint64_t seed, int threads, double threshold,
-         const std::string& reciprocity, std::optional<double> tol, int hemicube_resolution,
+      [](const MeshHandle& h, const py::dict& settings, std::uint64_t seed, int threads,
          bool with_stderr) {
-        FormFactorOptions o;
-        o.estimator = estimator;
-        check_option_choice(option_spec("--estimator"), estimator, "estimator");
-        if (estimator != "auto") {
-          const std::string used = estimator_count_option(estimator);
-          if (samples && used != "samples")
-            throw UsageError("samples does not apply to estimator " + estimator);
-          if (rays && used != "rays")
-            throw UsageError("rays does not apply to estimator " + estimator);
-        }
-        if (samples) check_option_value(option_spec("--samples"), *samples, "samples");
-        if (rays) check_option_value(option_spec("--rays"), *rays, "rays");
-        if (tol) check_option_value(option_spec("--ff-tol"), *tol, "tol");
-        check_option_value(option_spec("--threshold"), threshold, "threshold");
-        check_option_choice(option_spec("--reciprocity"), reciprocity, "reciprocity");
-        check_option_value(option_spec("--hemicube-res"), hemicube_resolution,
-                           "hemicube_resolution");
-        if (samples) o.samples = *samples;
-        if (rays) o.rays = *rays;
-        if (tol) o.tol = *tol, o.tol_given = true;
         if (threads < 0) throw UsageError("threads must be >= 0 (0 = all cores)");
-        o.seed = seed;
-        o.threads = threads;
-        o.threshold = threshold;
-        o.reciprocity = reciprocity;
-        o.hemicube_resolution = hemicube_resolution;
+        const FormFactorArgs args = ff_args_from_keywords(settings);
+        // As `lambert formfactors`: what the estimator does not read is refused (the rows'
+        // `reads`, then auto's pick for this mesh), then the CLI's FormFactorOptions.
+        const OptionGiven given = [&settings](const std::string& name) {
+          const OptionSpec& row = option_spec(name);
+          return !row.keyword.empty() && row.group == "form factors" &&
+                 settings.contains(row.keyword.c_str());
+        };
+        const Selection selection{"formfactors", "matrix", args.estimator, {}, "", false, false};
+        const std::vector<std::string> unread = unread_options(given, selection);
+        if (!unread.empty()) {
+          const OptionSpec& row = option_spec(unread.front());
+          throw UsageError(row.keyword + " does not apply to estimator " + args.estimator +
+                           " (read by " + row.reader + ")");
+        }
+        RunArgs run;
+        run.seed = seed;
+        run.threads = threads;
+        run.quiet = true;
+        FormFactorOptions o;
+        try {
+          check_ff_args_for_mesh(args, h.mesh);
+          o = make_ff_options(args, run);
+        } catch (const UsageError& e) {
+          throw UsageError(with_keywords(e.what()));
+        }
         o.with_stderr = with_stderr;
-        o.progress = false;
         FormFactors ff;
         {
           Released release;
@@ -561,9 +626,7 @@ PYBIND11_MODULE(_lambert, m) {
         }
         return ff_result(std::move(ff), h);
       },
-      py::arg("mesh"), py::arg("estimator"), py::arg("samples"), py::arg("rays"), py::arg("seed"),
-      py::arg("threads"), py::arg("threshold"), py::arg("reciprocity"), py::arg("tol"),
-      py::arg("hemicube_resolution"), py::arg("stderr"));
+      py::arg("mesh"), py::arg("settings"), py::arg("seed"), py::arg("threads"), py::arg("stderr"));
 
   m.def(
       "save_form_factors",

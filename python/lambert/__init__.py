@@ -144,18 +144,19 @@ def _wrap_ff(result, mesh, computed):
 
 def form_factors(mesh, estimator="auto", samples=None, rays=None, seed=1, threads=0,
                  threshold=0.0, reciprocity="auto", tol=None, hemicube_resolution=128,
-                 stderr=False):
+                 specular_depth=8, specular_rays=1024, stderr=False):
     """The form factors of the mesh, as a `FormFactors` (matrix, stderr, settings, stats).
 
     The keywords are the CLI's options (docs/options.md) with the same values, ranges and
-    defaults; the same settings give the CLI's F bit for bit. An option the estimator does
-    not read is refused (UsageError), as on the command line.
+    defaults; the same settings give the CLI's F bit for bit. A keyword set to a value other
+    than its default that the estimator does not read is refused (UsageError), as on the
+    command line.
 
     Parameters
     ----------
     mesh : Mesh
         The patches (``scene.mesh(...)``).
-@declared --estimator --samples --rays --ff-tol --threshold --reciprocity --hemicube-res
+@declared --estimator --samples --rays --ff-tol --threshold --reciprocity --hemicube-res --specular-depth --specular-rays
     seed : int, default 1
         The random seed: the same seed gives the same F whatever ``threads`` is.
     threads : int, default 0
@@ -168,11 +169,16 @@ def form_factors(mesh, estimator="auto", samples=None, rays=None, seed=1, thread
     FormFactors
     """
     _check_mesh(mesh)
-    result = _lambert.form_factors(mesh, str(estimator), _opt_int(samples, "samples"),
-                                   _opt_int(rays, "rays"), _int(seed, "seed"),
-                                   _int(threads, "threads"), float(threshold), str(reciprocity),
-                                   None if tol is None else float(tol),
-                                   _int(hemicube_resolution, "hemicube_resolution"), bool(stderr))
+    given = dict(estimator=str(estimator), samples=_opt_int(samples, "samples"),
+                 rays=_opt_int(rays, "rays"), threshold=float(threshold),
+                 reciprocity=str(reciprocity), tol=None if tol is None else float(tol),
+                 hemicube_resolution=_int(hemicube_resolution, "hemicube_resolution"),
+                 specular_depth=_int(specular_depth, "specular_depth"),
+                 specular_rays=_int(specular_rays, "specular_rays"))
+    # By name, only what differs from the declared default (what the CLI calls given).
+    settings = {k: v for k, v in given.items() if v is not None and not _is_default(k, v)}
+    result = _lambert.form_factors(mesh, settings, _int(seed, "seed"), _int(threads, "threads"),
+                                   bool(stderr))
     return _wrap_ff(result, mesh, computed=True)
 
 
@@ -311,13 +317,27 @@ def render(mesh, B, eye=None, look_at=None, up=None, fov=None, width=None, heigh
 
 # --- the declared options' documentation (pipeline/option_specs.hpp) ---------------------------
 
-_SPECS = {spec["name"]: spec for spec in _lambert.option_specs()}
+_ALL_SPECS = _lambert.option_specs()
+# The keywords' rows: those of every command (a command's own row, such as run's cheaper
+# --samples, is the CLI's only).
+_SPECS = {spec["name"]: spec for spec in _ALL_SPECS if not spec["commands"]}
+_KEYWORD_SPECS = {spec["keyword"]: spec for spec in _SPECS.values()
+                  if spec["keyword"] and spec["group"] == "form factors"}
 
 
 def option_specs():
-    """The declared options (name, Python keyword, kind, accepts, range or choices, default,
-    doc): the table the CLI and these keywords are checked and documented from."""
-    return [dict(spec) for spec in _SPECS.values()]
+    """Every declared option of the CLI and these keywords (name, Python keyword, commands,
+    group, kind, accepts, range or choices, default, what reads it, doc): the table they are
+    checked and documented from, one row per meaning (``commands`` empty: every command)."""
+    return [dict(spec) for spec in _ALL_SPECS]
+
+
+def _is_default(keyword, value):
+    """True when a form-factor keyword's value is its declared default."""
+    spec = _KEYWORD_SPECS[keyword]
+    if spec["kind"] == "choice":
+        return value == spec["default"]
+    return float(value) == float(spec["default"])
 
 
 def _document_declared(function):
@@ -331,7 +351,8 @@ def _document_declared(function):
             continue
         for name in line.split()[1:]:
             spec = _SPECS[name]
-            kind = {"integer": "int", "real": "float", "choice": "str"}[spec["kind"]]
+            kind = {"integer": "int", "real": "float", "choice": "str", "flag": "bool",
+                    "text": "str"}[spec["kind"]]
             lines.append(f"    {spec['keyword']} : {kind}, default {spec['default']}")
             lines.append(f"        {spec['doc']}. Accepts {spec['accepts']} (the CLI's {name}).")
     function.__doc__ = "\n".join(lines)

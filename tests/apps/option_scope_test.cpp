@@ -3,8 +3,8 @@
 // the registries, and runs it on a small scene: the command either refuses the option (exit
 // 2) or its result B differs from the same command without it. Options that by design
 // change no result (output paths, logging, threads, memory checks) must leave B bitwise
-// equal instead. The table of pipeline/option_scope.cpp decides the refusals; this walk checks
-// it against what the code actually reads.
+// equal instead. The rows of pipeline/option_specs.cpp decide the refusals; this walk checks
+// it against what the code actually reads. (Every option's row: tests/apps/option_specs_test.cpp.)
 
 #include "pipeline/option_scope.hpp"
 
@@ -160,24 +160,6 @@ std::string long_name(const CLI::Option* o) {
 
 }  // namespace
 
-TEST(OptionScope, EveryRowNamesAnOptionOfSomeCommand) {
-  CLI::App app;
-  RunOptions r;
-  SolveCommandOptions s;
-  CompareOptions c;
-  FormFactorsOptions f;
-  RenderOptions d;
-  HeatOptions h;
-  const std::vector<CLI::App*> commands = {
-      add_run_command(app, r),         add_solve_command(app, s),  add_compare_command(app, c),
-      add_formfactors_command(app, f), add_render_command(app, d), add_heat_command(app, h)};
-  for (const OptionScope& row : option_scopes()) {
-    int found = 0;
-    for (const CLI::App* cmd : commands) found += cmd->get_option_no_throw(row.option) != nullptr;
-    EXPECT_GT(found, 0) << row.option;
-  }
-}
-
 TEST(OptionScope, RefusalsNameTheOptionTheChoiceAndTheReader) {
   testing::TempDir dir;
   const std::string scene = write_scene(dir);
@@ -239,7 +221,7 @@ TEST(OptionScopeSlow, NoOptionOfSolveIsAcceptedAndIgnored) {
 
   // The axes, from the registries: the hierarchical method, every estimator with the default
   // solver and every solver with the default estimator. No row of the scope table reads the
-  // estimator and the solver together (pipeline/option_scope.cpp: a row's predicate looks at
+  // estimator and the solver together (pipeline/option_specs.cpp: a row's predicate looks at
   // one of them), and what an option changes does not depend on the other, so the star
   // covers every row for every registry entry at a fraction of the cross product's runs.
   struct Axes {

@@ -411,9 +411,10 @@ def test_keywords_are_checked_and_documented_from_the_declarations(cornell_mesh)
     form_factors and solve is in help() with its range and default, its signature default is
     the declared one, and a value outside the range is refused naming the keyword."""
     import inspect
-    specs = {s["name"]: s for s in lambert.option_specs()}
+    specs = {s["name"]: s for s in lambert.option_specs() if not s["commands"]}
     for fn, names in ((lambert.form_factors, ["--estimator", "--samples", "--rays", "--ff-tol",
-                                              "--threshold", "--reciprocity", "--hemicube-res"]),
+                                              "--threshold", "--reciprocity", "--hemicube-res",
+                                              "--specular-depth", "--specular-rays"]),
                       (lambert.solve, ["--solver", "--tol", "--max-iter", "--omega",
                                        "--preconditioner", "--restart"])):
         parameters = inspect.signature(fn).parameters
@@ -433,3 +434,27 @@ def test_keywords_are_checked_and_documented_from_the_declarations(cornell_mesh)
     F = lambert.form_factors(cornell_mesh, estimator="hybrid", samples=2)
     with pytest.raises(lambert.UsageError, match=r"omega: 2.5 is not a number in \[0.001, 1.999\]"):
         lambert.solve(cornell_mesh, F, solver="sor", omega=2.5)
+
+
+def test_form_factor_keywords_go_by_name_through_the_clis_checks(cornell_mesh):
+    """The form-factor keywords reach the library by name and pass the CLI's checks: what the
+    chosen estimator does not read is refused with the reader from the declarations, auto's
+    pick and the specular options are checked against the mesh, and a keyword at its declared
+    default counts as not given (as an option left off the command line)."""
+    with pytest.raises(lambert.UsageError,
+                       match=r"^reciprocity does not apply to estimator mc \(read by the "
+                             r"estimators gather and hemicube\)$"):
+        lambert.form_factors(cornell_mesh, estimator="mc", reciprocity="average")
+    with pytest.raises(lambert.UsageError,
+                       match="^specular_depth and specular_rays do not apply: the scene has no "
+                             "mirror or glass surface"):
+        lambert.form_factors(cornell_mesh, estimator="hybrid", samples=2, specular_depth=2)
+    with pytest.raises(lambert.UsageError, match=r"^rays does not apply: estimator auto picks "
+                                                 r"hybrid for \d+ patches"):
+        lambert.form_factors(cornell_mesh, rays=64)
+    # Defaults given explicitly are not "given": the same F as leaving them off.
+    a = lambert.form_factors(cornell_mesh, estimator="mc", samples=2, seed=5)
+    b = lambert.form_factors(cornell_mesh, estimator="mc", samples=2, seed=5, reciprocity="auto",
+                             threshold=0.0, hemicube_resolution=128, specular_depth=8)
+    assert (a.matrix != b.matrix).nnz == 0
+    assert a.settings == b.settings
