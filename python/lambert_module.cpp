@@ -309,14 +309,6 @@ class Released {
 };
 
 // UsageError for an unknown solver, tol outside (0, 1) or max_iterations < 1.
-// The solver keywords against their declarations (pipeline/option_specs.hpp): the CLI's
-// values and ranges, named as the keyword.
-void check_solver_args(const std::string& solver, double tol, int max_iterations) {
-  check_option_choice(option_spec("--solver"), solver, "solver");
-  check_option_value(option_spec("--tol"), tol, "tol");
-  check_option_value(option_spec("--max-iter"), max_iterations, "max_iterations");
-}
-
 // The form-factor keywords given (those whose value is not the declared default: the
 // Python wrapper drops those), checked by their rows and set as the CLI sets its options.
 FormFactorArgs ff_args_from_keywords(const py::dict& settings) {
@@ -361,6 +353,49 @@ FormFactorArgs ff_args_from_keywords(const py::dict& settings) {
     }
   }
   return args;
+}
+
+// The solver keywords given (those not at their declared default), checked by their rows;
+// what the solver does not read is refused as `lambert solve` refuses it.
+SolveOptions solve_options_from_keywords(const py::dict& settings) {
+  SolveOptions o;
+  for (const auto& [key, value] : settings) {
+    const std::string keyword = py::cast<std::string>(key);
+    const OptionSpec* row = nullptr;
+    for (const OptionSpec& s : option_specs())
+      if (s.group == "solver" && s.keyword == keyword && s.commands.empty()) row = &s;
+    if (row == nullptr) throw UsageError("solve: unknown keyword '" + keyword + "'");
+    if (row->kind == OptionKind::Choice) {
+      const std::string text = py::cast<std::string>(value);
+      check_option_choice(*row, text, keyword);
+      (row->name == "--solver" ? o.solver : o.preconditioner) = text;
+      continue;
+    }
+    const double x = py::cast<double>(value);
+    check_option_value(*row, x, keyword);
+    if (row->name == "--tol")
+      o.tol = x;
+    else if (row->name == "--max-iter")
+      o.max_iterations = static_cast<int>(x);
+    else if (row->name == "--omega")
+      o.omega = x;
+    else if (row->name == "--restart")
+      o.restart = static_cast<int>(x);
+    else
+      LAMBERT_CHECK(false, "solve: no binding for " + row->name);
+  }
+  const OptionGiven given = [&settings](const std::string& name) {
+    const OptionSpec& row = option_spec(name);
+    return !row.keyword.empty() && row.group == "solver" && settings.contains(row.keyword.c_str());
+  };
+  const Selection selection{"solve", "matrix", "", {o.solver}, "", false, false};
+  const std::vector<std::string> unread = unread_options(given, selection);
+  if (!unread.empty()) {
+    const OptionSpec& row = option_spec(unread.front());
+    throw UsageError(row.keyword + " does not apply to solver " + o.solver + " (read by " +
+                     row.reader + ")");
+  }
+  return o;
 }
 
 // A message of the shared checks with the CLI's option names written as the Python keywords
@@ -675,21 +710,10 @@ PYBIND11_MODULE(_lambert, m) {
   m.def(
       "solve",
       [](const MeshHandle& h, const IndexArray& indptr, const IndexArray& indices,
-         const ValueArray& data, const std::string& solver, double tol, int max_iterations,
-         double omega, const std::string& preconditioner, int restart, int threads,
+         const ValueArray& data, const py::dict& settings, int threads,
          std::optional<ValueArray> initial, const py::dict& medium_options) {
-        check_solver_args(solver, tol, max_iterations);
-        check_option_value(option_spec("--omega"), omega, "omega");
-        check_option_choice(option_spec("--preconditioner"), preconditioner, "preconditioner");
-        check_option_value(option_spec("--restart"), restart, "restart");
+        SolveOptions o = solve_options_from_keywords(settings);
         const SparseRowMatrix F = csr_from_arrays(h.mesh.size(), indptr, indices, data, "F");
-        SolveOptions o;
-        o.solver = solver;
-        o.tol = tol;
-        o.max_iterations = max_iterations;
-        o.omega = omega;
-        o.preconditioner = preconditioner;
-        o.restart = restart;
         o.threads = threads;
         if (initial) o.initial_guess = matrix_n3(*initial, h.mesh.size(), "initial_guess");
         const MediumArgs margs = medium_args(medium_options);
@@ -724,17 +748,15 @@ PYBIND11_MODULE(_lambert, m) {
         }
         return py::make_tuple(adopt_matrix(sol.B), report_dict(sol));
       },
-      py::arg("mesh"), py::arg("indptr"), py::arg("indices"), py::arg("data"), py::arg("solver"),
-      py::arg("tol"), py::arg("max_iterations"), py::arg("omega"), py::arg("preconditioner"),
-      py::arg("restart"), py::arg("threads"), py::arg("initial_guess"), py::arg("medium"));
+      py::arg("mesh"), py::arg("indptr"), py::arg("indices"), py::arg("data"), py::arg("settings"),
+      py::arg("threads"), py::arg("initial_guess"), py::arg("medium"));
 
   m.def(
       "heat",
       [](const MeshHandle& h, const IndexArray& indptr, const IndexArray& indices,
          const ValueArray& data, const std::string& surfaces_json, double ambient,
-         const std::string& unit, const std::string& solver, double tol, int max_iterations,
-         int threads) {
-        check_solver_args(solver, tol, max_iterations);
+         const std::string& unit, const py::dict& settings, int threads) {
+        SolveOptions o = solve_options_from_keywords(settings);
         if (!(ambient >= 0.0) || !std::isfinite(ambient))
           throw UsageError("ambient_temperature must be finite and >= 0 K");
         const double metres = metres_per_unit(unit);
@@ -746,10 +768,6 @@ PYBIND11_MODULE(_lambert, m) {
         ff.F = csr_from_arrays(h.mesh.size(), indptr, indices, data, "F");
         const ThermalProblem problem = make_heat_problem(h.mesh, cond, ff.F, metres, ambient);
         refuse_floating_enclosure(h.mesh, problem, ff, "surfaces");
-        SolveOptions o;
-        o.solver = solver;
-        o.tol = tol;
-        o.max_iterations = max_iterations;
         o.threads = threads;
         ThermalSolution sol;
         {
@@ -794,7 +812,7 @@ PYBIND11_MODULE(_lambert, m) {
       },
       py::arg("mesh"), py::arg("indptr"), py::arg("indices"), py::arg("data"),
       py::arg("surfaces_json"), py::arg("ambient_temperature"), py::arg("length_unit"),
-      py::arg("solver"), py::arg("tol"), py::arg("max_iterations"), py::arg("threads"));
+      py::arg("settings"), py::arg("threads"));
 
   m.def(
       "solve_hierarchical",

@@ -169,14 +169,18 @@ def form_factors(mesh, estimator="auto", samples=None, rays=None, seed=1, thread
     FormFactors
     """
     _check_mesh(mesh)
-    given = dict(estimator=str(estimator), samples=_opt_int(samples, "samples"),
-                 rays=_opt_int(rays, "rays"), threshold=float(threshold),
-                 reciprocity=str(reciprocity), tol=None if tol is None else float(tol),
-                 hemicube_resolution=_int(hemicube_resolution, "hemicube_resolution"),
-                 specular_depth=_int(specular_depth, "specular_depth"),
-                 specular_rays=_int(specular_rays, "specular_rays"))
-    # By name, only what differs from the declared default (what the CLI calls given).
-    settings = {k: v for k, v in given.items() if v is not None and not _is_default(k, v)}
+    # By name, what the CLI would call given: a keyword whose default is None when set, the
+    # others when they differ from their declared default.
+    optional = dict(samples=_opt_int(samples, "samples"), rays=_opt_int(rays, "rays"),
+                    tol=None if tol is None else float(tol))
+    defaulted = dict(estimator=str(estimator), threshold=float(threshold),
+                     reciprocity=str(reciprocity),
+                     hemicube_resolution=_int(hemicube_resolution, "hemicube_resolution"),
+                     specular_depth=_int(specular_depth, "specular_depth"),
+                     specular_rays=_int(specular_rays, "specular_rays"))
+    settings = {k: v for k, v in optional.items() if v is not None}
+    settings.update({k: v for k, v in defaulted.items()
+                     if not _is_default("form factors", k, v)})
     result = _lambert.form_factors(mesh, settings, _int(seed, "seed"), _int(threads, "threads"),
                                    bool(stderr))
     return _wrap_ff(result, mesh, computed=True)
@@ -246,9 +250,12 @@ def solve(mesh, F, solver="gauss-seidel", tol=1e-8, max_iterations=10000, omega=
     if unknown:
         raise TypeError(f"solve() got unexpected keyword arguments {sorted(unknown)}")
     indptr, indices, data = _csr_arrays(F, mesh, "F")
-    return Solution(*_lambert.solve(mesh, indptr, indices, data, str(solver), float(tol),
-                                    _int(max_iterations, "max_iterations"), float(omega),
-                                    str(preconditioner), _int(restart, "restart"),
+    given = dict(solver=str(solver), tol=float(tol),
+                 max_iterations=_int(max_iterations, "max_iterations"), omega=float(omega),
+                 preconditioner=str(preconditioner), restart=_int(restart, "restart"))
+    # By name, only what differs from the declared default (what the CLI calls given).
+    settings = {k: v for k, v in given.items() if not _is_default("solver", k, v)}
+    return Solution(*_lambert.solve(mesh, indptr, indices, data, settings,
                                     _int(threads, "threads"), initial_guess, medium))
 
 
@@ -268,9 +275,12 @@ def heat(mesh, F, surfaces, ambient_temperature=0.0, length_unit="m", solver="ga
         raise TypeError(f"surfaces must be a dict of surface name -> condition, got "
                         f"{type(surfaces).__name__}")
     indptr, indices, data = _csr_arrays(F, mesh, "F")
+    given = dict(solver=str(solver), tol=float(tol),
+                 max_iterations=_int(max_iterations, "max_iterations"))
+    settings = {k: v for k, v in given.items() if not _is_default("solver", k, v)}
     return _lambert.heat(mesh, indptr, indices, data, json.dumps(surfaces),
-                         float(ambient_temperature), str(length_unit), str(solver), float(tol),
-                         _int(max_iterations, "max_iterations"), _int(threads, "threads"))
+                         float(ambient_temperature), str(length_unit), settings,
+                         _int(threads, "threads"))
 
 
 def solve_hierarchical(scene, epsilon=1e-4, min_area=0.0, link_rays=16, tol=1e-6,
@@ -321,8 +331,8 @@ _ALL_SPECS = _lambert.option_specs()
 # The keywords' rows: those of every command (a command's own row, such as run's cheaper
 # --samples, is the CLI's only).
 _SPECS = {spec["name"]: spec for spec in _ALL_SPECS if not spec["commands"]}
-_KEYWORD_SPECS = {spec["keyword"]: spec for spec in _SPECS.values()
-                  if spec["keyword"] and spec["group"] == "form factors"}
+_KEYWORD_SPECS = {(spec["group"], spec["keyword"]): spec for spec in _SPECS.values()
+                  if spec["keyword"]}
 
 
 def option_specs():
@@ -332,9 +342,10 @@ def option_specs():
     return [dict(spec) for spec in _ALL_SPECS]
 
 
-def _is_default(keyword, value):
-    """True when a form-factor keyword's value is its declared default."""
-    spec = _KEYWORD_SPECS[keyword]
+def _is_default(group, keyword, value):
+    """True when the keyword's value is its declared default (group: "form factors" for
+    form_factors' keywords, "solver" for solve's: both have a `tol`)."""
+    spec = _KEYWORD_SPECS[(group, keyword)]
     if spec["kind"] == "choice":
         return value == spec["default"]
     return float(value) == float(spec["default"])

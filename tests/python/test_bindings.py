@@ -250,8 +250,8 @@ def test_non_monotone_indptr_is_a_usage_error(cornell_mesh):
     indices = F.indices.astype(np.int64)
     indptr[1], indptr[2] = 3, 1  # row 0 would run past row 1's start
     with pytest.raises(lambert.UsageError, match="indptr"):
-        ext.solve(cornell_mesh, indptr, indices, F.data.astype(np.float64), "gauss-seidel",
-                  1e-8, 100, 1.5, "diagonal", 30, 1, None, {})
+        ext.solve(cornell_mesh, indptr, indices, F.data.astype(np.float64),
+                  {"max_iterations": 100}, 1, None, {})
 
 
 def test_medium_solve_equals_the_cli(tmp_path, cornell):
@@ -458,3 +458,21 @@ def test_form_factor_keywords_go_by_name_through_the_clis_checks(cornell_mesh):
                              threshold=0.0, hemicube_resolution=128, specular_depth=8)
     assert (a.matrix != b.matrix).nnz == 0
     assert a.settings == b.settings
+
+
+def test_solver_keywords_the_solver_does_not_read_are_refused(cornell_mesh):
+    """solve's keywords go by name through `lambert solve`'s check: omega is the SOR
+    factor, direct iterates nothing (no tol, no max_iterations), a preconditioner is for the
+    Krylov solvers; at their declared defaults they count as not given."""
+    F = lambert.form_factors(cornell_mesh, estimator="hybrid", samples=2)
+    cases = [(dict(solver="jacobi", omega=1.2), r"^omega does not apply to solver jacobi \(read "
+                                                r"by the solver sor\)$"),
+             (dict(solver="direct", tol=1e-6), "^tol does not apply to solver direct"),
+             (dict(solver="gauss-seidel", preconditioner="ilut"),
+              "^preconditioner does not apply to solver gauss-seidel")]
+    for kwargs, message in cases:
+        with pytest.raises(lambert.UsageError, match=message):
+            lambert.solve(cornell_mesh, F, **kwargs)
+    a = lambert.solve(cornell_mesh, F, solver="direct")
+    b = lambert.solve(cornell_mesh, F, solver="direct", tol=1e-8, omega=1.5)
+    assert np.array_equal(a.B, b.B)
