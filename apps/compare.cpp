@@ -394,6 +394,7 @@ CLI::App* add_compare_command(CLI::App& app, CompareOptions& opts) {
   auto* cmd = app.add_subcommand(
       "compare", "Run several solvers on one system: table, histories and convergence plots");
   opts.scene.default_patches = 2000;
+  opts.scene.require_emitter = true;  // B from E: a scene where nothing emits is refused
   add_scene_options(cmd, opts.scene);
   add_method_options(cmd, opts.method, true);
   add_ff_options(cmd, opts.ff);

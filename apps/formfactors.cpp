@@ -47,6 +47,7 @@ Json diagnostics_json(const LoadedScene& s, const FormFactors& ff, const FormFac
           {"pairs_tested", ff.stats.pairs_tested},
           {"pairs_culled", ff.stats.pairs_culled},
           {"pairs_unverified", ff.stats.pairs_unverified},
+          {"unverified_exchange_share", unverified_exchange_share(ff, s.mesh)},
           {"rays", ff.stats.rays},
           {"seconds", ff.stats.seconds},
           {"rays_per_second", ff.stats.seconds > 0 ? ff.stats.rays / ff.stats.seconds : 0.0},

@@ -99,7 +99,9 @@ int render_matrix(const RenderOptions& opts) {
     plan.inputs.push_back({"--radiosity", opts.radiosity});
     check_vertex_interp(opts.shade, false, "--radiosity");
   }
-  const LoadedScene loaded = load_scene(opts.scene, plan);
+  SceneArgs scene_args = opts.scene;
+  scene_args.require_emitter = opts.radiosity.empty();  // --radiosity: B is given
+  const LoadedScene loaded = load_scene(scene_args, plan);
   const Camera camera = make_camera(loaded.scene, opts.camera);
   RadiosityResult r;
   if (medium) {
@@ -144,6 +146,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opts) {
       "render",
       "Render the radiosity solution (HDR EXR + sRGB PNG), optionally per-vertex EXR/PLY");
   opts.scene.default_patches = 2000;
+  opts.scene.require_emitter = true;  // B from E: a scene where nothing emits is refused
   add_scene_options(cmd, opts.scene);
   add_run_options(cmd, opts.run);
   add_method_options(cmd, opts.method);

@@ -510,6 +510,7 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& opts) {
   auto* cmd = app.add_subcommand(
       "run", "The main job: load, mesh, form factors, solve, render; writes every output");
   opts.scene.default_patches = 1600;
+  opts.scene.require_emitter = true;  // B from E: a scene where nothing emits is refused
   opts.ff.samples = kRunDefaultSamples;
   add_scene_options(cmd, opts.scene);
   add_run_options(cmd, opts.run);

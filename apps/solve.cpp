@@ -235,6 +235,7 @@ int write_solve_outputs(const SolveCommandOptions& opts, const LoadedScene& load
 CLI::App* add_solve_command(CLI::App& app, SolveCommandOptions& opts) {
   auto* cmd = app.add_subcommand("solve", "Solve the radiosity system and write per-patch B");
   opts.scene.default_patches = 2000;
+  opts.scene.require_emitter = true;  // B from E: a scene where nothing emits is refused
   add_scene_options(cmd, opts.scene);
   add_method_options(cmd, opts.method);
   add_ff_options(cmd, opts.ff);

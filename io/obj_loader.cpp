@@ -333,6 +333,10 @@ std::map<std::int32_t, std::set<std::int32_t>> build_faces(const ObjData& obj,
   for (const auto& f : obj.faces) group_materials[f.group].insert(material_of(f));
   std::map<std::pair<std::int32_t, std::int32_t>, std::int32_t> surface_of;
   std::map<std::int32_t, std::set<std::int32_t>> surfaces_of_use;
+  struct {
+    int first_line = 0, worst_line = 0;
+    double worst = 0.0, worst_relative = 0.0;
+  } nonplanar;
   for (const auto& of : obj.faces) {
     Face face;
     face.line = of.line;
@@ -366,14 +370,32 @@ std::map<std::int32_t, std::set<std::int32_t>> build_faces(const ObjData& obj,
       throw SceneError(where(name, of.line) + ": non-planar polygon with " +
                        std::to_string(poly.size()) + " corners (more than " +
                        std::to_string(kMaxSplitCorners) + " cannot be split into triangles)");
-    ++report.nonplanar_faces_split;
-    diag.warn(where(name, of.line) + ": non-planar polygon (off its plane by " +
-              num(off) + ") split into triangles");
+    // One warning for them all after the loop (a CAD export has thousands): count, first
+    // line, and the worst one's deviation relative to its size.
+    if (report.nonplanar_faces_split++ == 0) nonplanar.first_line = of.line;
+    if (off / extent > nonplanar.worst_relative) {
+      nonplanar.worst_relative = off / extent;
+      nonplanar.worst = off;
+      nonplanar.worst_line = of.line;
+    }
+    log_debug(where(name, of.line) + ": non-planar polygon (off its plane by " + num(off) +
+              ") split into triangles");
     for (const auto& t : triangulate(poly)) {
       Face tri = face;
       tri.vertices = {face.vertices[t[0]], face.vertices[t[1]], face.vertices[t[2]]};
       scene.faces.push_back(tri);
     }
+  }
+  if (report.nonplanar_faces_split > 0) {
+    const int n = report.nonplanar_faces_split;
+    const std::string off = "off its plane by " + num(nonplanar.worst) + ", " +
+                            num(100.0 * nonplanar.worst_relative) + " % of its size";
+    diag.warn(where(name, nonplanar.first_line) + ": " +
+              (n == 1 ? "non-planar polygon (" + off + ") split into triangles"
+                      : std::to_string(n) +
+                            " non-planar polygons (the first here) split into triangles; the "
+                            "worst (line " +
+                            std::to_string(nonplanar.worst_line) + ") is " + off));
   }
   return surfaces_of_use;
 }

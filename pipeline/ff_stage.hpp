@@ -77,6 +77,11 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
                                 const RunArgs& run, bool with_stderr = false,
                                 const Medium* medium = nullptr);
 
+/// The share of the exchange Σ_i A_i Σ_j F_ij (patch rows) that the pairs whose visibility
+/// could not be sampled as designed carry (FormFactorStats::unverified_exchange): the size of
+/// the warning's effect; 0 when F exchanges nothing.
+double unverified_exchange_share(const FormFactors& ff, const PatchMesh& mesh);
+
 /// Warns once per cause (analysis.hpp's find_lighting_problems) when F makes the result
 /// silently B = E: nothing sees anything, or an emitter sees nothing. (A scene without an
 /// emitter is warned about by the loader.)

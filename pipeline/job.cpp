@@ -17,6 +17,7 @@
 #include "core/log.hpp"
 #include "core/memory.hpp"
 #include "geometry/formfactors/media.hpp"
+#include "geometry/media/medium.hpp"
 #include "io/obj_loader.hpp"
 #include "io/stl_loader.hpp"
 #include "solvers/radiosity.hpp"
@@ -207,7 +208,23 @@ Scene load_scene_file(const SceneArgs& args) {
 }
 
 Scene load_checked_scene(const SceneArgs& args, const JobPlan& plan) {
-  Scene scene = load_scene_file(args);
+  SceneArgs quiet = args;  // a scene that must emit is refused below, not warned about
+  if (args.require_emitter) quiet.load.warn_without_emitter = false;
+  Scene scene = load_scene_file(quiet);
+  const bool medium_emits =
+      plan.medium && plan.medium->emission.size() > 0 && plan.medium->emission.maxCoeff() > 0.0;
+  const bool emits = std::any_of(scene.surfaces.begin(), scene.surfaces.end(), [&](const auto& s) {
+    return scene.materials[s.material].emits();
+  });
+  if (args.require_emitter && !emits && !medium_emits) {
+    const std::string path = args.scene.empty() ? builtin_cornell_box_path() : args.scene;
+    throw UsageError(path +
+                     ": nothing emits (no material with Ke > 0, no --medium-emission): B would "
+                     "be zero everywhere; make surfaces emit with --emit NAME_OR_GLOB=R,G,B "
+                     "(`lambert info " +
+                     (args.scene.empty() ? std::string() : args.scene + " ") +
+                     "--list-surfaces` lists the names)");
+  }
   std::vector<NamedFile> inputs = plan.inputs;
   for (size_t k = 0; k < scene.files.size(); ++k) {
     const std::string& f = scene.files[k];

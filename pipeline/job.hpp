@@ -43,6 +43,10 @@ struct SceneArgs {
   std::int64_t default_patches = 0;        ///< used when neither is given
   bool discontinuity = false;              ///< --discontinuity
   int discontinuity_sources = 0;           ///< --discontinuity-sources
+  /// The command computes B from the emission: a scene where nothing emits (and no
+  /// participating medium of the job's plan emits) is refused when loaded, before any work
+  /// (UsageError naming --emit), instead of a long run that ends in a black result.
+  bool require_emitter = false;
 };
 
 /// Threads, seed and verbosity.

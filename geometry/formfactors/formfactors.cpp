@@ -49,6 +49,7 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
   CsrAppender upper(n, 2 * range_pairs, options.with_stderr);
   std::vector<std::vector<RowEntry>> rows(n);
   std::vector<std::int64_t> tested(n, 0), rays(n, 0), unverified(n, 0);
+  std::vector<double> unverified_g(n, 0.0);
   Progress progress("form factors", options.progress ? range_pairs : 0, "rays");
   const std::int64_t block_pairs = std::max<std::int64_t>(1, total_pairs / kBlocks);
   for (std::int32_t i = 0; i < first; ++i) upper.append_row({});
@@ -69,6 +70,7 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
           const PairEstimate e = estimator(ctx, i, j);
           row_rays += e.rays;
           unverified[i] += e.unverified;
+          if (e.unverified) unverified_g[i] += 2.0 * e.G;  // both entries of the pair
           if (e.G > 0.0) rows[i].push_back({j, e.G, e.var});
         }
         rays[i] = row_rays;
@@ -90,6 +92,7 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
     out.stats.pairs_tested += tested[i];
     out.stats.rays += rays[i];
     out.stats.pairs_unverified += unverified[i];
+    out.stats.unverified_exchange += unverified_g[i];
   }
   out.stats.pairs_culled = range_pairs - out.stats.pairs_tested;
   upper.finish(out.F, out.stderr_F);

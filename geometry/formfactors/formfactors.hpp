@@ -86,6 +86,9 @@ struct FormFactorStats {
   /// (analytic) whose integral stopped at its budget before --ff-tol: reported and warned
   /// about, expected 0.
   std::int64_t pairs_unverified = 0;
+  /// Σ A_i F_ij + A_j F_ji of those pairs (scene units²): with the total exchange
+  /// Σ_i A_i Σ_j F_ij, the share of F they carry (the size of the warning's effect).
+  double unverified_exchange = 0.0;
   double seconds = 0.0;           ///< wall time of the computation
   /// Reciprocity averaging (0 when not applied; see reciprocity.hpp), of its averaging step
   /// alone (G = A_i F_ij before, G' = (A_i F_ij + A_j F_ji) / 2): the largest relative change

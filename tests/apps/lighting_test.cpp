@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -135,17 +136,45 @@ TEST(LightingWarnings, LightFacingOutOfTheBoxIsNamedByRun) {
 // One warning for a scene without an emitter (the loader's, naming the file and --emit),
 // not a second one from the F check.
 TEST(LightingWarnings, SceneWithoutEmitterIsWarnedAboutOnce) {
+  // formfactors needs no light: one warning, the work done.
   testing::TempDir dir;
   const std::string obj = write_obj(dir, "dark", cube(false));
-  for (const auto& args :
-       {small({"render", obj, "-o", dir.file("img.exr"), "--size", "16x16", "--antialias", "1"}),
-        small({"formfactors", obj, "-o", dir.file("F.bin")})}) {
+  const auto [code, err] = run_captured(small({"formfactors", obj, "-o", dir.file("F.bin")}));
+  EXPECT_EQ(code, kExitOk) << err;
+  EXPECT_EQ(count(err, "emit"), 1 + count(err, "--emit")) << err;  // one line mentions it
+  EXPECT_EQ(count(err, ": no emitter (no material with Ke > 0)"), 1) << err;
+  EXPECT_EQ(count(err, "no surface emits"), 0) << err;
+}
+
+TEST(LightingWarnings, ACommandThatSolvesForBRefusesASceneWhereNothingEmits) {
+  // Issue 35: "warned, then 28 s of form factors and a black image, exit 0". Every command
+  // that computes B from E, with either method, refuses it when loaded: exit 2, one line
+  // naming --emit, no output; an emitting medium is light enough.
+  testing::TempDir dir;
+  const std::string obj = write_obj(dir, "dark", cube(false));
+  const std::vector<std::vector<std::string>> commands = {
+      {"render", obj, "-o", dir.file("img.exr"), "--size", "16x16", "--antialias", "1"},
+      {"run", obj, "-o", dir.file("out/")},
+      {"solve", obj, "-o", dir.file("B.csv")},
+      {"compare", obj, "--solvers", "jacobi", "-o", dir.file("cmp/")}};
+  const auto refused = [&](const std::vector<std::string>& args) {
     const auto [code, err] = run_captured(args);
-    EXPECT_EQ(code, kExitOk) << err;
-    EXPECT_EQ(count(err, "emit"), 1 + count(err, "--emit")) << err;  // one line mentions it
-    EXPECT_EQ(count(err, ": no emitter (no material with Ke > 0)"), 1) << err;
-    EXPECT_EQ(count(err, "no surface emits"), 0) << err;
-  }
+    EXPECT_EQ(code, kExitUsage) << args[0] << ": " << err;
+    EXPECT_NE(err.find("dark.obj: nothing emits"), std::string::npos) << err;
+    EXPECT_NE(err.find("--emit NAME_OR_GLOB=R,G,B"), std::string::npos) << err;
+    EXPECT_EQ(count(err, "lambert: "), 1) << err;
+  };
+  for (const auto& args : commands) refused(small(args));
+  refused({"solve", obj, "--method", "hierarchical", "-o", dir.file("B.csv")});
+  // No file written (run and compare create their -o DIR/ before loading: left empty).
+  for (const char* out : {"img.exr", "B.csv"}) EXPECT_FALSE(std::filesystem::exists(dir.file(out)));
+  for (const char* out : {"out", "cmp"})
+    EXPECT_TRUE(!std::filesystem::exists(dir.file(out)) || std::filesystem::is_empty(dir.file(out)))
+        << out;
+  const auto [code, err] = run_captured(
+      small({"solve", obj, "-o", dir.file("B.csv"), "--medium-box", "0.2,0.2,0.2,0.8,0.8,0.8",
+             "--sigma-a", "0.5,0.5,0.5", "--medium-emission", "1,1,1", "--voxels", "1"}));
+  EXPECT_EQ(code, kExitOk) << err;
 }
 
 TEST(LightingWarnings, AWorkingSceneHasNoWarning) {

@@ -179,6 +179,37 @@ TEST(ObjLoader, NonPlanarPolygonIsSplitPreservingItsTriangles) {
   for (const auto& f : s.faces) EXPECT_EQ(f.vertices.size(), 3u);
 }
 
+TEST(ObjLoader, ManyNonPlanarPolygonsAreOneWarningWithCountFirstAndWorst) {
+  // Issue 35: 3,028 lines on Sponza, one per polygon. Now one line: how many, where the
+  // first is, and the worst one's deviation (absolute and relative to its size).
+  testing::TempDir dir;
+  dir.write("s.mtl", kMtl);
+  std::string obj = "mtllib s.mtl\ng w\nusemtl white\n";
+  // 200 unit quads side by side, corner 3 lifted by 0.01 + k * 1e-4 (quad 199 the worst:
+  // 0.0299, lines 4.. are the vertices, faces from line 804).
+  for (int k = 0; k < 200; ++k)
+    obj += "v " + std::to_string(k) + " 0 0\nv " + std::to_string(k + 1) + " 0 0\nv " +
+           std::to_string(k + 1) + " 1 " + std::to_string(0.01 + k * 1e-4) + "\nv " +
+           std::to_string(k) + " 1 0\n";
+  for (int k = 0; k < 200; ++k)
+    obj += "f " + std::to_string(4 * k + 1) + " " + std::to_string(4 * k + 2) + " " +
+           std::to_string(4 * k + 3) + " " + std::to_string(4 * k + 4) + "\n";
+  LoadReport report;
+  const Scene s = load_obj(dir.write("s.obj", obj), &report);
+  EXPECT_EQ(report.nonplanar_faces_split, 200);
+  EXPECT_EQ(s.faces.size(), 400u);
+  int lines = 0;
+  for (const std::string& w : report.warnings)
+    if (w.find("non-planar") != std::string::npos) {
+      ++lines;
+      EXPECT_NE(w.find("s.obj:804: 200 non-planar polygons (the first here) split into "
+                       "triangles; the worst (line 1003)"),
+                std::string::npos)
+          << w;
+    }
+  EXPECT_EQ(lines, 1);
+}
+
 TEST(ObjLoader, EmptySceneIsAnErrorAndNoEmitterOnlyAWarning) {
   testing::TempDir dir;
   EXPECT_NE(load_error(dir, "mtllib s.mtl\n# nothing\n").find("empty scene"), std::string::npos);
