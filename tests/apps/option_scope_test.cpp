@@ -23,6 +23,7 @@
 #include "common/temp_dir.hpp"
 #include "core/error.hpp"
 #include "geometry/formfactors/formfactors.hpp"
+#include "pipeline/option_specs.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
@@ -316,6 +317,129 @@ TEST(OptionScopeSlow, NoOptionOfSolveIsAcceptedAndIgnored) {
   }
   std::printf("%zu options x %zu method/estimator/solver choices: %d runs, %d refused, %d read\n",
               options.size(), axes.size(), runs, refused, read);
+}
+
+}  // namespace lambert
+
+namespace lambert {
+namespace {
+
+// A value the row accepts (its default where it has one; the bound or a choice otherwise).
+std::vector<std::string> value_of(const OptionSpec& s) {
+  switch (s.kind) {
+    case OptionKind::Flag:
+      return {};
+    case OptionKind::Choice:
+      return {s.default_text.empty() ? s.choices.front() : s.default_text};
+    case OptionKind::Integer:
+    case OptionKind::Real:
+      return {s.default_text.empty() ? number_text(s.lo) : s.default_text};
+    case OptionKind::Text:
+      return {s.default_text};
+  }
+  return {};
+}
+
+}  // namespace
+
+TEST(OptionScope, EveryCommandRefusesEveryOptionItsChoicesDoNotRead) {
+  // Every option with a reader (pipeline/option_specs.cpp `read_by`) x every command that
+  // takes it x every registry entry (--method hierarchical; each named estimator; each
+  // solver): where the row says the command line's choices do not read it, the command
+  // refuses it before any work (exit 2, "OPTION does not apply"). The other half (a read
+  // option changes the result) is OptionScopeSlow's walk.
+  testing::TempDir dir;
+  const std::string scene = write_scene(dir);
+  struct Command {
+    std::string name;
+    bool method, solver, shading;
+  };
+  const std::vector<Command> commands = {
+      {"run", true, true, true},    {"render", true, true, true},
+      {"solve", true, true, false}, {"compare", true, false, false},
+      {"heat", false, true, false}, {"formfactors", false, false, false}};
+  const std::string surfaces =
+      dir.write("h.json", "{\"*\": {\"emissivity\": 0.5, \"temperature\": 300}}");
+  int refusals = 0;
+  for (const Command& c : commands) {
+    // The axes this command offers: {extra args, the Selection they make}.
+    std::vector<std::pair<std::vector<std::string>, Selection>> axes;
+    const std::string solver = SolveOptions().solver;
+    std::vector<std::string> all_solvers = solver_names();
+    const auto solvers_of = [&](const std::string& s) {
+      return c.name == "compare"       ? all_solvers
+             : c.name == "formfactors" ? std::vector<std::string>{}
+                                       : std::vector<std::string>{s};
+    };
+    // run and render draw random pixel samples at their default --antialias 2.
+    const Selection base{c.name, "matrix", "", {}, c.shading ? "gouraud" : "", false, c.shading};
+    for (const std::string& e : form_factor_estimators()) {
+      Selection s = base;
+      s.estimator = e;
+      s.solvers = solvers_of(solver);
+      axes.push_back({{"--estimator", e}, s});
+    }
+    if (c.solver)
+      for (const std::string& v : solver_names()) {
+        Selection s = base;
+        s.estimator = "hybrid";
+        s.solvers = {v};
+        axes.push_back({{"--estimator", "hybrid", "--solver", v}, s});
+      }
+    if (c.method) {
+      Selection s = base;
+      s.method = "hierarchical";
+      // compare's hierarchical runs are checked against a matrix reference it computes
+      // (F with --estimator auto, solved directly): the estimator options apply there.
+      if (c.name == "compare") s.estimator = "auto";
+      axes.push_back({{"--method", "hierarchical"}, s});
+    }
+    // The command as the CLI registers it: the rows it takes under their own name (the
+    // --tol of formfactors is --ff-tol's alias, --ff-tol's row).
+    CLI::App app;
+    RunOptions ro;
+    RenderOptions dr;
+    SolveCommandOptions so;
+    CompareOptions co;
+    HeatOptions ho;
+    FormFactorsOptions fo;
+    const CLI::App* cmd = c.name == "run"       ? add_run_command(app, ro)
+                          : c.name == "render"  ? add_render_command(app, dr)
+                          : c.name == "solve"   ? add_solve_command(app, so)
+                          : c.name == "compare" ? add_compare_command(app, co)
+                          : c.name == "heat"    ? add_heat_command(app, ho)
+                                                : add_formfactors_command(app, fo);
+    const auto takes = [&](const std::string& name) {
+      const CLI::Option* o = cmd->get_option_no_throw(name);
+      return o != nullptr && "--" + o->get_lnames().front() == name;
+    };
+    for (const OptionSpec& row : option_specs()) {
+      if (!row.reads || find_option_spec(row.name, c.name) != &row || !takes(row.name)) continue;
+      for (const auto& [extra, selection] : axes) {
+        if (row.reads(selection)) continue;
+        const std::string out = c.name == "formfactors" ? dir.file("out.bin")
+                                : c.name == "solve"     ? dir.file("out.csv")
+                                : c.name == "render"    ? dir.file("out.exr")
+                                                        : dir.file("out/");
+        std::vector<std::string> args = {c.name, scene, "-q", "-o", out};
+        if (c.name == "heat") args.insert(args.end(), {"--surfaces", surfaces});
+        args.insert(args.end(), extra.begin(), extra.end());
+        args.push_back(row.name);
+        const std::vector<std::string> value = value_of(row);
+        args.insert(args.end(), value.begin(), value.end());
+        const auto [code, err] = run_capturing(args);
+        EXPECT_EQ(code, kExitUsage) << ::testing::PrintToString(args) << ": " << err;
+        EXPECT_NE(err.find(row.name + " does not apply"), std::string::npos)
+            << ::testing::PrintToString(args) << ": " << err;
+        ++refusals;
+      }
+    }
+  }
+  for (const char* out : {"out.bin", "out.csv", "out.exr"})
+    EXPECT_FALSE(std::filesystem::exists(dir.file(out))) << out;
+  EXPECT_TRUE(!std::filesystem::exists(dir.file("out")) ||
+              std::filesystem::is_empty(dir.file("out")));
+  std::printf("%d refusals checked\n", refusals);
 }
 
 }  // namespace lambert
