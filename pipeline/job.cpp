@@ -249,6 +249,7 @@ LoadedScene load_scene(const SceneArgs& args, const JobPlan& plan) {
   out.scene = load_checked_scene(args, plan);
   MeshOptions mo = mesh_options(args);
   const MeshPlan mesh_plan = plan_mesh(out.scene, mo);
+  if (!mesh_plan.note.empty()) log_info(mesh_plan.note);
   if (mesh_plan.patches <= kMaxPatches) check_job_memory(mesh_plan.patches, plan);
   // Planned: mesh_scene need not search again (discontinuity meshing plans its own
   // correction from the target).

@@ -341,6 +341,26 @@ std::vector<SurfaceElements> collect_all(const Scene& scene) {
   return surfaces;
 }
 
+// The area of a surface's elements (scene units²).
+double elements_area(const SurfaceElements& s) {
+  double a = 0.0;
+  for (const auto& e : s.elements) {
+    const auto& P = s.points;
+    a += 0.5 * (P[e.v[1]] - P[e.v[0]]).cross(P[e.v[2]] - P[e.v[0]]).norm();
+    if (e.n == 4) a += 0.5 * (P[e.v[2]] - P[e.v[0]]).cross(P[e.v[3]] - P[e.v[0]]).norm();
+  }
+  return a;
+}
+
+std::string thousands(std::int64_t n) {  // 69938 -> "69,938"
+  std::string digits = std::to_string(n), out;
+  for (std::size_t k = 0; k < digits.size(); ++k) {
+    if (k > 0 && (digits.size() - k) % 3 == 0) out += ',';
+    out += digits[k];
+  }
+  return out;
+}
+
 MeshPlan plan_surfaces(const Scene& scene, const std::vector<SurfaceElements>& surfaces,
                        const MeshOptions& options) {
   LAMBERT_CHECK(options.max_edge >= 0 && options.target_patches >= 0, "negative mesh target");
@@ -354,26 +374,62 @@ MeshPlan plan_surfaces(const Scene& scene, const std::vector<SurfaceElements>& s
     return t;
   };
   double max_edge = options.max_edge;
+  MeshPlan plan;
   if (max_edge <= 0 && options.target_patches > 0) {
-    // Bisection on log(max_edge): the patch count is monotone (non-increasing) in max_edge.
+    // The target is met by area: a surface that the edge h subdivides counts its patches;
+    // one that h leaves as its own elements (a detailed object finer than h, or a small
+    // face) counts its area share A_s / h², not its element count. So a 3,000-triangle
+    // bunny in a box takes its area's share of the budget and the walls keep theirs (it
+    // took 3,000 of 3,020 and left every wall one patch); the mesh then exceeds the target
+    // by the detail it cannot drop, and the plan says so. Non-increasing in h: bisection.
+    std::vector<double> area(surfaces.size());
+    for (std::size_t k = 0; k < surfaces.size(); ++k) area[k] = elements_area(surfaces[k]);
+    auto budget = [&](double h) {
+      double t = 0.0;
+      for (std::size_t k = 0; k < surfaces.size(); ++k) {
+        const std::int64_t c = count_patches(surfaces[k], classes[k], h);
+        const auto elements = static_cast<std::int64_t>(surfaces[k].elements.size());
+        t += c > elements ? static_cast<double>(c)
+                          : std::min(static_cast<double>(elements), area[k] / (h * h));
+      }
+      return t;
+    };
     const auto [lo_corner, hi_corner] = scene.bounds();
     double hi = (hi_corner - lo_corner).norm();  // one element per edge or fewer
     double lo = hi * 1e-4;
     const double target = static_cast<double>(options.target_patches);
-    if (total(lo) < target) {
+    if (budget(lo) < target) {
       max_edge = lo;
     } else {
       for (int it = 0; it < 60; ++it) {
         const double mid = std::sqrt(lo * hi);
-        (static_cast<double>(total(mid)) > target ? lo : hi) = mid;
+        (budget(mid) > target ? lo : hi) = mid;
       }
       // Pick whichever bracket is closer to the target.
-      const double dlo = std::abs(static_cast<double>(total(lo)) - target);
-      const double dhi = std::abs(static_cast<double>(total(hi)) - target);
-      max_edge = dlo < dhi ? lo : hi;
+      max_edge = std::abs(budget(lo) - target) < std::abs(budget(hi) - target) ? lo : hi;
+    }
+    // Where the mesh exceeds the target by more than 10 %, name the detail that made it.
+    const std::int64_t made = total(max_edge);
+    if (static_cast<double>(made) > 1.1 * target) {
+      std::size_t worst = 0;
+      std::int64_t worst_elements = -1;
+      for (std::size_t k = 0; k < surfaces.size(); ++k) {
+        const auto elements = static_cast<std::int64_t>(surfaces[k].elements.size());
+        if (count_patches(surfaces[k], classes[k], max_edge) == elements &&
+            elements > worst_elements) {
+          worst = k;
+          worst_elements = elements;
+        }
+      }
+      plan.note = "meshing: the target of " + thousands(options.target_patches) +
+                  " patches grew to " + thousands(made) + ": detailed surfaces keep at least " +
+                  "one patch per face (the largest, '" + scene.surfaces[worst].name + "', has " +
+                  thousands(worst_elements) + " faces); the others get their area's share";
     }
   }
-  return {max_edge, total(max_edge)};
+  plan.max_edge = max_edge;
+  plan.patches = total(max_edge);
+  return plan;
 }
 
 }  // namespace

@@ -78,6 +78,9 @@ struct MeshOptions {
 struct MeshPlan {
   double max_edge = 0.0;     ///< the edge bound mesh_scene will use
   std::int64_t patches = 0;  ///< the exact patch count it will produce
+  /// For a patch target: a line for the log when the mesh exceeds the target by more than
+  /// 10 % (detail that keeps a patch per face), naming the largest such surface; else "".
+  std::string note;
 };
 /// The edge bound and patch count mesh_scene(scene, options) will use and produce.
 MeshPlan plan_mesh(const Scene& scene, const MeshOptions& options);

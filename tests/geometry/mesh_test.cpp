@@ -190,3 +190,57 @@ TEST(Mesh, EightyThousandOneFaceSurfacesKeepTheirFaces) {
 }
 
 }  // namespace lambert
+
+namespace lambert {
+
+TEST(Mesh, APatchTargetIsSharedByAreaBesideADetailedObject) {
+  // Issue 35: a 3,000-triangle bunny in the Cornell box took 3,000 of the 3,020 patches of the
+  // default target and left every wall one patch. A 4 x 4 x 3 room (80 m², 6 quads) holds a
+  // 0.5 x 0.5 sheet of 3,200 triangles (0.25 m²): with a 2,000-patch target the room's
+  // surfaces get their area's share (about 2,000 x 80 / 80.25; each within the quantisation
+  // of a whole number of segments per edge: h ~ 0.2 puts 15-20 segments on an edge, so a
+  // surface's count is within 2 x 1/15 of A_s / h²), the sheet keeps one patch per face,
+  // and the plan says why the mesh exceeds the target.
+  Scene s;
+  const double L = 4.0, H = 3.0;
+  add_polygon(s, "floor", white(), {{0, 0, 0}, {L, 0, 0}, {L, L, 0}, {0, L, 0}});
+  add_polygon(s, "ceiling", white(), {{0, 0, H}, {0, L, H}, {L, L, H}, {L, 0, H}});
+  add_polygon(s, "south", white(), {{0, 0, 0}, {0, 0, H}, {L, 0, H}, {L, 0, 0}});
+  add_polygon(s, "north", white(), {{0, L, 0}, {L, L, 0}, {L, L, H}, {0, L, H}});
+  add_polygon(s, "west", white(), {{0, 0, 0}, {0, L, 0}, {0, L, H}, {0, 0, H}});
+  add_polygon(s, "east", white(), {{L, 0, 0}, {L, 0, H}, {L, L, H}, {L, L, 0}});
+  const int n = 40;
+  const double x0 = 1.75, d = 0.5 / n, z = 0.5;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const Eigen::Vector3d a(x0 + i * d, x0 + j * d, z), b(x0 + (i + 1) * d, x0 + j * d, z),
+          c(x0 + (i + 1) * d, x0 + (j + 1) * d, z), e(x0 + i * d, x0 + (j + 1) * d, z);
+      add_polygon(s, "sheet", white(), {a, b, c});
+      add_polygon(s, "sheet", white(), {a, c, e});
+    }
+  const MeshOptions options{0, 2000};
+  const MeshPlan plan = plan_mesh(s, options);
+  const PatchMesh mesh = mesh_scene(s, options);
+  ASSERT_EQ(plan.patches, mesh.size());
+  std::map<std::string, std::int64_t> count;
+  for (const Patch& p : mesh.patches) ++count[mesh.surface_names[p.surface]];
+  EXPECT_EQ(count["sheet"], 2 * n * n);
+  const double h2 = plan.max_edge * plan.max_edge;
+  const std::vector<double> area = surface_areas(s);
+  double room = 0.0;
+  for (std::size_t k = 0; k < s.surfaces.size(); ++k) {
+    const std::string& name = s.surfaces[k].name;
+    if (name == "sheet") continue;
+    room += static_cast<double>(count[name]);
+    EXPECT_NEAR(static_cast<double>(count[name]) / (area[k] / h2), 1.0, 2.0 / 15.0) << name;
+  }
+  // The room's surfaces meet the target's room share (the budget counts the sheet as its
+  // area share, 2000 x 0.25 / 80.25 ~ 6 patches): within the step of one segment per edge.
+  EXPECT_NEAR(room, 2000.0 * 80.0 / 80.25, 0.15 * 2000.0);
+  EXPECT_NE(plan.note.find("grew to"), std::string::npos) << plan.note;
+  EXPECT_NE(plan.note.find("'sheet', has 3,200 faces"), std::string::npos) << plan.note;
+  // Without detail the target is met as before, and nothing is said.
+  EXPECT_EQ(plan_mesh(mixed_scene(), {0, 1000}).note, "");
+}
+
+}  // namespace lambert
