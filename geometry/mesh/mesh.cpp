@@ -411,20 +411,26 @@ MeshPlan plan_surfaces(const Scene& scene, const std::vector<SurfaceElements>& s
     // Where the mesh exceeds the target by more than 10 %, name the detail that made it.
     const std::int64_t made = total(max_edge);
     if (static_cast<double>(made) > 1.1 * target) {
-      std::size_t worst = 0;
-      std::int64_t worst_elements = -1;
+      std::size_t worst = 0, detailed = 0;
+      std::int64_t worst_elements = -1, detail_faces = 0;
       for (std::size_t k = 0; k < surfaces.size(); ++k) {
         const auto elements = static_cast<std::int64_t>(surfaces[k].elements.size());
-        if (count_patches(surfaces[k], classes[k], max_edge) == elements &&
-            elements > worst_elements) {
+        if (count_patches(surfaces[k], classes[k], max_edge) != elements || elements < 2) continue;
+        ++detailed;
+        detail_faces += elements;
+        if (elements > worst_elements) {
           worst = k;
           worst_elements = elements;
         }
       }
       plan.note = "meshing: the target of " + thousands(options.target_patches) +
-                  " patches grew to " + thousands(made) + ": detailed surfaces keep at least " +
-                  "one patch per face (the largest, '" + scene.surfaces[worst].name + "', has " +
-                  thousands(worst_elements) + " faces); the others get their area's share";
+                  " patches grew to " + thousands(made) + ": " +
+                  (detailed == 1 ? std::string("a detailed surface keeps")
+                                 : thousands(static_cast<std::int64_t>(detailed)) +
+                                       " detailed surfaces keep") +
+                  " one patch per face (" + thousands(detail_faces) + " faces; the largest, '" +
+                  scene.surfaces[worst].name + "', has " + thousands(worst_elements) +
+                  "); the others get their area's share";
     }
   }
   plan.max_edge = max_edge;
