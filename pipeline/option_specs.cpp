@@ -210,9 +210,8 @@ Row text(std::string name, std::string value_name,
   return r;
 }
 
-// The commands of each family (the apps/options.cpp functions that register them).
+// The commands that compute or load F (--ff).
 const std::vector<std::string> kComputesF = {"render", "run", "solve", "compare", "heat"};
-const std::vector<std::string> kMethodCommands = {"render", "run", "solve", "compare"};
 
 std::vector<OptionSpec> make_specs() {
   const FormFactorArgs ff;
