@@ -37,7 +37,7 @@ struct Method {
 /// The registry, in the order `--help` lists it; the first row is the default.
 const std::vector<Method>& methods();
 
-/// The registry's names (for CLI::IsMember).
+/// The registry's names (the choices of --method).
 std::vector<std::string> method_names();
 
 /// The registry row of `name` (UsageError if there is none).

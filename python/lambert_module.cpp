@@ -308,93 +308,109 @@ class Released {
   py::gil_scoped_release release_;
 };
 
-// UsageError for an unknown solver, tol outside (0, 1) or max_iterations < 1.
-// The form-factor keywords given (those whose value is not the declared default: the
-// Python wrapper drops those), checked by their rows and set as the CLI sets its options.
-FormFactorArgs ff_args_from_keywords(const py::dict& settings) {
-  FormFactorArgs args;
+// The keywords given by name (the wrapper sends those not at their declared default), each
+// checked by its row of `group` in the declarations (a row of every command: run's cheaper
+// --samples is the CLI's only) and handed to `set` as text (choices) or a number.
+template <class Set>
+void apply_keywords(const py::dict& settings, const std::string& group, const char* function,
+                    Set set) {
   for (const auto& [key, value] : settings) {
     const std::string keyword = py::cast<std::string>(key);
     const OptionSpec* row = nullptr;
     for (const OptionSpec& s : option_specs())
-      if (s.group == "form factors" && s.keyword == keyword && s.commands.empty()) row = &s;
-    if (row == nullptr) throw UsageError("form_factors: unknown keyword '" + keyword + "'");
+      if (s.group == group && s.keyword == keyword && s.commands.empty()) row = &s;
+    if (row == nullptr)
+      throw UsageError(std::string(function) + ": unknown keyword '" + keyword + "'");
+    std::string text;
+    double x = 0.0;
     if (row->kind == OptionKind::Choice) {
-      const std::string text = py::cast<std::string>(value);
+      text = py::cast<std::string>(value);
       check_option_choice(*row, text, keyword);
-      (row->name == "--estimator" ? args.estimator : args.reciprocity) = text;
-      args.reciprocity_given |= row->name == "--reciprocity";
-      continue;
-    }
-    const double x = py::cast<double>(value);
-    check_option_value(*row, x, keyword);
-    const int n = static_cast<int>(x);  // Integer rows: whole, in an int's range
-    if (row->name == "--samples") {
-      args.samples = n;
-      args.samples_given = true;
-    } else if (row->name == "--rays") {
-      args.rays = n;
-      args.rays_given = true;
-    } else if (row->name == "--ff-tol") {
-      args.tol = x;
-      args.tol_given = true;
-    } else if (row->name == "--threshold") {
-      args.threshold = x;
-    } else if (row->name == "--hemicube-res") {
-      args.hemicube_resolution = n;
-    } else if (row->name == "--specular-depth") {
-      args.specular_depth = n;
-      args.specular_given = true;
-    } else if (row->name == "--specular-rays") {
-      args.specular_rays = n;
-      args.specular_given = true;
     } else {
-      LAMBERT_CHECK(false, "form_factors: no binding for " + row->name);
+      x = py::cast<double>(value);
+      check_option_value(*row, x, keyword);
     }
+    set(row->name, text, x);
   }
+}
+
+// Refuses (UsageError, naming the keyword and its reader) the first keyword of `group` given
+// that `selection` does not read: the CLI's refusal (unread_options), in Python's names.
+void refuse_unread_keywords(const py::dict& settings, const std::string& group,
+                            const Selection& selection, const std::string& choice) {
+  const OptionGiven given = [&](const std::string& name) {
+    const OptionSpec& row = option_spec(name);
+    return !row.keyword.empty() && row.group == group && settings.contains(row.keyword.c_str());
+  };
+  const std::vector<std::string> unread = unread_options(given, selection);
+  if (unread.empty()) return;
+  const OptionSpec& row = option_spec(unread.front());
+  throw UsageError(row.keyword + " does not apply to " + choice + " (read by " + row.reader + ")");
+}
+
+// The form-factor keywords, set as the CLI sets its options (FormFactorArgs).
+FormFactorArgs ff_args_from_keywords(const py::dict& settings) {
+  FormFactorArgs args;
+  apply_keywords(settings, "form factors", "form_factors",
+                 [&](const std::string& name, const std::string& text, double x) {
+                   const int n = static_cast<int>(x);  // Integer rows: whole, in int's range
+                   if (name == "--estimator") {
+                     args.estimator = text;
+                   } else if (name == "--reciprocity") {
+                     args.reciprocity = text;
+                     args.reciprocity_given = true;
+                   } else if (name == "--samples") {
+                     args.samples = n;
+                     args.samples_given = true;
+                   } else if (name == "--rays") {
+                     args.rays = n;
+                     args.rays_given = true;
+                   } else if (name == "--ff-tol") {
+                     args.tol = x;
+                     args.tol_given = true;
+                   } else if (name == "--threshold") {
+                     args.threshold = x;
+                   } else if (name == "--hemicube-res") {
+                     args.hemicube_resolution = n;
+                   } else if (name == "--specular-depth") {
+                     args.specular_depth = n;
+                     args.specular_given = true;
+                   } else if (name == "--specular-rays") {
+                     args.specular_rays = n;
+                     args.specular_given = true;
+                   } else {
+                     LAMBERT_CHECK(false, "form_factors: no binding for " + name);
+                   }
+                 });
+  refuse_unread_keywords(settings, "form factors",
+                         {"formfactors", "matrix", args.estimator, {}, "", false, false},
+                         "estimator " + args.estimator);
   return args;
 }
 
-// The solver keywords given (those not at their declared default), checked by their rows;
-// what the solver does not read is refused as `lambert solve` refuses it.
+// The solver keywords (SolveOptions); what the solver does not read is refused as `lambert
+// solve` refuses it.
 SolveOptions solve_options_from_keywords(const py::dict& settings) {
   SolveOptions o;
-  for (const auto& [key, value] : settings) {
-    const std::string keyword = py::cast<std::string>(key);
-    const OptionSpec* row = nullptr;
-    for (const OptionSpec& s : option_specs())
-      if (s.group == "solver" && s.keyword == keyword && s.commands.empty()) row = &s;
-    if (row == nullptr) throw UsageError("solve: unknown keyword '" + keyword + "'");
-    if (row->kind == OptionKind::Choice) {
-      const std::string text = py::cast<std::string>(value);
-      check_option_choice(*row, text, keyword);
-      (row->name == "--solver" ? o.solver : o.preconditioner) = text;
-      continue;
-    }
-    const double x = py::cast<double>(value);
-    check_option_value(*row, x, keyword);
-    if (row->name == "--tol")
-      o.tol = x;
-    else if (row->name == "--max-iter")
-      o.max_iterations = static_cast<int>(x);
-    else if (row->name == "--omega")
-      o.omega = x;
-    else if (row->name == "--restart")
-      o.restart = static_cast<int>(x);
-    else
-      LAMBERT_CHECK(false, "solve: no binding for " + row->name);
-  }
-  const OptionGiven given = [&settings](const std::string& name) {
-    const OptionSpec& row = option_spec(name);
-    return !row.keyword.empty() && row.group == "solver" && settings.contains(row.keyword.c_str());
-  };
-  const Selection selection{"solve", "matrix", "", {o.solver}, "", false, false};
-  const std::vector<std::string> unread = unread_options(given, selection);
-  if (!unread.empty()) {
-    const OptionSpec& row = option_spec(unread.front());
-    throw UsageError(row.keyword + " does not apply to solver " + o.solver + " (read by " +
-                     row.reader + ")");
-  }
+  apply_keywords(settings, "solver", "solve",
+                 [&](const std::string& name, const std::string& text, double x) {
+                   if (name == "--solver")
+                     o.solver = text;
+                   else if (name == "--preconditioner")
+                     o.preconditioner = text;
+                   else if (name == "--tol")
+                     o.tol = x;
+                   else if (name == "--max-iter")
+                     o.max_iterations = static_cast<int>(x);
+                   else if (name == "--omega")
+                     o.omega = x;
+                   else if (name == "--restart")
+                     o.restart = static_cast<int>(x);
+                   else
+                     LAMBERT_CHECK(false, "solve: no binding for " + name);
+                 });
+  refuse_unread_keywords(settings, "solver", {"solve", "matrix", "", {o.solver}, "", false, false},
+                         "solver " + o.solver);
   return o;
 }
 
@@ -627,21 +643,9 @@ PYBIND11_MODULE(_lambert, m) {
       [](const MeshHandle& h, const py::dict& settings, std::uint64_t seed, int threads,
          bool with_stderr) {
         if (threads < 0) throw UsageError("threads must be >= 0 (0 = all cores)");
-        const FormFactorArgs args = ff_args_from_keywords(settings);
         // As `lambert formfactors`: what the estimator does not read is refused (the rows'
         // `reads`, then auto's pick for this mesh), then the CLI's FormFactorOptions.
-        const OptionGiven given = [&settings](const std::string& name) {
-          const OptionSpec& row = option_spec(name);
-          return !row.keyword.empty() && row.group == "form factors" &&
-                 settings.contains(row.keyword.c_str());
-        };
-        const Selection selection{"formfactors", "matrix", args.estimator, {}, "", false, false};
-        const std::vector<std::string> unread = unread_options(given, selection);
-        if (!unread.empty()) {
-          const OptionSpec& row = option_spec(unread.front());
-          throw UsageError(row.keyword + " does not apply to estimator " + args.estimator +
-                           " (read by " + row.reader + ")");
-        }
+        const FormFactorArgs args = ff_args_from_keywords(settings);
         RunArgs run;
         run.seed = seed;
         run.threads = threads;
