@@ -402,7 +402,7 @@ int run_accuracy(const AccuracyOptions& opts) {
   // The largest F held at a time: an all-pairs estimate with standard errors (the hybrid
   // reference) beside the run's own.
   plan.ff = FormFactorOptions{};
-  plan.ff->with_stderr = true;
+  plan.ff->run.with_stderr = true;
   std::optional<StudyMedium> sm;
   if (const std::shared_ptr<const Medium> medium = make_medium(opts.medium)) {
     sm.emplace();
@@ -434,9 +434,9 @@ int run_accuracy(const AccuracyOptions& opts) {
 
   // The reference.
   FormFactorOptions base;
-  base.seed = opts.run.seed;
-  base.threads = opts.run.threads;
-  base.progress = !opts.run.quiet;
+  base.run.seed = opts.run.seed;
+  base.run.threads = opts.run.threads;
+  base.run.progress = !opts.run.quiet;
   FormFactors ref;
   if (analytic) {
     log_info("accuracy: reference by quadrature of the exact point-to-patch factor");
@@ -444,12 +444,12 @@ int run_accuracy(const AccuracyOptions& opts) {
   } else {
     FormFactorOptions o = base;
     o.estimator = "hybrid";
-    o.samples = opts.reference_samples;
+    o.pair.samples = opts.reference_samples;
     // Its own random streams: sharing the runs' lattice shifts would correlate their errors
     // with the reference's and make them look smaller than they are.
-    o.seed = hash_keys(opts.run.seed, 0x7265666572656E63ull);
-    o.with_stderr = true;
-    log_info("accuracy: reference hybrid k=" + std::to_string(o.samples));
+    o.run.seed = hash_keys(opts.run.seed, 0x7265666572656E63ull);
+    o.run.with_stderr = true;
+    log_info("accuracy: reference hybrid k=" + std::to_string(o.pair.samples));
     ref = compute_form_factors(mesh, o);
   }
   SparseF ref_stderr;  // the surface reference's own error (the medium's factors have none)
@@ -496,9 +496,12 @@ int run_accuracy(const AccuracyOptions& opts) {
   for (const RunSpec& spec : run_specs(opts)) {
     FormFactorOptions o = base;
     o.estimator = spec.estimator;
-    if (spec.estimator == "hemicube") o.hemicube_resolution = spec.value;
-    else if (spec.estimator == "gather") o.rays = spec.value;
-    else o.samples = spec.value;
+    if (spec.estimator == "hemicube")
+      o.hemicube.resolution = spec.value;
+    else if (spec.estimator == "gather")
+      o.gather.rays = spec.value;
+    else
+      o.pair.samples = spec.value;
     // gather keeps its default (averaged); the hemicube rows say which they are.
     o.reciprocity = spec.symmetrize ? "average" : spec.estimator == "gather" ? "auto" : "none";
     AccuracyRow row;

@@ -169,7 +169,7 @@ int compare_matrix(const CompareOptions& opts) {
   Zones zones;
   if (medium) {
     zones = make_zones(*medium);
-    if (ff.options.medium_zones == 0) {
+    if (ff.options.contents.medium_zones == 0) {
       warn_about_lighting(loaded.mesh, ff.F);
       check_closed_lossless(loaded.mesh, ff);
       ff = medium_form_factors(loaded, ff, *medium, zones, opts.medium, opts.run);

@@ -55,8 +55,8 @@ struct DistributedF {
 FormFactorOptions distributed_ff_options(const FormFactorArgs& args, const RunArgs& run,
                                          std::int32_t n, bool with_stderr) {
   FormFactorOptions o = make_ff_options(args, run);
-  o.with_stderr = with_stderr;
-  if (o.estimator == "auto" && auto_estimator(n, o.tol_given) == "gather") {
+  o.run.with_stderr = with_stderr;
+  if (o.estimator == "auto" && auto_estimator(n, o.analytic.tol_given) == "gather") {
     o.estimator = "hybrid";
     o.estimator_requested = "auto";
     log_info("--distributed: auto picks hybrid (gather, its pick at " + std::to_string(n) +
@@ -92,15 +92,15 @@ DistributedF distributed_form_factors(const dist::Session& s, const LoadedScene&
       return;
     }
     FormFactorOptions o = distributed_ff_options(args, run, n, with_stderr);
-    o.row_begin = out.rows[s.rank()];
-    o.row_end = out.rows[s.rank() + 1];
-    if (o.row_end > o.row_begin) {
+    o.subset.row_begin = out.rows[s.rank()];
+    o.subset.row_end = out.rows[s.rank() + 1];
+    if (o.subset.row_end > o.subset.row_begin) {
       partial = compute_form_factors(scene.mesh, o, &scene_bvh(scene, run.threads));
     } else {  // more ranks than rows
       partial.F.resize(n, n);
       partial.F.makeCompressed();
     }
-    o.row_begin = o.row_end = 0;
+    o.subset.row_begin = o.subset.row_end = 0;
     out.options = o;
     compute_seconds = timer.seconds();
   });

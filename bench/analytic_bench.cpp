@@ -156,13 +156,13 @@ void room(const std::vector<double>& tols, int boxes, int threads) {
   std::vector<FormFactors> runs;
   std::vector<std::string> names;
   FormFactorOptions o;
-  o.progress = false;
-  o.threads = threads;
+  o.run.progress = false;
+  o.run.threads = threads;
   o.estimator = "analytic";
   std::vector<double> sorted = tols;
   std::sort(sorted.begin(), sorted.end());  // tightest first: the others compare to it
   for (double tol : sorted) {
-    o.tol = tol;
+    o.analytic.tol = tol;
     runs.push_back(compute_form_factors(mesh, o));
     char buf[64];
     std::snprintf(buf, sizeof buf, "analytic tol %.0e", tol);
@@ -170,7 +170,7 @@ void room(const std::vector<double>& tols, int boxes, int threads) {
   }
   o.estimator = "hybrid";
   for (int k : {32, 1024}) {
-    o.samples = k;
+    o.pair.samples = k;
     runs.push_back(compute_form_factors(mesh, o));
     names.push_back("hybrid " + std::to_string(k) + " samples");
   }
@@ -190,8 +190,8 @@ void cornell(const std::vector<double>& sizes, int threads) {
   for (double n : sizes) {
     const PatchMesh mesh = mesh_scene(scene, {0.0, static_cast<std::int64_t>(n)});
     FormFactorOptions o;
-    o.progress = false;
-    o.threads = threads;
+    o.run.progress = false;
+    o.run.threads = threads;
     o.estimator = "analytic";
     const FormFactors a = compute_form_factors(mesh, o);
     o.estimator = "hybrid";

@@ -203,11 +203,11 @@ int main(int argc, char** argv) {
   auto options = [&](const char* est, int count, std::uint64_t seed, const char* recip) {
     FormFactorOptions o;
     o.estimator = est;
-    (std::string(est) == "gather" ? o.rays : o.samples) = count;
-    o.seed = seed;
+    (std::string(est) == "gather" ? o.gather.rays : o.pair.samples) = count;
+    o.run.seed = seed;
     o.reciprocity = recip;
-    o.threads = threads;
-    o.progress = false;
+    o.run.threads = threads;
+    o.run.progress = false;
     return o;
   };
 

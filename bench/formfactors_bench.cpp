@@ -136,9 +136,9 @@ int main(int argc, char** argv) {
     for (const char* est : {"mc", "hybrid"}) {
       FormFactorOptions o;
       o.estimator = est;
-      o.samples = samples;
-      o.threads = threads;
-      o.progress = false;
+      o.pair.samples = samples;
+      o.run.threads = threads;
+      o.run.progress = false;
       const FormFactors ff = compute_form_factors(mesh, o);
       (std::string(est) == "mc" ? e2e_mc : e2e_hybrid).push_back(ff.stats.rays / ff.stats.seconds);
     }
@@ -156,9 +156,9 @@ int main(int argc, char** argv) {
     raw_closest.push_back(raw_closest_hit_rate(bvh, grays, threads));
     FormFactorOptions o;
     o.estimator = "gather";
-    o.rays = gather_k;
-    o.threads = threads;
-    o.progress = false;
+    o.gather.rays = gather_k;
+    o.run.threads = threads;
+    o.run.progress = false;
     const FormFactors ff = compute_form_factors(mesh, o);
     e2e_gather.push_back(ff.stats.rays / ff.stats.seconds);
   }
@@ -174,12 +174,13 @@ int main(int argc, char** argv) {
     // Beyond ~10,000 patches one ray per pair already gives a per-surface error well
     // below 1 %, and keeps the 30,000-patch fill (~3e8 pairs) within minutes on 2 cores.
     o.estimator = "mc";
-    o.samples = n > 10000 ? 1 : n > 2000 ? 4 : samples;
-    o.threads = threads;
-    o.progress = false;
+    o.pair.samples = n > 10000 ? 1 : n > 2000 ? 4 : samples;
+    o.run.threads = threads;
+    o.run.progress = false;
     const ChildResult r = fill_in_child(n, o);
     std::printf("%-9lld %-9d %8s %10d %12.3g %10.3g %12.2f %12.0f\n", static_cast<long long>(n),
-                r.patches, o.estimator.c_str(), o.samples, r.rays, r.nnz, r.seconds, r.max_rss_kb / 1024.0);
+                r.patches, o.estimator.c_str(), o.pair.samples, r.rays, r.nnz, r.seconds,
+                r.max_rss_kb / 1024.0);
     std::fflush(stdout);
   }
   return 0;

@@ -46,10 +46,12 @@ Measure run(const PatchMesh& mesh, const SparseF& ref, const std::string& estima
             int threads) {
   FormFactorOptions o;
   o.estimator = estimator;
-  if (estimator == "hemicube") o.hemicube_resolution = value;
-  else o.samples = value;
-  o.threads = threads;
-  o.progress = false;
+  if (estimator == "hemicube")
+    o.hemicube.resolution = value;
+  else
+    o.pair.samples = value;
+  o.run.threads = threads;
+  o.run.progress = false;
   const FormFactors ff = compute_form_factors(mesh, o);
   Measure m{estimator, value, ff.stats.seconds};
   compare(ff.F, ref, m);
@@ -97,9 +99,9 @@ int main(int argc, char** argv) {
     for (int r : res) {
       FormFactorOptions o;
       o.estimator = "hemicube";
-      o.hemicube_resolution = r;
-      o.threads = threads;
-      o.progress = false;
+      o.hemicube.resolution = r;
+      o.run.threads = threads;
+      o.run.progress = false;
       ff::HemicubeStats hs;
       const FormFactors ff = ff::compute_hemicube(mesh, o, &hs);
       std::printf("hemicube N=%-4d %8.2f s  nnz %lld  pixels tested %.3g\n", r, ff.stats.seconds,
@@ -109,12 +111,12 @@ int main(int argc, char** argv) {
   }
 
   FormFactorOptions ro;
-  ro.samples = reference_samples;
-  ro.seed = 0x5EED;  // a stream independent of the sweep's (seed 1), so hybrid at k equal
-                     // to the reference's count is not compared with itself
-  ro.threads = threads;
-  ro.with_stderr = true;
-  ro.progress = false;
+  ro.pair.samples = reference_samples;
+  ro.run.seed = 0x5EED;  // a stream independent of the sweep's (seed 1), so hybrid at k equal
+                         // to the reference's count is not compared with itself
+  ro.run.threads = threads;
+  ro.run.with_stderr = true;
+  ro.run.progress = false;
   const FormFactors ref = compute_form_factors(mesh, ro);
   double se2 = 0.0;
   for (std::int64_t k = 0; k < ref.stderr_F.nonZeros(); ++k) se2 += std::pow(ref.stderr_F.valuePtr()[k], 2);

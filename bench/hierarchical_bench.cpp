@@ -158,11 +158,11 @@ MatrixRun run_matrix(const Scene& scene, std::int64_t patches, const FormFactorO
 FormFactorOptions matrix_options(const Settings& s, const char* estimator) {
   FormFactorOptions o;
   o.estimator = estimator;
-  o.samples = s.samples;
-  o.rays = s.family_rays;
-  o.seed = s.seed;
-  o.threads = s.threads;
-  o.progress = false;
+  o.pair.samples = s.samples;
+  o.gather.rays = s.family_rays;
+  o.run.seed = s.seed;
+  o.run.threads = s.threads;
+  o.run.progress = false;
   return o;
 }
 

@@ -68,8 +68,8 @@ struct Run {
 std::pair<Eigen::MatrixX3d, Eigen::MatrixX3d> solve_mesh(const PatchMesh& mesh, int samples) {
   FormFactorOptions fo;
   fo.estimator = "hybrid";
-  fo.samples = samples;
-  fo.progress = false;
+  fo.pair.samples = samples;
+  fo.run.progress = false;
   const FormFactors F = compute_form_factors(mesh, fo);
   SolveOptions so;
   so.tol = 1e-10;
@@ -184,8 +184,8 @@ int main(int argc, char** argv) {
     // their lit part reflects), so the reference errs the same way, by about 0.2 % at 48k.
     FormFactorOptions fo;
     fo.estimator = "gather";
-    fo.rays = 4096;
-    fo.progress = false;
+    fo.gather.rays = 4096;
+    fo.run.progress = false;
     SolveOptions so;
     so.tol = 1e-10;
     const FormFactors ref_F = compute_form_factors(ref_mesh, fo);

@@ -60,9 +60,9 @@ Solved solve(const Scene& scene, std::int64_t patches, int threads) {
   s.mesh = mesh_scene(scene, mo);
   FormFactorOptions fo;
   fo.estimator = "gather";
-  fo.rays = 1024;
-  fo.threads = threads;
-  fo.progress = false;
+  fo.gather.rays = 1024;
+  fo.run.threads = threads;
+  fo.run.progress = false;
   const FormFactors F = compute_form_factors(s.mesh, fo);
   SolveOptions so;
   so.tol = 1e-10;

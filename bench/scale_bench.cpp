@@ -143,9 +143,9 @@ CaseResult run_case(const std::string& scene_name, std::int64_t target, int rays
   r.raw_rate = raw_closest_hit_rate(bvh, hemisphere_rays(mesh, 64, stride), threads);  // freed here
   FormFactorOptions o;
   o.estimator = "gather";
-  o.rays = rays_per_patch;
-  o.threads = threads;
-  o.progress = false;
+  o.gather.rays = rays_per_patch;
+  o.run.threads = threads;
+  o.run.progress = false;
   const FormFactors ff = compute_form_factors(mesh, o, &bvh);  // averaged (the default)
   r.average_s = ff.stats.reciprocity_seconds;
   r.ff_s = ff.stats.seconds - r.average_s;

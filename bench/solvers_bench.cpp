@@ -79,8 +79,8 @@ int main(int argc, char** argv) {
   const lambert::LoadedScene scene = lambert::load_scene(sa);
   lambert::FormFactorOptions fo;
   fo.estimator = "hybrid";
-  fo.samples = samples;
-  fo.progress = false;
+  fo.pair.samples = samples;
+  fo.run.progress = false;
   Timer ff_timer;
   const lambert::FormFactors ff = lambert::compute_form_factors(scene.mesh, fo);
   const double ff_seconds = ff_timer.seconds();

@@ -54,12 +54,12 @@ Scene mirror_over_plates() {
 FormFactorOptions options(int rays, int depth, int threads) {
   FormFactorOptions o;
   o.estimator = "gather";
-  o.rays = 1024;
-  o.specular_rays = rays;
-  o.specular_depth = depth;
-  o.threads = threads;
-  o.with_stderr = true;
-  o.progress = false;
+  o.gather.rays = 1024;
+  o.specular.rays = rays;
+  o.specular.depth = depth;
+  o.run.threads = threads;
+  o.run.with_stderr = true;
+  o.run.progress = false;
   return o;
 }
 
@@ -102,12 +102,12 @@ void cornell_cost(std::int64_t patches, int threads) {
               mesh.size(), static_cast<long long>(patches));
   Timer t0;
   FormFactorOptions direct = options(1024, 0, threads);
-  direct.with_stderr = false;
+  direct.run.with_stderr = false;
   const FormFactors d = compute_form_factors(mesh, direct, &bvh);
   const double direct_s = t0.seconds();
   Timer t1;
   FormFactorOptions full = options(1024, 8, threads);
-  full.with_stderr = false;
+  full.run.with_stderr = false;
   const FormFactors f = compute_form_factors(mesh, full, &bvh);
   const double full_s = t1.seconds();
   // The specular pass alone, then raw Embree on as many cosine rays, back to back.

@@ -171,7 +171,7 @@ RowSumRule row_sum_rule(const FormFactors& ff, const std::string& settings) {
 // each specular bounce.
 bool extended_settings(const std::string& settings) {
   FormFactorOptions o;
-  return parse_ff_settings(settings, o) && o.extended;
+  return parse_ff_settings(settings, o) && o.contents.extended;
 }
 
 // The number of participating-medium zones the settings say F holds after its patches
@@ -179,7 +179,7 @@ bool extended_settings(const std::string& settings) {
 // its own rays, so its diagonal may be nonzero), 0 for none.
 std::int64_t medium_zones_of(const std::string& settings) {
   FormFactorOptions o;
-  return parse_ff_settings(settings, o) ? o.medium_zones : 0;
+  return parse_ff_settings(settings, o) ? o.contents.medium_zones : 0;
 }
 
 // The first row whose diagonal entry may be nonzero: every row of extended form factors (a
@@ -576,22 +576,22 @@ std::string format_ff_settings(const FormFactorOptions& o) {
   char threshold[32];
   std::snprintf(threshold, sizeof threshold, "%.17g", o.threshold);
   char tol[32];
-  std::snprintf(tol, sizeof tol, "%.17g", o.tol);
+  std::snprintf(tol, sizeof tol, "%.17g", o.analytic.tol);
   // symmetrize= stays for readers older than reciprocity= (and is what they parse).
   const bool average = o.reciprocity == "average";
-  return "estimator=" + o.estimator + " samples=" + std::to_string(o.samples) +
-         " rays=" + std::to_string(o.rays) + " seed=" + std::to_string(o.seed) +
-         " threshold=" + threshold + " hemicube_res=" + std::to_string(o.hemicube_resolution) +
+  return "estimator=" + o.estimator + " samples=" + std::to_string(o.pair.samples) +
+         " rays=" + std::to_string(o.gather.rays) + " seed=" + std::to_string(o.run.seed) +
+         " threshold=" + threshold + " hemicube_res=" + std::to_string(o.hemicube.resolution) +
          " reciprocity=" + (average ? "average" : "none") + " symmetrize=" + (average ? "1" : "0") +
-         (o.extended ? " specular_depth=" + std::to_string(o.specular_depth) +
-                           " specular_rays=" + std::to_string(o.specular_rays)
-                     : "") +
+         (o.contents.extended ? " specular_depth=" + std::to_string(o.specular.depth) +
+                                    " specular_rays=" + std::to_string(o.specular.rays)
+                              : "") +
          (o.estimator == "analytic" ? std::string(" tol=") + tol : std::string()) +
-         (o.medium_zones > 0
-              ? " medium_zones=" + std::to_string(o.medium_zones) +
-                    " medium_extinction=" + std::to_string(o.medium_extinction) +
-                    " medium_rays=" + std::to_string(o.medium_rays) +
-                    " transmittance_samples=" + std::to_string(o.transmittance_samples)
+         (o.contents.medium_zones > 0
+              ? " medium_zones=" + std::to_string(o.contents.medium_zones) +
+                    " medium_extinction=" + std::to_string(o.contents.medium_extinction) +
+                    " medium_rays=" + std::to_string(o.contents.medium_rays) +
+                    " transmittance_samples=" + std::to_string(o.contents.transmittance_samples)
               : std::string());
 }
 
@@ -612,37 +612,37 @@ bool parse_ff_settings(const std::string& text, FormFactorOptions& options) {
       estimator = !value.empty();
     } else if (key == "samples") {
       samples = parse_int(value, k) && k >= 1 && k <= INT32_MAX;
-      o.samples = static_cast<int>(k);
+      o.pair.samples = static_cast<int>(k);
     } else if (key == "seed") {
-      seed = parse_uint(value, o.seed);
+      seed = parse_uint(value, o.run.seed);
     } else if (key == "threshold") {
       threshold = parse_double(value, o.threshold);
     } else if (key == "hemicube_res") {
       if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
-      o.hemicube_resolution = static_cast<int>(k);
+      o.hemicube.resolution = static_cast<int>(k);
     } else if (key == "rays") {
       if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
-      o.rays = static_cast<int>(k);
+      o.gather.rays = static_cast<int>(k);
     } else if (key == "specular_depth") {
       if (!parse_int(value, k) || k < 1 || k > 64) return false;
-      o.specular_depth = static_cast<int>(k);
-      o.extended = true;
+      o.specular.depth = static_cast<int>(k);
+      o.contents.extended = true;
     } else if (key == "specular_rays") {
       if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
-      o.specular_rays = static_cast<int>(k);
+      o.specular.rays = static_cast<int>(k);
     } else if (key == "medium_zones") {
       if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
-      o.medium_zones = static_cast<std::int32_t>(k);
+      o.contents.medium_zones = static_cast<std::int32_t>(k);
     } else if (key == "medium_extinction") {
-      if (!parse_uint(value, o.medium_extinction)) return false;
+      if (!parse_uint(value, o.contents.medium_extinction)) return false;
     } else if (key == "medium_rays") {
       if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
-      o.medium_rays = static_cast<int>(k);
+      o.contents.medium_rays = static_cast<int>(k);
     } else if (key == "transmittance_samples") {
       if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
-      o.transmittance_samples = static_cast<int>(k);
+      o.contents.transmittance_samples = static_cast<int>(k);
     } else if (key == "tol") {
-      if (!parse_double(value, o.tol) || !(o.tol > 0.0)) return false;
+      if (!parse_double(value, o.analytic.tol) || !(o.analytic.tol > 0.0)) return false;
     } else if (key == "symmetrize") {
       if (value != "0" && value != "1") return false;
       if (!reciprocity) o.reciprocity = value == "1" ? "average" : "none";

@@ -19,7 +19,7 @@ void plan_form_factors(JobPlan& plan, const FormFactorArgs& args, const RunArgs&
     return;
   }
   plan.ff = make_ff_options(args, run);
-  plan.ff->with_stderr = with_stderr;
+  plan.ff->run.with_stderr = with_stderr;
 }
 
 std::string selected_estimator(const FormFactorArgs& args) {
@@ -29,18 +29,18 @@ std::string selected_estimator(const FormFactorArgs& args) {
 FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run) {
   FormFactorOptions o;
   o.estimator = args.estimator;
-  o.samples = args.samples;
-  o.rays = args.rays;
-  o.seed = run.seed;
-  o.threads = run.threads;
+  o.pair.samples = args.samples;
+  o.gather.rays = args.rays;
+  o.run.seed = run.seed;
+  o.run.threads = run.threads;
   o.threshold = args.threshold;
-  o.hemicube_resolution = args.hemicube_resolution;
+  o.hemicube.resolution = args.hemicube_resolution;
   o.reciprocity = args.symmetrize ? "average" : args.reciprocity;
-  o.progress = !run.quiet;
-  o.specular_depth = args.specular_depth;
-  o.specular_rays = args.specular_rays;
-  o.tol = args.tol;
-  o.tol_given = args.tol_given;
+  o.run.progress = !run.quiet;
+  o.specular.depth = args.specular_depth;
+  o.specular.rays = args.specular_rays;
+  o.analytic.tol = args.tol;
+  o.analytic.tol_given = args.tol_given;
   if (args.estimator != "auto") {
     const std::vector<std::string> unused = unused_count_options(args, args.estimator);
     if (!unused.empty())
@@ -97,7 +97,7 @@ void log_auto_pick(const FormFactors& ff, std::int32_t patches) {
           ? "--ff-tol given, " + n + " <= " + std::to_string(kAutoAnalyticMaxPatches)
           : n + (ff.options.estimator == "gather" ? " >= " : " < ") +
                 std::to_string(kAutoGatherPatches) +
-                (ff.options.tol_given
+                (ff.options.analytic.tol_given
                      ? "; analytic only up to " + std::to_string(kAutoAnalyticMaxPatches) +
                            " patches, name it to force it"
                      : "");
@@ -127,15 +127,15 @@ namespace {
 // file. Its extinction hash (medium.hpp) names the medium it was computed for.
 void check_loaded_medium(const FormFactors& ff, const Medium* medium, const std::string& path) {
   const FormFactorOptions& o = ff.options;
-  if (o.medium_zones == 0) return;
+  if (o.contents.medium_zones == 0) return;
   if (medium == nullptr)
     throw UsageError(path + ": holds the exchange factors of a participating medium (" +
-                     std::to_string(o.medium_zones) +
+                     std::to_string(o.contents.medium_zones) +
                      " zones): give the medium it was computed with (--medium-box with "
                      "--sigma-a/--sigma-s, or --medium-grid)");
-  if (extinction_hash(*medium) != o.medium_extinction)
+  if (extinction_hash(*medium) != o.contents.medium_extinction)
     throw SceneError(path + ": computed for another participating medium (" +
-                     std::to_string(o.medium_zones) +
+                     std::to_string(o.contents.medium_zones) +
                      " zones; its box, voxels or extinction sigma_a + sigma_s differ from the "
                      "medium given): give the same medium, or a form-factor file without one");
 }
@@ -148,14 +148,14 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
     FormFactorFileInfo info;
     FormFactors ff =
         read_form_factors(args.ff_file, mesh_hash(scene.mesh), scene.mesh.size(), &info);
-    ff.options.threads = run.threads;
-    ff.options.progress = !run.quiet;
-    ff.options.with_stderr = ff.stderr_F.nonZeros() > 0;
+    ff.options.run.threads = run.threads;
+    ff.options.run.progress = !run.quiet;
+    ff.options.run.with_stderr = ff.stderr_F.nonZeros() > 0;
     if (!parse_ff_settings(info.settings, ff.options)) {
       ff.options.estimator.clear();
       log_warn(args.ff_file + ": records no form-factor settings; reports show them as unknown");
     }
-    if (ff.options.extended && ff.specular_continued.size() != ff.F.rows())
+    if (ff.options.contents.extended && ff.specular_continued.size() != ff.F.rows())
       log_warn(args.ff_file +
                ": extended form factors without their specular bookkeeping "
                "(a Matrix Market file): the energy balance counts light carried on by mirrors "
@@ -167,16 +167,16 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
   }
   check_ff_args_for_mesh(args, scene.mesh);
   FormFactorOptions o = make_ff_options(args, run);
-  o.with_stderr = with_stderr;
+  o.run.with_stderr = with_stderr;
   FormFactors ff = compute_form_factors(scene.mesh, o, &scene_bvh(scene, run.threads));
   log_auto_pick(ff, scene.mesh.size());
   log_info("form factors: " + std::to_string(scene.mesh.size()) + " patches, " +
            format_si(static_cast<double>(ff.F.nonZeros())) + " entries, " +
            format_si(static_cast<double>(ff.stats.rays)) + " rays in " +
            format_duration(ff.stats.seconds) + reciprocity_summary(ff) +
-           (ff.options.extended ? ", " + format_si(static_cast<double>(ff.stats.specular_rays)) +
+           (ff.options.contents.extended ? ", " + format_si(static_cast<double>(ff.stats.specular_rays)) +
                                       " of them on specular paths (depth " +
-                                      std::to_string(ff.options.specular_depth) + ")"
+                                      std::to_string(ff.options.specular.depth) + ")"
                                 : ""));
   if (ff.stats.pairs_unverified > 0) {
     // The size of the effect: the share of the pairs and of the exchange Σ A_i F_ij.
@@ -234,17 +234,17 @@ Json ff_settings_json(const FormFactorOptions& o, const std::string& loaded_from
   return {
       {"estimator", known(o.estimator)},
       {"estimator_requested", o.estimator_requested.empty() ? Json() : Json(o.estimator_requested)},
-      {"samples", known(o.samples)},
-      {"rays_per_patch", known(o.rays)},  // "rays" is the traced count in reports
-      {"seed", known(o.seed)},
+      {"samples", known(o.pair.samples)},
+      {"rays_per_patch", known(o.gather.rays)},  // "rays" is the traced count in reports
+      {"seed", known(o.run.seed)},
       {"threshold", known(o.threshold)},
-      {"hemicube_resolution", known(o.hemicube_resolution)},
-      {"tol", o.estimator == "analytic" ? Json(o.tol) : Json()},
+      {"hemicube_resolution", known(o.hemicube.resolution)},
+      {"tol", o.estimator == "analytic" ? Json(o.analytic.tol) : Json()},
       {"reciprocity", known(o.reciprocity)},
       {"symmetrize", known(o.reciprocity == "average")},
-      {"extended", known(o.extended)},  // specular paths included (specular.hpp)
-      {"specular_depth", o.extended ? Json(o.specular_depth) : Json()},
-      {"specular_rays", o.extended ? Json(o.specular_rays) : Json()},
+      {"extended", known(o.contents.extended)},  // specular paths included (specular.hpp)
+      {"specular_depth", o.contents.extended ? Json(o.specular.depth) : Json()},
+      {"specular_rays", o.contents.extended ? Json(o.specular.rays) : Json()},
       {"loaded_from", loaded_from}};
 }
 

@@ -71,7 +71,7 @@ std::vector<std::string> unused_count_options(const FormFactorArgs& args,
 /// logs a one-line summary on stderr. A loaded F's `options` are the settings stored in the
 /// file (threads and progress from `run`); when the file records none, `options.estimator`
 /// is empty (reports then show the settings as unknown) and a warning is logged. A loaded F
-/// holding a participating medium's zones (`options.medium_zones` > 0) needs `medium`
+/// holding a participating medium's zones (`options.contents.medium_zones` > 0) needs `medium`
 /// (UsageError without one) with the extinction it was computed for (SceneError otherwise).
 FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& args,
                                 const RunArgs& run, bool with_stderr = false,

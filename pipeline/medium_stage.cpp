@@ -115,17 +115,17 @@ MediumResult solve_scene_with_medium(const LoadedScene& scene, const FormFactors
   const Zones& zones = out.zones;
   // A loaded F may hold the zones already (obtain_form_factors checked it is this medium's).
   FormFactors extended;
-  if (surface.options.medium_zones == 0) {
+  if (surface.options.contents.medium_zones == 0) {
     warn_about_lighting(mesh, surface.F);
     check_closed_lossless(mesh, surface);
     extended = medium_form_factors(scene, surface, m, zones, args, run);
   }
-  const FormFactors& F = surface.options.medium_zones == 0 ? extended : surface;
+  const FormFactors& F = surface.options.contents.medium_zones == 0 ? extended : surface;
   LAMBERT_CHECK(F.F.rows() == n + zones.size(), "extended F does not match the zones");
   out.seconds = timer.seconds();
-  out.loaded = surface.options.medium_zones > 0;
-  out.rays = F.options.medium_rays;
-  out.transmittance_samples = F.options.transmittance_samples;
+  out.loaded = surface.options.contents.medium_zones > 0;
+  out.rays = F.options.contents.medium_rays;
+  out.transmittance_samples = F.options.contents.transmittance_samples;
   out.stats = F.stats;
   out.entries = F.F.nonZeros();
   log_info("medium: " + std::to_string(zones.size()) + " zones, " + std::to_string(out.entries) +

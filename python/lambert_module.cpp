@@ -139,14 +139,14 @@ py::tuple csr_arrays(SparseRowMatrix&& F) {
 py::dict options_dict(const FormFactorOptions& o) {
   py::dict d;
   d["estimator"] = o.estimator;
-  d["samples"] = o.samples;
-  d["rays"] = o.rays;
-  d["seed"] = o.seed;
+  d["samples"] = o.pair.samples;
+  d["rays"] = o.gather.rays;
+  d["seed"] = o.run.seed;
   d["threshold"] = o.threshold;
-  d["hemicube_resolution"] = o.hemicube_resolution;
-  d["tol"] = o.tol;
+  d["hemicube_resolution"] = o.hemicube.resolution;
+  d["tol"] = o.analytic.tol;
   d["reciprocity"] = o.reciprocity;
-  d["extended"] = o.extended;
+  d["extended"] = o.contents.extended;
   return d;
 }
 
@@ -657,7 +657,7 @@ PYBIND11_MODULE(_lambert, m) {
         } catch (const UsageError& e) {
           throw UsageError(with_keywords(e.what()));
         }
-        o.with_stderr = with_stderr;
+        o.run.with_stderr = with_stderr;
         FormFactors ff;
         {
           Released release;

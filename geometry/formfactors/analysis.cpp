@@ -248,12 +248,12 @@ PointFactors point_form_factors(const PatchMesh& mesh, const Eigen::Vector3d& po
     throw UsageError("--point and --normal must be finite and the normal non-zero");
   const Eigen::Vector3d n = normal.normalized();
   const std::vector<ff::PatchGeom> geom = ff::patch_geometry(mesh);
-  const Bvh bvh(mesh, options.threads);
+  const Bvh bvh(mesh, options.run.threads);
   const double offset = ff::kRayOffset * mesh.scale;
   const std::int32_t np = mesh.size();
   std::vector<double> f(np, 0.0), var(np, 0.0);
   std::vector<std::int64_t> rays(np, 0);
-  parallel_for(np, 64, options.threads, [&](std::int64_t b, std::int64_t e) {
+  parallel_for(np, 64, options.run.threads, [&](std::int64_t b, std::int64_t e) {
     for (std::int64_t jj = b; jj < e; ++jj) {
       const auto j = static_cast<std::int32_t>(jj);
       const double unocc = ff::point_to_patch(point, n, geom[j]);
@@ -263,20 +263,20 @@ PointFactors point_form_factors(const PatchMesh& mesh, const Eigen::Vector3d& po
         continue;
       }
       // The shared visible-fraction kernel (visibility.hpp), in replicates for the error.
-      const int R = ff::replicate_count(options.samples);
+      const int R = ff::replicate_count(options.pair.samples);
       double replicate[ff::kReplicates];
       int seen = 0, exhausted = 0;
       for (int rep = 0; rep < R; ++rep) {
-        const int k = ff::replicate_size(options.samples, rep);
-        const int v = ff::count_visible(
-            bvh, point, n, geom[j], k,
-            hash_keys(options.seed, 0xFFFFFFFFull, hash_keys(j, static_cast<std::uint64_t>(rep))),
-            offset, exhausted);
+        const int k = ff::replicate_size(options.pair.samples, rep);
+        const int v = ff::count_visible(bvh, point, n, geom[j], k,
+                                        hash_keys(options.run.seed, 0xFFFFFFFFull,
+                                                  hash_keys(j, static_cast<std::uint64_t>(rep))),
+                                        offset, exhausted);
         seen += v;
         replicate[rep] = unocc * v / k;
       }
-      rays[j] = options.samples;
-      f[j] = unocc * seen / options.samples;
+      rays[j] = options.pair.samples;
+      f[j] = unocc * seen / options.pair.samples;
       var[j] = ff::replicate_variance(replicate, R);
     }
   });

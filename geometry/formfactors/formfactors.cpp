@@ -32,39 +32,43 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
   Timer timer;
   const std::int32_t n = mesh.size();
   const std::vector<PatchGeom> geom = patch_geometry(mesh);
-  const PairContext ctx{geom, bvh, options.samples, options.seed, kRayOffset * mesh.scale,
-                       options.tol};
+  const PairContext ctx{geom,
+                        bvh,
+                        options.pair.samples,
+                        options.run.seed,
+                        kRayOffset * mesh.scale,
+                        options.analytic.tol};
   const double plane_eps = kPlaneEps * mesh.scale;
   const std::int64_t total_pairs = static_cast<std::int64_t>(n) * (n - 1) / 2;
   // A row range (distributed form factors) computes the pairs of rows [first, last) only;
   // every pair keeps its stream hash_keys(seed, i, j), so its entries are the same doubles.
-  const bool ranged = options.row_end > options.row_begin;
-  const std::int32_t first = ranged ? options.row_begin : 0;
-  const std::int32_t last = ranged ? options.row_end : n;
+  const bool ranged = options.subset.row_end > options.subset.row_begin;
+  const std::int32_t first = ranged ? options.subset.row_begin : 0;
+  const std::int32_t last = ranged ? options.subset.row_end : n;
   auto pairs_before = [n](std::int64_t i) { return i * (n - 1) - i * (i - 1) / 2; };
   const std::int64_t range_pairs = pairs_before(last) - pairs_before(first);
 
   // Room for every pair of the range in both triangles; pages of pairs that do not exchange
   // energy are never written, so they cost address space only.
-  CsrAppender upper(n, 2 * range_pairs, options.with_stderr);
+  CsrAppender upper(n, 2 * range_pairs, options.run.with_stderr);
   std::vector<std::vector<RowEntry>> rows(n);
   std::vector<std::int64_t> tested(n, 0), rays(n, 0), unverified(n, 0);
   std::vector<double> unverified_g(n, 0.0);
-  Progress progress("form factors", options.progress ? range_pairs : 0, "rays");
+  Progress progress("form factors", options.run.progress ? range_pairs : 0, "rays");
   const std::int64_t block_pairs = std::max<std::int64_t>(1, total_pairs / kBlocks);
   for (std::int32_t i = 0; i < first; ++i) upper.append_row({});
   for (std::int32_t block_begin = first; block_begin < last;) {
     std::int32_t block_end = block_begin;
     for (std::int64_t pairs = 0; block_end < last && pairs < block_pairs; ++block_end)
       pairs += n - 1 - block_end;
-    parallel_for(block_end - block_begin, 1, options.threads,
+    parallel_for(block_end - block_begin, 1, options.run.threads,
                  [&](std::int64_t begin, std::int64_t end) {
       for (std::int64_t r = begin; r < end; ++r) {
         const auto i = static_cast<std::int32_t>(block_begin + r);
         std::int64_t row_rays = 0;
-        const bool all = options.only.empty();
+        const bool all = options.subset.only.empty();
         for (std::int32_t j = i + 1; j < n; ++j) {
-          if (!all && !options.only[i] && !options.only[j]) continue;
+          if (!all && !options.subset.only[i] && !options.subset.only[j]) continue;
           if (!can_exchange(geom[i], geom[j], plane_eps)) continue;
           ++tested[i];
           const PairEstimate e = estimator(ctx, i, j);
@@ -98,7 +102,7 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
   upper.finish(out.F, out.stderr_F);
   std::vector<double> area(n);
   for (std::int32_t i = 0; i < n; ++i) area[i] = geom[i].area;
-  mirror_upper(out.F, options.with_stderr ? &out.stderr_F : nullptr, area);
+  mirror_upper(out.F, options.run.with_stderr ? &out.stderr_F : nullptr, area);
   out.stats.seconds = timer.seconds();
   return out;
 }
@@ -130,7 +134,7 @@ constexpr double kCsrEntry = sizeof(double) + sizeof(SparseF::StorageIndex);
 // the block, about 1/kBlocks of the pairs).
 double pairwise_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
   const double n = static_cast<double>(patches), pairs = n * (n - 1.0) / 2.0;
-  const double csr = 2.0 * 16.0 * (o.with_stderr ? 2.0 : 1.0);
+  const double csr = 2.0 * 16.0 * (o.run.with_stderr ? 2.0 : 1.0);
   const double staging = 24.0 * 2.0 / static_cast<double>(ff::kBlocks);  // 2 blocks' worth
   return pairs * (csr + staging);
 }
@@ -141,7 +145,7 @@ double pairwise_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
 // place, but F has no room for the union (up to 2 entries per entry), so its one
 // reallocation holds the old and the new storage: 2 more CSR entries per entry.
 double hemicube_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
-  const double n = static_cast<double>(patches), res = o.hemicube_resolution;
+  const double n = static_cast<double>(patches), res = o.hemicube.resolution;
   const double pixels = res * res + 4.0 * res * std::ceil(res / 2.0);
   const double entries = n * std::min(n - 1.0, pixels);
   return entries * (16.0 + 12.0 + (o.reciprocity == "average" ? 2.0 * kCsrEntry : 0.0));
@@ -154,13 +158,13 @@ double hemicube_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
 // n doubles and K hits (16 bytes).
 double gather_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
   const double n = static_cast<double>(patches);
-  const double row = std::min(n - 1.0, static_cast<double>(o.rays));
+  const double row = std::min(n - 1.0, static_cast<double>(o.gather.rays));
   const double entries =
       std::min(n * (n - 1.0), (o.reciprocity == "average" ? 2.0 : 1.0) * n * row);
   const double staging = std::min(n, static_cast<double>(ff::kGatherBlockRows)) * row * 24.0;
-  const double per_thread = 8.0 * n + 16.0 * o.rays;
-  return entries * kCsrEntry * (o.with_stderr ? 2.0 : 1.0) + staging +
-         static_cast<double>(resolve_threads(o.threads)) * per_thread;
+  const double per_thread = 8.0 * n + 16.0 * o.gather.rays;
+  return entries * kCsrEntry * (o.run.with_stderr ? 2.0 : 1.0) + staging +
+         static_cast<double>(resolve_threads(o.run.threads)) * per_thread;
 }
 
 const std::vector<EstimatorEntry>& registry() {
@@ -277,7 +281,7 @@ FormFactorOptions resolve_form_factor_options(const FormFactorOptions& options,
                                               std::int64_t patches) {
   FormFactorOptions o = options;
   if (o.estimator == "auto") {
-    o.estimator = auto_estimator(patches, o.tol_given);
+    o.estimator = auto_estimator(patches, o.analytic.tol_given);
     o.estimator_requested = "auto";
   }
   const EstimatorEntry& e = find_estimator(o.estimator);
@@ -294,14 +298,14 @@ double form_factor_peak_bytes(std::int64_t patches, const FormFactorOptions& opt
 
 FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions& options,
                                  const Bvh* bvh) {
-  if (options.samples < 1) throw UsageError("--samples must be at least 1");
-  if (options.rays < 1) throw UsageError("--rays must be at least 1");
-  if (!(options.tol > 0.0) || !std::isfinite(options.tol))
+  if (options.pair.samples < 1) throw UsageError("--samples must be at least 1");
+  if (options.gather.rays < 1) throw UsageError("--rays must be at least 1");
+  if (!(options.analytic.tol > 0.0) || !std::isfinite(options.analytic.tol))
     throw UsageError("--ff-tol must be a positive number");
   // Not `threshold < 0`: NaN passes that and drops nothing (issue 33: Python took nan).
   if (!(options.threshold >= 0.0 && options.threshold <= 1.0))
     throw UsageError("--threshold must be a number in [0, 1]");
-  if (options.hemicube_resolution < 4 || options.hemicube_resolution > 8192)
+  if (options.hemicube.resolution < 4 || options.hemicube.resolution > 8192)
     throw UsageError("--hemicube-res must be in [4, 8192]");
   if (mesh.patches.empty()) throw UsageError("the scene has no patches");
   const FormFactorOptions o = resolve_form_factor_options(options, mesh.size());
@@ -309,10 +313,10 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
   // Standard errors come from the spread of independent replicates (replicates.hpp),
   // which needs at least two of them, and Student's t with so few is wide: ask for four.
   const std::string count = e.count_option;
-  if (e.traces_rays && o.with_stderr && (count == "rays" ? o.rays : o.samples) < 4)
+  if (e.traces_rays && o.run.with_stderr && (count == "rays" ? o.gather.rays : o.pair.samples) < 4)
     throw UsageError("--stderr needs --" + count + " of at least 4 (standard errors come from "
                      "independent replicates of the " + count + ")");
-  const bool specular = mesh.has_specular() && o.specular_depth > 0;
+  const bool specular = mesh.has_specular() && o.specular.depth > 0;
   if (specular && !e.traces_rays)
     throw UsageError("--estimator " + o.estimator + " does not follow rays through mirrors and "
                      "glass: use mc, hybrid or gather for this scene, or --specular-depth 0 "
@@ -320,14 +324,14 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
   if (specular) ff::check_grey_specular(mesh);
   std::unique_ptr<Bvh> own;
   if (!bvh && e.uses_bvh) {
-    own = std::make_unique<Bvh>(mesh, o.threads);
+    own = std::make_unique<Bvh>(mesh, o.run.threads);
     bvh = own.get();
   }
-  const bool ranged = o.row_end > o.row_begin;
+  const bool ranged = o.subset.row_end > o.subset.row_begin;
   if (ranged) {
-    if (o.row_begin < 0 || o.row_end > mesh.size())
-      throw UsageError("row range [" + std::to_string(o.row_begin) + ", " +
-                       std::to_string(o.row_end) + ") outside the mesh");
+    if (o.subset.row_begin < 0 || o.subset.row_end > mesh.size())
+      throw UsageError("row range [" + std::to_string(o.subset.row_begin) + ", " +
+                       std::to_string(o.subset.row_end) + ") outside the mesh");
     if (!e.pairwise)
       throw UsageError("--estimator " + o.estimator +
                        " computes whole rows and its reciprocity "
@@ -340,7 +344,7 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
       throw UsageError(
           "specular paths cross every row: distributed form factors need "
           "--specular-depth 0 on a scene with mirrors or glass");
-    if (!o.only.empty()) throw UsageError("a row range does not combine with an update");
+    if (!o.subset.only.empty()) throw UsageError("a row range does not combine with an update");
   }
   FormFactors out = e.compute(mesh, o, bvh);
   out.options = o;
@@ -349,8 +353,8 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
     apply_threshold(out, o.threshold);
     return out;
   }
-  if (!o.only.empty()) {
-    LAMBERT_CHECK(o.only.size() == mesh.patches.size(), "row flags do not match the mesh");
+  if (!o.subset.only.empty()) {
+    LAMBERT_CHECK(o.subset.only.size() == mesh.patches.size(), "row flags do not match the mesh");
     return out;  // partial: update_form_factors completes it
   }
   if (o.reciprocity == "average") {
@@ -358,8 +362,8 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
     std::vector<double> areas(mesh.patches.size());
     for (size_t i = 0; i < areas.size(); ++i) areas[i] = mesh.patches[i].area;
     out.F.makeCompressed();
-    ff::average_reciprocal(out.F, o.with_stderr ? &out.stderr_F : nullptr, areas, out.stats,
-                          o.threads);
+    ff::average_reciprocal(out.F, o.run.with_stderr ? &out.stderr_F : nullptr, areas, out.stats,
+                           o.run.threads);
     if (o.estimator == "gather") {  // its pairs: those connected either way = the pattern's
       const std::int64_t n = mesh.size();
       out.stats.pairs_tested = out.F.nonZeros() / 2;
@@ -372,7 +376,7 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
   // of at most 1 (extended rows may exceed it): S is reciprocal by its own averaging.
   if (specular) {
     ff::add_specular_transport(mesh, o, *bvh, out);
-    out.options.extended = true;
+    out.options.contents.extended = true;
   }
   apply_threshold(out, o.threshold);
   return out;
@@ -382,13 +386,14 @@ FormFactors update_form_factors(const PatchMesh& mesh, const std::vector<std::in
                                 const SparseF& old_F, const FormFactorOptions& options,
                                 const Bvh* bvh) {
   // Specular paths connect patches far apart through mirrors: recomputed whole.
-  if (mesh.has_specular() && options.specular_depth > 0) return compute_form_factors(mesh, options, bvh);
+  if (mesh.has_specular() && options.specular.depth > 0)
+    return compute_form_factors(mesh, options, bvh);
   const std::int32_t n = mesh.size();
   LAMBERT_CHECK(static_cast<std::int32_t>(origin.size()) == n, "origin map does not match the mesh");
   FormFactorOptions o = options;
-  o.with_stderr = false;
-  o.only.assign(n, 0);
-  for (std::int32_t i = 0; i < n; ++i) o.only[i] = origin[i] < 0;
+  o.run.with_stderr = false;
+  o.subset.only.assign(n, 0);
+  for (std::int32_t i = 0; i < n; ++i) o.subset.only[i] = origin[i] < 0;
   FormFactors part = compute_form_factors(mesh, o, bvh);
   const bool pairwise = estimator_count_option(part.options.estimator) == "samples";
   // Both sides of a pair with a new patch: G from row i is A_i F_ij where row i was
@@ -439,7 +444,7 @@ FormFactors update_form_factors(const PatchMesh& mesh, const std::vector<std::in
   }
   FormFactors out;
   out.options = part.options;
-  out.options.only.clear();
+  out.options.subset.only.clear();
   out.stats = part.stats;
   out.F.resize(n, n);
   out.F.setFromTriplets(entries.begin(), entries.end());

@@ -18,48 +18,52 @@ namespace lambert {
 /// Row-major sparse form-factor matrix: row i holds F_ij for every j patch i sees.
 using SparseF = SparseRowMatrix;
 
-/// Settings of one form-factor computation.
-struct FormFactorOptions {
-  /// A name from form_factor_estimators(), or "auto" (resolve_form_factor_options: analytic
-  /// when tol_given on up to kAutoAnalyticMaxPatches patches, else hybrid below
-  /// kAutoGatherPatches patches, gather at or above).
-  std::string estimator = "auto";
-  /// What was asked for when `estimator` was resolved from "auto" ("" when it was named).
-  std::string estimator_requested;
-  int samples = 32;                  ///< sample pairs (rays) per patch pair (pair estimators)
-  int rays = 1024;                   ///< rays per patch (estimator "gather")
-  std::uint64_t seed = 1;
-  int threads = 0;                   ///< 0 = all cores
-  double threshold = 0.0;            ///< drop entries with F_ij < threshold (after estimation)
-  bool with_stderr = false;          ///< also estimate the standard error of each entry
-  int hemicube_resolution = 128;     ///< hemicube top-face resolution (estimator "hemicube")
-  /// Estimator "analytic": absolute error target of every entry F_ij (its quadrature error
-  /// estimate, reported as the standard error).
+/// Parameters of the sampling pair estimators (mc, hybrid; also the sensor-point factors of
+/// analysis.hpp).
+struct PairEstimatorParams {
+  int samples = 32;  ///< sample pairs (rays) per patch pair
+};
+
+/// Parameters of the estimator "gather".
+struct GatherParams {
+  int rays = 1024;  ///< rays per patch
+};
+
+/// Parameters of the estimator "hemicube".
+struct HemicubeParams {
+  int resolution = 128;  ///< top-face resolution (pixels per side)
+};
+
+/// Parameters of the estimator "analytic" (and of "auto", which tol_given steers).
+struct AnalyticParams {
+  /// Absolute error target of every entry F_ij (its quadrature error estimate, reported as
+  /// the standard error).
   double tol = 1e-6;
   /// The user asked for `tol` (--ff-tol): "auto" then picks analytic, the one estimator that
   /// honours an error target (docs/form-factors.md, "Choosing an estimator").
   bool tol_given = false;
-  /// "average": replace A_i F_ij and A_j F_ji by their mean (reciprocity.hpp); "none";
-  /// "auto": average for gather, none for the others (the pair estimators are reciprocal by
-  /// construction; the hemicube keeps its historical default, --symmetrize to average).
-  std::string reciprocity = "auto";
-  bool progress = true;              ///< draw a progress bar (when stderr is a terminal)
-  /// Extended form factors (specular.hpp), used when the mesh has specular surfaces: the
-  /// most specular bounces a path follows (0: specular surfaces only receive and block),
-  /// and the cosine rays per patch that trace the paths with at least one bounce.
-  int specular_depth = 8;
-  int specular_rays = 1024;
-  /// Set on the result: F holds the specular paths (the mesh had specular surfaces and
-  /// specular_depth > 0).
-  bool extended = false;
-  /// Set on the result of extend_with_medium (media.hpp): F also holds the medium's zones,
-  /// rows and columns N..N+medium_zones-1 (0: no medium). The extinction hash
-  /// (medium.hpp: extinction_hash) names the medium the zones came from; medium_rays and
-  /// transmittance_samples are its settings.
-  std::int32_t medium_zones = 0;
-  std::uint64_t medium_extinction = 0;
-  int medium_rays = 0;
-  int transmittance_samples = 0;
+};
+
+/// Extended form factors (specular.hpp), read by every estimator that traces rays (mc,
+/// hybrid, gather) when the mesh has specular surfaces.
+struct SpecularParams {
+  /// The most specular bounces a path follows (0: specular surfaces only receive and block).
+  int depth = 8;
+  int rays = 1024;  ///< cosine rays per patch that trace the paths with at least one bounce
+};
+
+/// How a computation runs, read by every estimator: the seed of its random streams, and what
+/// does not change the values of F (for a given seed they are bitwise identical for any
+/// thread count).
+struct FormFactorRun {
+  std::uint64_t seed = 1;    ///< the random streams' seed (core/sampling.hpp: hash_keys)
+  int threads = 0;           ///< 0 = all cores
+  bool progress = true;      ///< draw a progress bar (when stderr is a terminal)
+  bool with_stderr = false;  ///< also estimate the standard error of each entry
+};
+
+/// Which entries to compute (default: all of F), for updates and distributed runs.
+struct FormFactorSubset {
   /// Incremental updates (adaptive meshing): when non-empty (one flag per patch), only the
   /// pairs with a flagged patch are estimated (pair estimators: both entries of each such
   /// pair; gather and hemicube: the flagged rows); everything else is left empty, and
@@ -73,6 +77,45 @@ struct FormFactorOptions {
   /// need whole columns). The default [0, 0) is every row.
   std::int32_t row_begin = 0;
   std::int32_t row_end = 0;
+};
+
+/// What F holds besides the patches' diffuse exchange: set on a result (and read back from
+/// a saved F's settings), never read by an estimator.
+struct FormFactorContents {
+  /// F holds the specular paths (the mesh had specular surfaces and specular.depth > 0).
+  bool extended = false;
+  /// Set by extend_with_medium (media.hpp): F also holds the medium's zones, rows and
+  /// columns N..N+medium_zones-1 (0: no medium). The extinction hash (medium.hpp:
+  /// extinction_hash) names the medium the zones came from; medium_rays and
+  /// transmittance_samples are its settings.
+  std::int32_t medium_zones = 0;
+  std::uint64_t medium_extinction = 0;
+  int medium_rays = 0;
+  int transmittance_samples = 0;
+};
+
+/// Settings of one form-factor computation: the choice of estimator and what applies to
+/// every estimator, and one block per estimator's own parameters.
+struct FormFactorOptions {
+  /// A name from form_factor_estimators(), or "auto" (resolve_form_factor_options: analytic
+  /// when analytic.tol_given on up to kAutoAnalyticMaxPatches patches, else hybrid below
+  /// kAutoGatherPatches patches, gather at or above).
+  std::string estimator = "auto";
+  /// What was asked for when `estimator` was resolved from "auto" ("" when it was named).
+  std::string estimator_requested;
+  double threshold = 0.0;  ///< drop entries with F_ij < threshold (after estimation)
+  /// "average": replace A_i F_ij and A_j F_ji by their mean (reciprocity.hpp); "none";
+  /// "auto": average for gather, none for the others (the pair estimators are reciprocal by
+  /// construction; the hemicube keeps its historical default, --symmetrize to average).
+  std::string reciprocity = "auto";
+  PairEstimatorParams pair;     ///< read by mc and hybrid
+  GatherParams gather;          ///< read by gather
+  HemicubeParams hemicube;      ///< read by hemicube
+  AnalyticParams analytic;      ///< read by analytic (and auto)
+  SpecularParams specular;      ///< read by mc, hybrid and gather on a mesh with mirrors or glass
+  FormFactorRun run;            ///< read by every estimator
+  FormFactorSubset subset;      ///< read by every estimator (a row range: the pair estimators)
+  FormFactorContents contents;  ///< written on the result
 };
 
 /// What a computation did (for diagnostics and reports).
@@ -164,7 +207,7 @@ std::vector<std::int32_t> balanced_pair_rows(std::int32_t n, int parts);
 bool is_pair_estimator(const std::string& estimator);
 
 /// The estimator "auto" stands for at `patches` patches: "analytic" when an error target was
-/// given (`tol_given`) and patches <= kAutoAnalyticMaxPatches, else by kAutoGatherPatches.
+/// given (`analytic.tol_given`) and patches <= kAutoAnalyticMaxPatches, else by kAutoGatherPatches.
 std::string auto_estimator(std::int64_t patches, bool tol_given);
 
 /// Which per-count option an estimator reads: "samples" (pair estimators), "rays"
@@ -197,7 +240,7 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
 /// F on a refined mesh from F on the mesh it was refined from: `origin[i]` is the old
 /// index of new patch i when it is unchanged (the same polygon), -1 when it is new. Entries
 /// between unchanged patches are copied from `old_F`; the pairs with a new patch are
-/// estimated (FormFactorOptions::only) and, where both sides are estimated (pair
+/// estimated (FormFactorSubset::only) and, where both sides are estimated (pair
 /// estimators; a row estimator's two new rows), their G = A F is averaged, so that
 /// A_i F_ij = A_j F_ji holds for them; a row estimator's new row also gives the unchanged
 /// row its column (F_ji = A_i F_ij / A_j). Cost: O(changed x N) estimates, not O(N²).

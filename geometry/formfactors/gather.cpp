@@ -136,10 +136,10 @@ std::int64_t connected_pairs(const SparseF& F, int threads) {
 
 FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& options,
                            const Bvh& bvh) {
-  if (options.rays < 1) throw UsageError("--rays must be at least 1");
+  if (options.gather.rays < 1) throw UsageError("--rays must be at least 1");
   Timer timer;
   const std::int32_t n = mesh.size();
-  const int K = options.rays;
+  const int K = options.gather.rays;
   const std::vector<PatchGeom> geom = patch_geometry(mesh);
   const double offset = kRayOffset * mesh.scale;
   std::vector<Eigen::Vector3d> normals(n);
@@ -150,14 +150,14 @@ FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& optio
   const double row_max = std::min<double>(K, n - 1.0);
   const double room = std::min(static_cast<double>(n) * (n - 1.0),
                                (options.reciprocity == "average" ? 2.0 : 1.0) * n * row_max);
-  CsrAppender csr(n, static_cast<std::int64_t>(room), options.with_stderr);
+  CsrAppender csr(n, static_cast<std::int64_t>(room), options.run.with_stderr);
   std::vector<std::vector<RowEntry>> rows(std::min<std::int32_t>(n, kGatherBlockRows));
-  Progress progress("gather", options.progress ? n : 0, "rays");
+  Progress progress("gather", options.run.progress ? n : 0, "rays");
   for (std::int32_t block = 0; block < n; block += kGatherBlockRows) {
     const std::int32_t count = std::min(kGatherBlockRows, n - block);
     // Chunks of 16 rows: a row is K rays (~0.1 ms at K = 1024), so a chunk is a few ms,
     // large enough to amortise the buffers, small enough to balance.
-    parallel_for(count, 16, options.threads, [&](std::int64_t begin, std::int64_t end) {
+    parallel_for(count, 16, options.run.threads, [&](std::int64_t begin, std::int64_t end) {
       // Per thread (threads live for one parallel_for): hits and the dense accumulator.
       thread_local std::vector<Hit> hits;
       thread_local std::vector<double> acc;
@@ -166,12 +166,12 @@ FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& optio
       hits.reserve(K);
       for (std::int64_t r = begin; r < end; ++r) {
         const auto i = static_cast<std::int32_t>(block + r);
-        if (!options.only.empty() && !options.only[i]) {
+        if (!options.subset.only.empty() && !options.subset.only[i]) {
           rows[r].clear();
           continue;
         }
-        trace_row(geom, normals, bvh, i, K, options.seed, offset, hits);
-        row_from_hits(hits, K, options.with_stderr, acc, touched, rows[r]);
+        trace_row(geom, normals, bvh, i, K, options.run.seed, offset, hits);
+        row_from_hits(hits, K, options.run.with_stderr, acc, touched, rows[r]);
         progress.advance(1, K);
       }
     });
@@ -185,7 +185,7 @@ FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& optio
   // Averaging makes the pattern symmetric, and then the pairs are nnz / 2 for free
   // (compute_form_factors counts them there); only an F left as it is needs the search.
   if (options.reciprocity != "average") {
-    out.stats.pairs_tested = connected_pairs(out.F, options.threads);
+    out.stats.pairs_tested = connected_pairs(out.F, options.run.threads);
     out.stats.pairs_culled = static_cast<std::int64_t>(n) * (n - 1) / 2 - out.stats.pairs_tested;
   }
   out.stats.rays = static_cast<std::int64_t>(n) * K;

@@ -22,7 +22,7 @@ namespace lambert::ff {
 /// reserved CSR after each block: the staging is one block of rows.
 constexpr std::int32_t kGatherBlockRows = 4096;
 
-/// Estimator "gather": options.rays rays per patch, in replicate_count(rays) independently
+/// Estimator "gather": options.gather.rays rays per patch, in replicate_count(rays) independently
 /// shifted Kronecker point sets (replicates.hpp) whose spread gives the standard errors.
 /// Rows are computed in parallel, a block at a time, and appended in row order to a CSR
 /// reserved with room for averaging's mirrors, so F is bitwise identical for any thread

@@ -315,30 +315,30 @@ HemicubeDeltas hemicube_deltas(int resolution) {
 
 FormFactors compute_hemicube(const PatchMesh& mesh, const FormFactorOptions& options,
                              HemicubeStats* hemicube_stats) {
-  if (options.hemicube_resolution < 2)
-    throw UsageError("--hemicube-res must be at least 2");
+  if (options.hemicube.resolution < 2) throw UsageError("--hemicube-res must be at least 2");
   Timer timer;
   const std::int32_t n = mesh.size();
   const std::vector<PatchGeom> geom = patch_geometry(mesh);
-  const HemicubeDeltas dF = hemicube_deltas(options.hemicube_resolution);
+  const HemicubeDeltas dF = hemicube_deltas(options.hemicube.resolution);
   const double offset = kOffset * mesh.scale;
   const double edge_eps = kEdgeOnEps * mesh.scale;
 
   std::vector<std::vector<HemicubeEntry>> rows(n);
   std::vector<std::int64_t> tested(n, 0), pixels(n, 0);
-  Progress progress("hemicube", options.progress ? n : 0, "px");
+  Progress progress("hemicube", options.run.progress ? n : 0, "px");
   // Chunks of 4 rows: buffers are allocated once per chunk (3·res² pixels), while chunks
   // stay small enough to balance rows of uneven cost.
-  parallel_for(n, 4, options.threads, [&](std::int64_t begin, std::int64_t end) {
+  parallel_for(n, 4, options.run.threads, [&](std::int64_t begin, std::int64_t end) {
     Buffers buf(dF.n, dF.m);
     std::vector<double> acc(n, 0.0);
     for (std::int64_t ii = begin; ii < end; ++ii) {
       const auto i = static_cast<std::int32_t>(ii);
-      if (!options.only.empty() && !options.only[i]) continue;
+      if (!options.subset.only.empty() && !options.subset.only[i]) continue;
       buf.pixels = 0;
-      hemicube_row(geom, i, dF, offset, edge_eps, options.seed, buf, acc, rows[i]);
+      hemicube_row(geom, i, dF, offset, edge_eps, options.run.seed, buf, acc, rows[i]);
       rows[i].shrink_to_fit();
-      for (std::int32_t j = i + 1; j < n; ++j) tested[i] += can_exchange(geom[i], geom[j], edge_eps);
+      for (std::int32_t j = i + 1; j < n; ++j)
+        tested[i] += can_exchange(geom[i], geom[j], edge_eps);
       pixels[i] = buf.pixels;
       progress.advance(1, buf.pixels);
     }

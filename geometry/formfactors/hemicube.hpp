@@ -41,9 +41,9 @@ struct HemicubeStats {
 
 /// Estimator "hemicube": every row of F from one hemicube at the patch's centroid, lifted
 /// off the patch by a tiny offset and turned about the normal by an angle hashed from
-/// (options.seed, row) so that its aliasing is not aligned with the scene's edges. Rows are independent and run in parallel (per-thread
-/// buffers), so F is bitwise identical for any thread count. Reciprocity averaging is the
-/// caller's (compute_form_factors).
+/// (options.run.seed, row) so that its aliasing is not aligned with the scene's edges. Rows
+/// are independent and run in parallel (per-thread buffers), so F is bitwise identical for
+/// any thread count. Reciprocity averaging is the caller's (compute_form_factors).
 /// Cost O(N_patches² + N_patches · resolution²); stats.rays = 0.
 FormFactors compute_hemicube(const PatchMesh& mesh, const FormFactorOptions& options,
                              HemicubeStats* hemicube_stats = nullptr);

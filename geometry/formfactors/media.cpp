@@ -303,10 +303,10 @@ FormFactors extend_with_medium(const PatchMesh& mesh, const Medium& medium, cons
   }
   FormFactors out;
   out.options = surface.options;
-  out.options.medium_zones = m;
-  out.options.medium_extinction = extinction_hash(medium);
-  out.options.medium_rays = o.rays;
-  out.options.transmittance_samples = o.transmittance_samples;
+  out.options.contents.medium_zones = m;
+  out.options.contents.medium_extinction = extinction_hash(medium);
+  out.options.contents.medium_rays = o.rays;
+  out.options.contents.transmittance_samples = o.transmittance_samples;
   out.stats = surface.stats;
   const SparseF block = zone_block(zone_rows, share, zones, out.stats, o.threads);
 

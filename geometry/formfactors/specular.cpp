@@ -73,12 +73,12 @@ void trace_row(const PatchMesh& mesh, const std::vector<PatchGeom>& geom, const 
   out.arrivals.clear();
   out.continued = 0.0;
   out.rays = 0;
-  const int K = o.specular_rays;
+  const int K = o.specular.rays;
   const int R = replicate_count(K);
   for (int rep = 0; rep < R; ++rep) {
-    const Kronecker4 seq(hash_keys(o.seed ^ 0x73706563756c6172ull,  // "specular"
+    const Kronecker4 seq(hash_keys(o.run.seed ^ 0x73706563756c6172ull,  // "specular"
                                    static_cast<std::uint64_t>(i), static_cast<std::uint64_t>(rep)));
-    Rng rng(hash_keys(o.seed, static_cast<std::uint64_t>(i), 0x10000ull + rep));
+    Rng rng(hash_keys(o.run.seed, static_cast<std::uint64_t>(i), 0x10000ull + rep));
     const int k = replicate_size(K, rep);
     for (int s = 0; s < k; ++s) {
       double jac;
@@ -94,7 +94,7 @@ void trace_row(const PatchMesh& mesh, const std::vector<PatchGeom>& geom, const 
         const bool front = dir.dot(n) < 0.0;
         if (front && bounce > 0) out.arrivals.push_back({hit.patch, rep, w});
         const Specular* sp = mesh.specular_of(hit.patch);
-        if (!sp || (!front && !sp->dielectric) || bounce == o.specular_depth) break;
+        if (!sp || (!front && !sp->dielectric) || bounce == o.specular.depth) break;
         const Bounce next = bounce_at(*sp, dir, n, rng);
         if (front) out.continued += w * next.carried;
         w *= next.carried;
@@ -167,8 +167,8 @@ SpecularTransport compute_specular_transport(const PatchMesh& mesh,
                                              const FormFactorOptions& options, const Bvh& bvh,
                                              bool average) {
   LAMBERT_CHECK(mesh.has_specular(), "specular transport on a diffuse mesh");
-  if (options.specular_rays < 1) throw UsageError("--specular-rays must be at least 1");
-  if (options.with_stderr && options.specular_rays < 4)
+  if (options.specular.rays < 1) throw UsageError("--specular-rays must be at least 1");
+  if (options.run.with_stderr && options.specular.rays < 4)
     throw UsageError("--stderr needs --specular-rays of at least 4 (standard errors come from "
                      "independent replicates)");
   check_grey_specular(mesh);
@@ -182,10 +182,10 @@ SpecularTransport compute_specular_transport(const PatchMesh& mesh,
   constexpr std::int32_t kBlock = 4096;
   std::vector<RowPaths> rows(std::min(n, kBlock));
   std::vector<Eigen::Triplet<double, std::int64_t>> values, errors;
-  Progress progress("specular", options.progress ? n : 0, "rays");
+  Progress progress("specular", options.run.progress ? n : 0, "rays");
   for (std::int32_t block = 0; block < n; block += kBlock) {
     const std::int32_t count = std::min(kBlock, n - block);
-    parallel_for(count, 16, options.threads, [&](std::int64_t begin, std::int64_t end) {
+    parallel_for(count, 16, options.run.threads, [&](std::int64_t begin, std::int64_t end) {
       for (std::int64_t r = begin; r < end; ++r) {
         trace_row(mesh, geom, bvh, static_cast<std::int32_t>(block + r), options, offset,
                   rows[r]);
@@ -195,7 +195,7 @@ SpecularTransport compute_specular_transport(const PatchMesh& mesh,
     for (std::int32_t r = 0; r < count; ++r) {
       out.continued[block + r] = rows[r].continued;
       out.rays += rows[r].rays;
-      row_entries(block + r, rows[r].arrivals, options.specular_rays, options.with_stderr,
+      row_entries(block + r, rows[r].arrivals, options.specular.rays, options.run.with_stderr,
                   values, errors);
     }
   }
@@ -204,11 +204,11 @@ SpecularTransport compute_specular_transport(const PatchMesh& mesh,
   out.S.setFromTriplets(values.begin(), values.end());
   Eigen::VectorXd area(n);
   for (std::int32_t i = 0; i < n; ++i) area[i] = mesh.patches[i].area;
-  if (options.with_stderr) {
+  if (options.run.with_stderr) {
     out.stderr_S.resize(n, n);
     out.stderr_S.setFromTriplets(errors.begin(), errors.end());
   }
-  if (average) average_sides(out.S, options.with_stderr ? &out.stderr_S : nullptr, area);
+  if (average) average_sides(out.S, options.run.with_stderr ? &out.stderr_S : nullptr, area);
   return out;
 }
 
@@ -219,7 +219,7 @@ void add_specular_transport(const PatchMesh& mesh, const FormFactorOptions& opti
   SparseF sum = out.F + sp.S;
   out.F.swap(sum);
   out.F.makeCompressed();
-  if (options.with_stderr) {
+  if (options.run.with_stderr) {
     SparseF var = SparseF(out.stderr_F.cwiseAbs2()) + SparseF(sp.stderr_S.cwiseAbs2());
     out.stderr_F = var.cwiseSqrt();
     out.stderr_F.makeCompressed();

@@ -41,7 +41,7 @@ namespace lambert::ff {
 /// The specular part of the extended form factors.
 struct SpecularTransport {
   SparseF S;         ///< reciprocal (averaged), paths with >= 1 specular bounce
-  SparseF stderr_S;  ///< empty unless options.with_stderr
+  SparseF stderr_S;  ///< empty unless options.run.with_stderr
   /// Per row: the expected weight carried on past every front arrival counted in F (direct
   /// arrivals at specular faces included).
   Eigen::VectorXd continued;
@@ -52,9 +52,9 @@ struct SpecularTransport {
 /// channels: extended form factors carry one weight for all three.
 void check_grey_specular(const PatchMesh& mesh);
 
-/// The specular part of F for `mesh` (which has specular surfaces) with options.seed,
-/// specular_rays, specular_depth, threads, with_stderr and progress. `average` false keeps
-/// each row's own estimate S_ij (not reciprocal to rounding; for tests of the reversibility
+/// The specular part of F for `mesh` (which has specular surfaces) with `options`'
+/// specular block and its run settings (seed, threads, with_stderr, progress). `average` false
+/// keeps each row's own estimate S_ij (not reciprocal to rounding; for tests of the reversibility
 /// the averaging relies on).
 SpecularTransport compute_specular_transport(const PatchMesh& mesh,
                                              const FormFactorOptions& options, const Bvh& bvh,

@@ -134,7 +134,7 @@ TEST(FormFactorsCommand, GatherOnTheCornellBoxStoresItsRaysInTheSettings) {
   FormFactorOptions o;
   ASSERT_TRUE(parse_ff_settings(report.at("settings").get<std::string>(), o));
   EXPECT_EQ(o.estimator, "gather");
-  EXPECT_EQ(o.rays, 64);
+  EXPECT_EQ(o.gather.rays, 64);
   EXPECT_EQ(o.reciprocity, "average");  // auto: gather averages
   const auto& ff = report.at("form_factors");
   EXPECT_EQ(ff.at("rays_per_patch").get<int>(), 64);

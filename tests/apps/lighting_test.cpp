@@ -217,8 +217,8 @@ Solved solve_cube(const Scene& s, const std::string& surface) {
   mo.max_edge = 0.5;
   const PatchMesh mesh = mesh_scene(s, mo);
   FormFactorOptions fo;
-  fo.samples = 4;  // no occluders: hybrid is exact to quadrature whatever the rays
-  fo.progress = false;
+  fo.pair.samples = 4;  // no occluders: hybrid is exact to quadrature whatever the rays
+  fo.run.progress = false;
   const FormFactors ff = compute_form_factors(mesh, fo);
   check_closed_lossless(mesh, ff);  // must not throw
   const RadiosityProblem problem = make_problem(mesh, ff.F);

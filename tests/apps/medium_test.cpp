@@ -42,9 +42,9 @@ Scene opposed_squares(double w, double d) {
 FormFactors surface_factors(const PatchMesh& mesh, const std::string& estimator) {
   FormFactorOptions o;
   o.estimator = estimator;
-  o.samples = 64;
-  o.tol = 1e-7;
-  o.progress = false;
+  o.pair.samples = 64;
+  o.analytic.tol = 1e-7;
+  o.run.progress = false;
   return compute_form_factors(mesh, o);
 }
 

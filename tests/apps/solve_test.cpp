@@ -174,8 +174,8 @@ void expect_mc_64_5(const std::string& exr_settings) {
   FormFactorOptions o;
   ASSERT_TRUE(parse_ff_settings(exr_settings, o)) << exr_settings;
   EXPECT_EQ(o.estimator, "mc") << exr_settings;
-  EXPECT_EQ(o.samples, 64) << exr_settings;
-  EXPECT_EQ(o.seed, 5u) << exr_settings;
+  EXPECT_EQ(o.pair.samples, 64) << exr_settings;
+  EXPECT_EQ(o.run.seed, 5u) << exr_settings;
 }
 
 TEST(SolveCommand, LoadedFormFactorsReportTheSettingsThatMadeThem) {
@@ -344,8 +344,8 @@ TEST(CornellBox, EverySolverAgreesWithDirect) {
   args.patches = 200;
   const LoadedScene scene = load_scene(args);
   FormFactorOptions fo;
-  fo.samples = 4;
-  fo.progress = false;
+  fo.pair.samples = 4;
+  fo.run.progress = false;
   const FormFactors ff = compute_form_factors(scene.mesh, fo);
   const RadiosityProblem problem = make_problem(scene.mesh, ff.F);
   const double tol = 1e-9;

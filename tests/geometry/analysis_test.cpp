@@ -25,8 +25,8 @@ Scene inverted(Scene s, const std::string& surface = "") {
 // Few rays suffice: only which entries are zero matters here.
 SparseF form_factors(const PatchMesh& mesh) {
   FormFactorOptions o;
-  o.samples = 4;
-  o.progress = false;
+  o.pair.samples = 4;
+  o.run.progress = false;
   return compute_form_factors(mesh, o).F;
 }
 

@@ -332,9 +332,9 @@ void check_room(int boxes, double tol) {
   ASSERT_EQ(mesh.size(), static_cast<std::int32_t>(r.faces.size()));
   FormFactorOptions o;
   o.estimator = "analytic";
-  o.tol = tol;
-  o.progress = false;
-  o.with_stderr = true;
+  o.analytic.tol = tol;
+  o.run.progress = false;
+  o.run.with_stderr = true;
   const FormFactors ff = compute_form_factors(mesh, o);
   // Pairs of a box face and a plane it stands on may still spend their boolean budget
   // (corner identification fails near the contact; docs/form-factors.md "Where it stops
@@ -401,12 +401,12 @@ TEST(AnalyticEstimatorSlow, ClosedBoxWithTiltedPlateRowsSumToOne) {
   // 1e-7: the twelve pairs of faces sharing a cube edge converge algebraically at the contact
   // (isotropic splitting; docs/form-factors.md "The analytic estimator"), about 0.3 s each
   // here; 1e-9 takes 10 s.
-  o.tol = 1e-7;
-  o.progress = false;
-  o.with_stderr = true;
-  o.threads = 1;
+  o.analytic.tol = 1e-7;
+  o.run.progress = false;
+  o.run.with_stderr = true;
+  o.run.threads = 1;
   const FormFactors ff = compute_form_factors(mesh, o);
-  o.threads = 2;
+  o.run.threads = 2;
   const FormFactors ff2 = compute_form_factors(mesh, o);
   ASSERT_EQ(ff.F.nonZeros(), ff2.F.nonZeros());
   for (Eigen::Index k = 0; k < ff.F.nonZeros(); ++k)
@@ -423,8 +423,9 @@ TEST(AnalyticEstimatorSlow, ClosedBoxWithTiltedPlateRowsSumToOne) {
       const double a = mesh.patches[i].area * it.value(), b = mesh.patches[it.col()].area * ff.F.coeff(it.col(), i);
       EXPECT_NEAR(a, b, 1e-15 * a);
     }
-    EXPECT_LE(err, 7 * o.tol) << "row " << i;
-    EXPECT_NEAR(sum, 1.0, 7 * o.tol) << "row " << i << " (" << mesh.surface_names[mesh.patches[i].surface] << ")";
+    EXPECT_LE(err, 7 * o.analytic.tol) << "row " << i;
+    EXPECT_NEAR(sum, 1.0, 7 * o.analytic.tol)
+        << "row " << i << " (" << mesh.surface_names[mesh.patches[i].surface] << ")";
   }
   // The cube's faces see a little less of the opposite face than the empty cube's exact
   // opposite factor; the plate takes the difference.

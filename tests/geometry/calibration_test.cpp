@@ -73,13 +73,13 @@ void calibrate(const std::string& estimator, int samples) {
     for (int seed = 1; seed <= kSeeds; ++seed) {
       FormFactorOptions o;
       o.estimator = estimator;
-      o.samples = samples;
+      o.pair.samples = samples;
       // A fresh seed per case: the same seed in every configuration would reuse the same
       // random shifts (streams hash the seed with the patch indices, 0 and 1 in every
       // scene), making the cases' misses correlated.
-      o.seed = 1000 * ++stream + seed;
-      o.with_stderr = true;
-      o.progress = false;
+      o.run.seed = 1000 * ++stream + seed;
+      o.run.with_stderr = true;
+      o.run.progress = false;
       const FormFactors ff = compute_form_factors(mesh, o);
       const double G = ff.F.coeff(0, 1) * mesh.patches[0].area;
       const double se = ff.stderr_F.coeff(0, 1) * mesh.patches[0].area;
@@ -133,16 +133,16 @@ TEST(ErrorBars, TaperedHalfShadedReceiverIsWithinThreeSigma) {
   add_polygon(shaded, "b", kGrey, {{-1, 0, 1}, {-0.05, 2, 1}, {0.05, 2, 1}, {1, 0, 1}});
   add_polygon(shaded, "plate", kGrey, {{-3, 1, 1 - 1e-4}, {3, 1, 1 - 1e-4}, {3, 4, 1 - 1e-4}, {-3, 4, 1 - 1e-4}});
   FormFactorOptions o;
-  o.samples = 4;
-  o.progress = false;
+  o.pair.samples = 4;
+  o.run.progress = false;
   const PatchMesh open_mesh = mesh_scene(open, {});
   const double exact = compute_form_factors(open_mesh, o).F.coeff(0, 1) * open_mesh.patches[0].area;
   const PatchMesh mesh = mesh_scene(shaded, {});
   ASSERT_EQ(mesh.patches[1].vertex_count, 4);  // one non-parallelogram quad
   for (const std::string est : {"hybrid", "mc"}) {
     o.estimator = est;
-    o.samples = 1 << 14;
-    o.with_stderr = true;
+    o.pair.samples = 1 << 14;
+    o.run.with_stderr = true;
     const FormFactors ff = compute_form_factors(mesh, o);
     const double G = ff.F.coeff(0, 1) * mesh.patches[0].area;
     const double se = ff.stderr_F.coeff(0, 1) * mesh.patches[0].area;
@@ -197,9 +197,9 @@ TEST(ErrorBarsSlow, EnclosedCylinderPastABlockerHasRowSumsOfOne) {
   add_revolved(s, "blocker", 8, 3, true, cyl_r, cyl_z, {0.2, 0, 0});
   const PatchMesh mesh = mesh_scene(s, {});
   FormFactorOptions o;
-  o.samples = 64;
-  o.with_stderr = true;
-  o.progress = false;
+  o.pair.samples = 64;
+  o.run.with_stderr = true;
+  o.run.progress = false;
   for (const std::string est : {"hybrid", "mc"}) {
     o.estimator = est;
     const FormFactors ff = compute_form_factors(mesh, o);

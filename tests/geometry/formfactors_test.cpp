@@ -17,11 +17,11 @@ FormFactors compute(const Scene& scene, const std::string& estimator, int sample
                     std::uint64_t seed = 1, double max_edge = 0.0, int threads = 0) {
   FormFactorOptions o;
   o.estimator = estimator;
-  o.samples = samples;
-  o.seed = seed;
-  o.threads = threads;
-  o.with_stderr = samples >= 4;  // replicate errors need >= 4 samples
-  o.progress = false;
+  o.pair.samples = samples;
+  o.run.seed = seed;
+  o.run.threads = threads;
+  o.run.with_stderr = samples >= 4;  // replicate errors need >= 4 samples
+  o.run.progress = false;
   return compute_form_factors(mesh_scene(scene, {max_edge, 0}), o);
 }
 
@@ -85,9 +85,9 @@ TEST(FormFactorHybrid, IsExactForUnoccludedPairs) {
   // The disks are 64-gons, triangulated into 62 triangles each by the mesher.
   const PatchMesh disks = mesh_scene(coaxial_disks(0.5, 0.5, 1.0, 64), {});
   FormFactorOptions o;
-  o.samples = 8;
-  o.with_stderr = true;
-  o.progress = false;
+  o.pair.samples = 8;
+  o.run.with_stderr = true;
+  o.run.progress = false;
   const auto [f, se] = surface_factor(disks, compute_form_factors(disks, o));
   // The 64-gon of equal area differs from the disk by O(1/64²) in F (measured ~2e-5).
   EXPECT_NEAR(f, coaxial_disks_factor(0.5, 0.5, 1.0), 1e-4 + 4 * se);
@@ -98,9 +98,9 @@ TEST(FormFactorHybrid, MeshedSquaresSumToTheSurfaceFactor) {
        {std::pair{parallel_squares(1.0), kCubeOpposite}, std::pair{perpendicular_squares(), kCubeAdjacent}}) {
     const PatchMesh mesh = mesh_scene(scene, {0.25, 0});
     FormFactorOptions o;
-    o.samples = 8;
-    o.with_stderr = true;
-    o.progress = false;
+    o.pair.samples = 8;
+    o.run.with_stderr = true;
+    o.run.progress = false;
     const FormFactors ff = compute_form_factors(mesh, o);
     const auto [f, se] = surface_factor(mesh, ff);
     // Unoccluded: quadrature error only, < 1e-5 per entry relative, plus stderr.
@@ -113,9 +113,9 @@ TEST(FormFactors, UnitCubeRowsSumToOneAndReciprocityIsExact) {
     const PatchMesh mesh = mesh_scene(unit_cube(), {0.34, 0});  // 3x3 patches per face
     FormFactorOptions o;
     o.estimator = est;
-    o.samples = est == "mc" ? 4096 : 8;
-    o.with_stderr = true;
-    o.progress = false;
+    o.pair.samples = est == "mc" ? 4096 : 8;
+    o.run.with_stderr = true;
+    o.run.progress = false;
     const FormFactors ff = compute_form_factors(mesh, o);
     for (std::int32_t i = 0; i < mesh.size(); ++i) {
       double sum = 0.0, var = 0.0;
@@ -230,11 +230,11 @@ TEST(FormFactors, RowRangesTogetherAreTheWholeFBitForBit) {
   for (const std::string est : {"mc", "hybrid"}) {
     FormFactorOptions o;
     o.estimator = est;
-    o.samples = 8;
-    o.seed = 7;
-    o.with_stderr = true;
+    o.pair.samples = 8;
+    o.run.seed = 7;
+    o.run.with_stderr = true;
     o.threshold = 1e-3;  // applied per pair: both entries of a pair live in one range
-    o.progress = false;
+    o.run.progress = false;
     const FormFactors whole = compute_form_factors(mesh, o);
     for (int parts : {1, 2, 3, 7}) {
       const std::vector<std::int32_t> rows = balanced_pair_rows(mesh.size(), parts);
@@ -244,8 +244,8 @@ TEST(FormFactors, RowRangesTogetherAreTheWholeFBitForBit) {
       std::vector<Eigen::Triplet<double, std::int64_t>> entries, errors;
       for (int r = 0; r < parts; ++r) {
         if (rows[r + 1] == rows[r]) continue;
-        o.row_begin = rows[r];
-        o.row_end = rows[r + 1];
+        o.subset.row_begin = rows[r];
+        o.subset.row_end = rows[r + 1];
         const FormFactors part = compute_form_factors(mesh, o);
         for (std::int32_t i = 0; i < mesh.size(); ++i)
           for (SparseF::InnerIterator it(part.F, i), e(part.stderr_F, i); it; ++it, ++e) {
@@ -253,7 +253,7 @@ TEST(FormFactors, RowRangesTogetherAreTheWholeFBitForBit) {
             errors.emplace_back(i, it.col(), e.value());
           }
       }
-      o.row_begin = o.row_end = 0;
+      o.subset.row_begin = o.subset.row_end = 0;
       // setFromTriplets sums duplicates: an entry computed twice would show as a mismatch.
       SparseF F(mesh.size(), mesh.size()), err(mesh.size(), mesh.size());
       F.setFromTriplets(entries.begin(), entries.end());
@@ -288,9 +288,9 @@ TEST(FormFactors, RowRangeRefusesRowEstimators) {
   const PatchMesh mesh = mesh_scene(unit_cube(), {0.5, 0});
   FormFactorOptions o;
   o.estimator = "gather";
-  o.row_begin = 0;
-  o.row_end = 2;
-  o.progress = false;
+  o.subset.row_begin = 0;
+  o.subset.row_end = 2;
+  o.run.progress = false;
   EXPECT_THROW(compute_form_factors(mesh, o), UsageError);
 }
 
@@ -316,9 +316,9 @@ TEST(FormFactors, FloorRunningUnderAWallMatchesTheClosedForm) {
       if (est == "mc" && h < 0.2) continue;
       FormFactorOptions o;
       o.estimator = est;
-      o.samples = est == "mc" ? 4096 : 4;
-      o.with_stderr = true;
-      o.progress = false;
+      o.pair.samples = est == "mc" ? 4096 : 4;
+      o.run.with_stderr = true;
+      o.run.progress = false;
       const auto [f, se] = surface_factor(mesh, compute_form_factors(mesh, o));
       // hybrid: unoccluded, quadrature error < 1e-6 per pair (quadrature_test.cpp), 1e-5
       // allowed; mc: 5 stderr of its own error (the shared-edge singularity makes its
@@ -348,14 +348,14 @@ TEST(FormFactors, PartlyShadedReceiverUsesTheKernelWeightedVisibleFraction) {
   add_polygon(shaded, "b", m, {{0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1}});
   add_polygon(shaded, "plate", m, {{-2, -2, 0.999}, {0.5, -2, 0.999}, {0.5, 3, 0.999}, {-2, 3, 0.999}});
   FormFactorOptions o;
-  o.samples = 4;
-  o.progress = false;
+  o.pair.samples = 4;
+  o.run.progress = false;
   const FormFactors ref = compute_form_factors(mesh_scene(open, {}), o);
   const double exact = ref.F.coeff(0, 1) * 0.5;  // G = A_a F_ac, A_a = 0.5
   for (const std::string est : {"hybrid", "mc"}) {
     o.estimator = est;
-    o.samples = est == "mc" ? 1 << 16 : 256;
-    o.with_stderr = true;
+    o.pair.samples = est == "mc" ? 1 << 16 : 256;
+    o.run.with_stderr = true;
     const PatchMesh mesh = mesh_scene(shaded, {est == "mc" ? 0.0 : 0.25, 0});
     const auto [f, se] = surface_factor(mesh, compute_form_factors(mesh, o));
     EXPECT_NEAR(f * 0.5, exact, 1e-3 * exact + 4 * se * 0.5) << est << " se " << se;
@@ -374,8 +374,8 @@ TEST(FormFactors, ThresholdDropsPairsTogetherAndKeepsReciprocity) {
   add_polygon(s, "big", m, {{0, 0, 0}, {4, 0, 0}, {4, 4, 0}, {0, 4, 0}});
   add_polygon(s, "small", m, {{1, 1, 1}, {1, 1.1, 1}, {1.1, 1.1, 1}, {1.1, 1, 1}});
   FormFactorOptions o;
-  o.samples = 4;
-  o.progress = false;
+  o.pair.samples = 4;
+  o.run.progress = false;
   const PatchMesh mesh = mesh_scene(s, {});
   const FormFactors all = compute_form_factors(mesh, o);
   const double f_small = all.F.coeff(1, 0), f_big = all.F.coeff(0, 1);

@@ -16,12 +16,12 @@ FormFactors gather(const PatchMesh& mesh, int rays, std::uint64_t seed = 1,
                    const std::string& reciprocity = "none", int threads = 0) {
   FormFactorOptions o;
   o.estimator = "gather";
-  o.rays = rays;
-  o.seed = seed;
-  o.threads = threads;
+  o.gather.rays = rays;
+  o.run.seed = seed;
+  o.run.threads = threads;
   o.reciprocity = reciprocity;
-  o.with_stderr = rays >= 4;
-  o.progress = false;
+  o.run.with_stderr = rays >= 4;
+  o.run.progress = false;
   return compute_form_factors(mesh, o);
 }
 

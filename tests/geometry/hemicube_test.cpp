@@ -20,11 +20,11 @@ FormFactors hemicube(const PatchMesh& mesh, int resolution, std::uint64_t seed =
                      int threads = 0, bool symmetrize = false) {
   FormFactorOptions o;
   o.estimator = "hemicube";
-  o.hemicube_resolution = resolution;
-  o.seed = seed;
-  o.threads = threads;
+  o.hemicube.resolution = resolution;
+  o.run.seed = seed;
+  o.run.threads = threads;
   o.reciprocity = symmetrize ? "average" : "none";
-  o.progress = false;
+  o.run.progress = false;
   return compute_form_factors(mesh, o);
 }
 

@@ -38,8 +38,8 @@ double exact_G(const Pair& p) {
 
 TEST(HybridQuadrature, UnoccludedPairsOfAnySizeRatioMatchTheClosedForm) {
   FormFactorOptions o;
-  o.samples = 4;
-  o.progress = false;
+  o.pair.samples = 4;
+  o.run.progress = false;
   double worst = 0.0;
   for (double ratio : {1.0, 3.0, 10.0, 30.0, 100.0})
     for (double height : {0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0})  // in small-patch sizes
@@ -67,8 +67,8 @@ TEST(HybridQuadrature, SmallSquareCloseAboveALargeOneIsExact) {
   for (double side : {0.1, 0.05}) {
     const Pair p{2.0, side, 0.1, 0.0, 0.0};
     FormFactorOptions o;
-    o.samples = 4;
-    o.progress = false;
+    o.pair.samples = 4;
+    o.run.progress = false;
     const PatchMesh mesh = mesh_scene(make_scene(p), {});
     const double G = compute_form_factors(mesh, o).F.coeff(1, 0) * mesh.patches[1].area;
     EXPECT_NEAR(G, exact_G(p), 1e-6 * exact_G(p)) << side;  // kQuadratureTolerance
@@ -90,8 +90,8 @@ TEST(ReferenceQuadrature, MatchesTheClosedFormToNineDigits) {
 // a wall: exact to 1e-6 with one patch each.
 TEST(HybridQuadrature, SharedEdgeIsExact) {
   FormFactorOptions o;
-  o.samples = 4;
-  o.progress = false;
+  o.pair.samples = 4;
+  o.run.progress = false;
   const FormFactors ff = compute_form_factors(mesh_scene(perpendicular_squares(), {}), o);
   EXPECT_NEAR(ff.F.coeff(0, 1), kCubeAdjacent, 1e-6 * kCubeAdjacent);
 }

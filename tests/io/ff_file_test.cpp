@@ -19,9 +19,9 @@ struct Fixture {
   PatchMesh mesh = mesh_scene(unit_cube(), {0.5, 0});
   FormFactors ff = [this] {
     FormFactorOptions o;
-    o.samples = 4;
-    o.with_stderr = true;
-    o.progress = false;
+    o.pair.samples = 4;
+    o.run.with_stderr = true;
+    o.run.progress = false;
     return compute_form_factors(mesh, o);
   }();
   FormFactorFileInfo info{mesh_hash(mesh), "estimator=hybrid samples=4"};
@@ -100,20 +100,20 @@ namespace lambert {
 TEST(FormFactorFile, SettingsTextRecoversEverySettingExactly) {
   FormFactorOptions o;
   o.estimator = "hemicube";
-  o.samples = 77;
-  o.seed = 18446744073709551615ull;  // the largest seed: all 64 bits survive
+  o.pair.samples = 77;
+  o.run.seed = 18446744073709551615ull;  // the largest seed: all 64 bits survive
   o.threshold = 1.0 / 3.0;           // %.17g reads back to the same double
-  o.hemicube_resolution = 96;
-  o.rays = 4321;
+  o.hemicube.resolution = 96;
+  o.gather.rays = 4321;
   o.reciprocity = "average";
   FormFactorOptions back;
   ASSERT_TRUE(parse_ff_settings(format_ff_settings(o) + " patches=24 max_edge=0.5", back));
   EXPECT_EQ(back.estimator, "hemicube");
-  EXPECT_EQ(back.samples, 77);
-  EXPECT_EQ(back.seed, o.seed);
+  EXPECT_EQ(back.pair.samples, 77);
+  EXPECT_EQ(back.run.seed, o.run.seed);
   EXPECT_EQ(back.threshold, o.threshold);
-  EXPECT_EQ(back.hemicube_resolution, 96);
-  EXPECT_EQ(back.rays, 4321);
+  EXPECT_EQ(back.hemicube.resolution, 96);
+  EXPECT_EQ(back.gather.rays, 4321);
   EXPECT_EQ(back.reciprocity, "average");
 }
 
@@ -122,7 +122,7 @@ TEST(FormFactorFile, SymmetrizeKeyOfOlderFilesReadsAsReciprocity) {
   ASSERT_TRUE(parse_ff_settings(
       "estimator=hemicube samples=32 seed=1 threshold=0 hemicube_res=64 symmetrize=1", o));
   EXPECT_EQ(o.reciprocity, "average");
-  EXPECT_EQ(o.rays, FormFactorOptions().rays);  // absent: kept
+  EXPECT_EQ(o.gather.rays, FormFactorOptions().gather.rays);  // absent: kept
 }
 
 TEST(FormFactorFile, SettingsOfOlderFilesAreRecoveredAndForeignTextIsRefused) {
@@ -131,8 +131,8 @@ TEST(FormFactorFile, SettingsOfOlderFilesAreRecoveredAndForeignTextIsRefused) {
   ASSERT_TRUE(
       parse_ff_settings("estimator=mc samples=64 seed=5 threshold=0 patches=9 max_edge=1", o));
   EXPECT_EQ(o.estimator, "mc");
-  EXPECT_EQ(o.samples, 64);
-  EXPECT_EQ(o.seed, 5u);
+  EXPECT_EQ(o.pair.samples, 64);
+  EXPECT_EQ(o.run.seed, 5u);
   EXPECT_EQ(o.reciprocity, "none");
   for (const char* foreign :
        {"", "made by hand", "estimator=mc samples=64", "estimator=mc samples=x seed=1 threshold=0",
@@ -149,8 +149,8 @@ TEST(FormFactorFile, MatrixMarketKeepsTheSettingsInItsHeaderComments) {
   testing::TempDir dir;
   FormFactorOptions o;
   o.estimator = "mc";
-  o.samples = 64;
-  o.seed = 5;
+  o.pair.samples = 64;
+  o.run.seed = 5;
   write_matrix_market(dir.file("F.mtx"), f.ff.F, {f.info.mesh_hash, format_ff_settings(o)});
   std::ifstream in(dir.file("F.mtx"));
   bool found = false;
@@ -162,8 +162,8 @@ TEST(FormFactorFile, MatrixMarketKeepsTheSettingsInItsHeaderComments) {
   FormFactorOptions back;
   ASSERT_TRUE(parse_ff_settings(info.settings, back));
   EXPECT_EQ(back.estimator, "mc");
-  EXPECT_EQ(back.samples, 64);
-  EXPECT_EQ(back.seed, 5u);
+  EXPECT_EQ(back.pair.samples, 64);
+  EXPECT_EQ(back.run.seed, 5u);
 }
 
 }  // namespace lambert
@@ -498,10 +498,10 @@ TEST(FormFactorFile, MediumZonesFollowThePatchesAndMaySeeThemselves) {
   EXPECT_EQ(ff.F.rows(), 3);
   FormFactorOptions o;
   ASSERT_TRUE(parse_ff_settings(info.settings, o));
-  EXPECT_EQ(o.medium_zones, 1);
-  EXPECT_EQ(o.medium_extinction, 77u);
-  EXPECT_EQ(o.medium_rays, 16);
-  EXPECT_EQ(o.transmittance_samples, 4);
+  EXPECT_EQ(o.contents.medium_zones, 1);
+  EXPECT_EQ(o.contents.medium_extinction, 77u);
+  EXPECT_EQ(o.contents.medium_rays, 16);
+  EXPECT_EQ(o.contents.transmittance_samples, 4);
   // The same file is from another mesh for 3 patches, and a patch row still sees none of
   // itself.
   EXPECT_TRUE(has(refusal<SceneError>(path, 3), "different scene"));
@@ -515,8 +515,8 @@ TEST(FormFactorFile, MediumZonesFollowThePatchesAndMaySeeThemselves) {
   EXPECT_TRUE(has(refusal<IoError>(too_many, 2), "5 medium zones in a matrix of 3 rows"));
   FormFactorOptions back;
   ASSERT_TRUE(parse_ff_settings(format_ff_settings(o), back));
-  EXPECT_EQ(back.medium_zones, 1);
-  EXPECT_EQ(back.medium_extinction, 77u);
+  EXPECT_EQ(back.contents.medium_zones, 1);
+  EXPECT_EQ(back.contents.medium_extinction, 77u);
 }
 
 }  // namespace lambert

@@ -30,8 +30,8 @@ struct Solved {
 Solved solve_hybrid(const PatchMesh& mesh, int samples) {
   FormFactorOptions fo;
   fo.estimator = "hybrid";
-  fo.samples = samples;
-  fo.progress = false;
+  fo.pair.samples = samples;
+  fo.run.progress = false;
   Solved out;
   out.F = compute_form_factors(mesh, fo);
   SolveOptions so;

@@ -25,7 +25,7 @@ std::vector<Eigen::Vector3d> matrix_means(const Scene& scene, std::int64_t patch
   const PatchMesh mesh = mesh_scene(scene, mo);
   FormFactorOptions fo;
   fo.estimator = "hybrid";
-  fo.samples = 4;
+  fo.pair.samples = 4;
   const FormFactors F = compute_form_factors(mesh, fo);
   SolveOptions so;
   so.tol = 1e-10;

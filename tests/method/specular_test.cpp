@@ -50,14 +50,14 @@ FormFactors extended(const PatchMesh& mesh, const std::string& estimator, int ra
                      std::uint64_t seed = 1, int threads = 0, int depth = 8) {
   FormFactorOptions o;
   o.estimator = estimator;
-  o.samples = 64;
-  o.rays = rays;
-  o.specular_rays = rays;
-  o.specular_depth = depth;
-  o.seed = seed;
-  o.threads = threads;
-  o.with_stderr = true;
-  o.progress = false;
+  o.pair.samples = 64;
+  o.gather.rays = rays;
+  o.specular.rays = rays;
+  o.specular.depth = depth;
+  o.run.seed = seed;
+  o.run.threads = threads;
+  o.run.with_stderr = true;
+  o.run.progress = false;
   return compute_form_factors(mesh, o);
 }
 
@@ -144,9 +144,9 @@ TEST(ExtendedFormFactors, PathsThroughGlassAreReversibleFromEitherEnd) {
   const PatchMesh mesh = mesh_scene(s, {});  // one patch per face
   const Bvh bvh(mesh);
   FormFactorOptions o;
-  o.specular_rays = 65536;
-  o.with_stderr = true;
-  o.progress = false;
+  o.specular.rays = 65536;
+  o.run.with_stderr = true;
+  o.run.progress = false;
   const ff::SpecularTransport sp = ff::compute_specular_transport(mesh, o, bvh, false);
   const double g_ab = 1.0 * sp.S.coeff(0, 1), g_ba = 0.24 * sp.S.coeff(1, 0);
   const double se = std::hypot(1.0 * sp.stderr_S.coeff(0, 1), 0.24 * sp.stderr_S.coeff(1, 0));
