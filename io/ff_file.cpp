@@ -6,10 +6,8 @@
 #include <charconv>
 #include <cinttypes>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 #include <vector>
 
 #include "core/atomic_file.hpp"
@@ -551,111 +549,7 @@ FormFactors read_matrix_market(std::istream& in, const std::string& path,
   return ff;
 }
 
-// strtoll/strtoull/strtod over the whole of `s`.
-bool parse_int(const std::string& s, long long& v) {
-  char* end = nullptr;
-  errno = 0;
-  v = std::strtoll(s.c_str(), &end, 10);
-  return !s.empty() && *end == '\0' && errno == 0;
-}
-bool parse_uint(const std::string& s, std::uint64_t& v) {
-  char* end = nullptr;
-  errno = 0;
-  v = std::strtoull(s.c_str(), &end, 10);
-  return !s.empty() && s[0] != '-' && *end == '\0' && errno == 0;
-}
-bool parse_double(const std::string& s, double& v) {
-  char* end = nullptr;
-  v = std::strtod(s.c_str(), &end);
-  return !s.empty() && *end == '\0' && std::isfinite(v);
-}
-
 }  // namespace
-
-std::string format_ff_settings(const FormFactorOptions& o) {
-  char threshold[32];
-  std::snprintf(threshold, sizeof threshold, "%.17g", o.threshold);
-  char tol[32];
-  std::snprintf(tol, sizeof tol, "%.17g", o.analytic.tol);
-  // symmetrize= stays for readers older than reciprocity= (and is what they parse).
-  const bool average = o.reciprocity == "average";
-  return "estimator=" + o.estimator + " samples=" + std::to_string(o.pair.samples) +
-         " rays=" + std::to_string(o.gather.rays) + " seed=" + std::to_string(o.run.seed) +
-         " threshold=" + threshold + " hemicube_res=" + std::to_string(o.hemicube.resolution) +
-         " reciprocity=" + (average ? "average" : "none") + " symmetrize=" + (average ? "1" : "0") +
-         (o.contents.extended ? " specular_depth=" + std::to_string(o.specular.depth) +
-                                    " specular_rays=" + std::to_string(o.specular.rays)
-                              : "") +
-         (o.estimator == "analytic" ? std::string(" tol=") + tol : std::string()) +
-         (o.contents.medium_zones > 0
-              ? " medium_zones=" + std::to_string(o.contents.medium_zones) +
-                    " medium_extinction=" + std::to_string(o.contents.medium_extinction) +
-                    " medium_rays=" + std::to_string(o.contents.medium_rays) +
-                    " transmittance_samples=" + std::to_string(o.contents.transmittance_samples)
-              : std::string());
-}
-
-bool parse_ff_settings(const std::string& text, FormFactorOptions& options) {
-  FormFactorOptions o = options;
-  bool estimator = false, samples = false, seed = false, threshold = false;
-  bool reciprocity = false;  // reciprocity= wins over the older symmetrize=
-  // Files older than these keys were made without averaging (and gather did not exist).
-  o.reciprocity = "none";
-  std::istringstream in(text);
-  for (std::string pair; in >> pair;) {
-    const size_t eq = pair.find('=');
-    if (eq == std::string::npos) continue;
-    const std::string key = pair.substr(0, eq), value = pair.substr(eq + 1);
-    long long k = 0;
-    if (key == "estimator") {
-      o.estimator = value;
-      estimator = !value.empty();
-    } else if (key == "samples") {
-      samples = parse_int(value, k) && k >= 1 && k <= INT32_MAX;
-      o.pair.samples = static_cast<int>(k);
-    } else if (key == "seed") {
-      seed = parse_uint(value, o.run.seed);
-    } else if (key == "threshold") {
-      threshold = parse_double(value, o.threshold);
-    } else if (key == "hemicube_res") {
-      if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
-      o.hemicube.resolution = static_cast<int>(k);
-    } else if (key == "rays") {
-      if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
-      o.gather.rays = static_cast<int>(k);
-    } else if (key == "specular_depth") {
-      if (!parse_int(value, k) || k < 1 || k > 64) return false;
-      o.specular.depth = static_cast<int>(k);
-      o.contents.extended = true;
-    } else if (key == "specular_rays") {
-      if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
-      o.specular.rays = static_cast<int>(k);
-    } else if (key == "medium_zones") {
-      if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
-      o.contents.medium_zones = static_cast<std::int32_t>(k);
-    } else if (key == "medium_extinction") {
-      if (!parse_uint(value, o.contents.medium_extinction)) return false;
-    } else if (key == "medium_rays") {
-      if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
-      o.contents.medium_rays = static_cast<int>(k);
-    } else if (key == "transmittance_samples") {
-      if (!parse_int(value, k) || k < 1 || k > INT32_MAX) return false;
-      o.contents.transmittance_samples = static_cast<int>(k);
-    } else if (key == "tol") {
-      if (!parse_double(value, o.analytic.tol) || !(o.analytic.tol > 0.0)) return false;
-    } else if (key == "symmetrize") {
-      if (value != "0" && value != "1") return false;
-      if (!reciprocity) o.reciprocity = value == "1" ? "average" : "none";
-    } else if (key == "reciprocity") {
-      if (value != "none" && value != "average") return false;
-      o.reciprocity = value;
-      reciprocity = true;
-    }
-  }
-  if (!(estimator && samples && seed && threshold)) return false;
-  options = o;
-  return true;
-}
 
 void write_matrix_market(const std::string& path, const SparseF& F, const FormFactorFileInfo& info,
                          ValuePrecision precision) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "geometry/formfactors/formfactors.hpp"
+#include "io/ff_settings.hpp"
 
 namespace lambert {
 
@@ -15,23 +16,6 @@ struct FormFactorFileInfo {
   std::uint64_t mesh_hash = 0;  ///< mesh_hash() of the PatchMesh F was computed on
   std::string settings;         ///< settings text: format_ff_settings() plus mesh notes
 };
-
-/// The settings of a computation as stored in a saved F: space-separated key=value pairs
-/// "estimator=E samples=K rays=R seed=S threshold=T hemicube_res=N reciprocity=none|average
-/// symmetrize=0|1" (threshold with %.17g, so it reads back exactly; estimator and reciprocity
-/// resolved, never "auto"; symmetrize repeats reciprocity for older readers). Writers may
-/// append more pairs (patches, max_edge).
-std::string format_ff_settings(const FormFactorOptions& options);
-
-/// Recovers estimator, samples, rays, seed, threshold, hemicube_res and reciprocity from a
-/// stored settings text into `options` (other members untouched; unknown keys ignored).
-/// Returns false, leaving `options` unchanged, when any of estimator, samples, seed,
-/// threshold is missing or malformed (a file written by another tool). hemicube_res and
-/// rays keep their values when absent (files before these were always stored wrote
-/// hemicube_res for the hemicube only, and predate gather); reciprocity is read from
-/// reciprocity=, else symmetrize=, else "none" (files before these keys were always stored
-/// wrote symmetrize for the hemicube only; the other estimators are reciprocal).
-bool parse_ff_settings(const std::string& text, FormFactorOptions& options);
 
 /// How saved values are stored: Double (exact), or Float (--ff-precision float: half the
 /// value bytes; each value and error rounded to the nearest float, a relative error of at

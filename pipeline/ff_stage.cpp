@@ -9,6 +9,7 @@
 #include "geometry/formfactors/analysis.hpp"
 #include "geometry/media/medium.hpp"
 #include "io/ff_file.hpp"
+#include "io/ff_settings.hpp"
 
 namespace lambert {
 
@@ -230,22 +231,9 @@ void check_closed_lossless(const PatchMesh& mesh, const FormFactors& ff, bool so
 }
 
 Json ff_settings_json(const FormFactorOptions& o, const std::string& loaded_from) {
-  const auto known = [&](Json v) { return o.estimator.empty() ? Json() : v; };
-  return {
-      {"estimator", known(o.estimator)},
-      {"estimator_requested", o.estimator_requested.empty() ? Json() : Json(o.estimator_requested)},
-      {"samples", known(o.pair.samples)},
-      {"rays_per_patch", known(o.gather.rays)},  // "rays" is the traced count in reports
-      {"seed", known(o.run.seed)},
-      {"threshold", known(o.threshold)},
-      {"hemicube_resolution", known(o.hemicube.resolution)},
-      {"tol", o.estimator == "analytic" ? Json(o.analytic.tol) : Json()},
-      {"reciprocity", known(o.reciprocity)},
-      {"symmetrize", known(o.reciprocity == "average")},
-      {"extended", known(o.contents.extended)},  // specular paths included (specular.hpp)
-      {"specular_depth", o.contents.extended ? Json(o.specular.depth) : Json()},
-      {"specular_rays", o.contents.extended ? Json(o.specular.rays) : Json()},
-      {"loaded_from", loaded_from}};
+  Json j = ff_settings_report(o);
+  j["loaded_from"] = loaded_from;
+  return j;
 }
 
 Json reciprocity_json(const FormFactors& ff) {

@@ -92,12 +92,12 @@ void warn_about_lighting(const PatchMesh& mesh, const SparseF& F);
 /// with `solving` false (F is only saved) the same message is a warning instead.
 void check_closed_lossless(const PatchMesh& mesh, const FormFactors& ff, bool solving = true);
 
-/// The settings that made F, for reports: {estimator (the resolved one),
-/// estimator_requested ("auto" or null), samples, rays_per_patch (--rays), seed, threshold,
-/// hemicube_resolution, tol (analytic's --ff-tol, else null), reciprocity, symmetrize (reciprocity
-/// == average), extended (F holds specular paths), specular_depth and specular_rays (null unless
-/// extended), loaded_from} ("" when computed here), every setting null when unknown (see
-/// obtain_form_factors).
+/// The settings that made F, for reports: ff_settings_report (io/ff_settings.hpp: estimator
+/// (the resolved one), estimator_requested ("auto" or null), samples, rays_per_patch (--rays),
+/// seed, threshold, hemicube_resolution, tol (analytic's --ff-tol, else null), reciprocity,
+/// symmetrize (reciprocity == average), extended (F holds specular paths), specular_depth and
+/// specular_rays (null unless extended); every setting null when unknown, see
+/// obtain_form_factors), then loaded_from ("" when computed here).
 Json ff_settings_json(const FormFactorOptions& options, const std::string& loaded_from);
 
 /// What reciprocity averaging changed (FormFactorStats' reciprocity_* members): {applied,
