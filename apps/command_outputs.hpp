@@ -9,6 +9,7 @@
 
 #include "apps/commands.hpp"
 #include "io/json.hpp"
+#include "pipeline/daylight_stage.hpp"
 
 namespace lambert {
 
@@ -33,6 +34,7 @@ struct MatrixSolveResult {
   std::optional<MediumResult> medium;
   std::vector<AdaptRound> rounds;
   Json distributed;  ///< the "distributed" section of the summary (null: none)
+  DaylightSources daylight;  ///< what the sky and the sun brought (empty: none)
 };
 
 /// Writes the per-patch CSV and the JSON summary, prints the per-channel lines; returns

@@ -179,7 +179,7 @@ int compare_matrix(const CompareOptions& opts) {
   }
   const RadiosityProblem problem =
       medium ? make_extended_problem(loaded.mesh, ff.F, zones.albedo, zones.emission, zones.area)
-             : make_problem(loaded.mesh, ff);
+             : make_lit_problem(loaded, ff, opts.run.seed, opts.run.threads, nullptr);
   if (!medium) {
     warn_about_lighting(loaded.mesh, ff.F);
     check_closed_lossless(loaded.mesh, ff);

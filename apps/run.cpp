@@ -277,7 +277,7 @@ int finish_matrix(const RunOptions& opts, const RunPaths& paths, const LoadedSce
   std::ostringstream settings;
   settings << "patches=" << loaded.mesh.size() << " max_edge=" << loaded.max_edge << ' '
            << ff_settings_text(r.ff_options, opts.ff.ff_file) << " solver=" << x.solver
-           << " tol=" << opts.solver.tol;
+           << " tol=" << opts.solver.tol << daylight_settings_text(loaded.scene.daylight);
   m.settings = settings.str();
   if (x.medium) describe_medium(*x.medium, m);
   if (!x.distributed.is_null()) m.sections["distributed"] = x.distributed;
@@ -302,6 +302,8 @@ int finish_matrix(const RunOptions& opts, const RunPaths& paths, const LoadedSce
                           {"status", to_string(r.solution.status)},
                           {"channels", channels}};
   for (const auto& e : r.solution.energy) m.energy.push_back(energy_json(e));
+  if (loaded.scene.daylight.any())
+    m.sections["daylight"] = daylight_json(loaded.scene.daylight, r.daylight);
   if (!x.rounds.empty()) {
     m.sections["adapt"] = adapt_json(x.rounds);
     const AdaptRound& last = x.rounds.back();
@@ -423,6 +425,7 @@ int run_matrix(const RunOptions& opts) {
     r.ff_entries = F.F.nonZeros();
     r.B = r.solution.B;
     r.indirect = indirect_irradiance(loaded.mesh, F.F, r.B);
+    r.daylight = daylight_sources(loaded, F, opts.run.seed, opts.run.threads);
     r.solved = true;
     warn_about_lighting(loaded.mesh, F.F);
   } else {

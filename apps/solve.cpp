@@ -76,6 +76,7 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
   double ff_seconds = 0.0;
   std::optional<MediumResult> medium_result;
   std::int64_t nonzeros = 0;
+  DaylightSources daylight;
   if (medium) {
     check_medium_scene(loaded.mesh, nullptr);
     ff = obtain_form_factors(loaded, opts.ff, opts.run, false, medium.get());
@@ -86,12 +87,14 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
     nonzeros = medium_result->entries;
   } else if (opts.adapt.active()) {
     rounds = adapt_scene(loaded, opts.ff, so, opts.run, opts.adapt, ff, sol);
+    daylight = daylight_sources(loaded, ff, opts.run.seed, opts.run.threads);
     ff_seconds = ff_timer.seconds() - sol.seconds;
     warn_about_lighting(loaded.mesh, ff.F);
   } else {
     ff = obtain_form_factors(loaded, opts.ff, opts.run);
     ff_seconds = ff_timer.seconds();
-    const RadiosityProblem problem = make_problem(loaded.mesh, ff);
+    const RadiosityProblem problem =
+        make_lit_problem(loaded, ff, opts.run.seed, opts.run.threads, &daylight);
     warn_about_lighting(loaded.mesh, ff.F);
     check_closed_lossless(loaded.mesh, ff);
     sol = solve_radiosity(problem, so);
@@ -106,6 +109,7 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
   result.nonzeros = nonzeros;
   result.medium = std::move(medium_result);
   result.rounds = std::move(rounds);
+  result.daylight = std::move(daylight);
   return write_solve_outputs(opts, loaded, result);
 }
 
@@ -204,6 +208,7 @@ int write_solve_outputs(const SolveCommandOptions& opts, const LoadedScene& load
   for (int c = 0; c < 3; ++c) channels.push_back(channel_json(sol.channels[c], sol.energy[c], c));
   j["surfaces"] = surface_averages_json(surfaces);
   if (!r.rounds.empty()) j["adapt"] = adapt_json(r.rounds);
+  if (loaded.scene.daylight.any()) j["daylight"] = daylight_json(loaded.scene.daylight, r.daylight);
   if (!r.distributed.is_null()) j["distributed"] = r.distributed;
   write_json_file(json_path, j);
 

@@ -67,6 +67,20 @@ struct Surface {
   std::int32_t material = 0;  ///< index into Scene::materials
 };
 
+/// Light from outside the scene (docs/scenes.md, "Daylight"): a uniform sky and a sun.
+/// The sky is a Lambertian dome of radiance `sky` (W m^-2 sr^-1 per channel, in the units
+/// of the scene's emission per steradian) on every direction that escapes the scene; the
+/// sun a directional source: `sun_irradiance` (W/m^2) on a surface facing it, its light
+/// travelling along `sun_direction` (a unit vector; straight down in a y-up scene: 0,-1,0).
+struct Daylight {
+  Eigen::Vector3d sky = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sun_direction = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sun_irradiance = Eigen::Vector3d::Zero();
+  bool has_sky() const { return sky.maxCoeff() > 0.0; }
+  bool has_sun() const { return sun_irradiance.maxCoeff() > 0.0; }
+  bool any() const { return has_sky() || has_sun(); }
+};
+
 /// A whole scene as loaded from a file (or built by a test).
 struct Scene {
   std::string source;  ///< file name it came from (for messages)
@@ -78,6 +92,7 @@ struct Scene {
   std::vector<Surface> surfaces;
   std::vector<Material> materials;
   Camera camera;  ///< default view for rendering
+  Daylight daylight;  ///< sky and sun (--sky, --sun); none by default
 
   /// Sum of all face areas.
   double total_area() const;

@@ -8,6 +8,7 @@
 #include "core/log.hpp"
 #include "core/timer.hpp"
 #include "geometry/mesh/adapt.hpp"
+#include "pipeline/daylight_stage.hpp"
 #include "pipeline/problem.hpp"
 
 namespace lambert {
@@ -20,8 +21,9 @@ double estimated_error(const PatchMesh& mesh, const std::vector<double>& e) {
   return area > 0 ? std::accumulate(e.begin(), e.end(), 0.0) / area : 0.0;
 }
 
-RadiositySolution solve_on(const LoadedScene& scene, const FormFactors& ff, SolveOptions so) {
-  const RadiosityProblem problem = make_problem(scene.mesh, ff);
+RadiositySolution solve_on(const LoadedScene& scene, const FormFactors& ff, SolveOptions so,
+                           const RunArgs& run) {
+  const RadiosityProblem problem = make_lit_problem(scene, ff, run.seed, run.threads, nullptr);
   return solve_radiosity(problem, so);
 }
 
@@ -45,7 +47,7 @@ std::vector<AdaptRound> adapt_scene(LoadedScene& scene, const FormFactorArgs& ff
   Timer timer;
   ff = compute_form_factors(scene.mesh, fo, &scene_bvh(scene, run.threads));
   check_closed_lossless(scene.mesh, ff);  // refinement keeps a closed lossless set closed
-  solution = solve_on(scene, ff, so);
+  solution = solve_on(scene, ff, so, run);
   std::int64_t changed_now = scene.mesh.size();  // patches whose factors this round computed
   for (int round = 0;; ++round) {
     // A discontinuity mesh is shaded with exact direct light at its vertices: its error is
@@ -95,7 +97,7 @@ std::vector<AdaptRound> adapt_scene(LoadedScene& scene, const FormFactorArgs& ff
     scene.bvh.reset();
     ff = update_form_factors(scene.mesh, origin, ff.F, fo, &scene_bvh(scene, run.threads));
     so.initial_guess = guess;
-    solution = solve_on(scene, ff, so);
+    solution = solve_on(scene, ff, so, run);
     changed_now = changed;
   }
   return out;

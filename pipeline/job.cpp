@@ -59,6 +59,30 @@ std::string parse_emit(const std::string& text, EmitRule& rule) {
   return why;
 }
 
+std::string parse_sun(const std::string& text, Daylight& light) {
+  const std::string want = "DX,DY,DZ,R,G,B: a direction the sunlight travels and its irradiance";
+  double v[6];
+  int n = 0;
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t comma = std::min(text.find(',', start), text.size());
+    double x = 0;
+    if (n == 6 || !parse_finite_number(text.substr(start, comma - start), x))
+      return "'" + text + "' is not " + want;
+    v[n++] = x;
+    start = comma + 1;
+  }
+  if (n != 6) return "'" + text + "' is not " + want;
+  const Eigen::Vector3d d(v[0], v[1], v[2]);
+  const double length = d.norm();
+  if (!(length > 0.0) || !std::isfinite(length))
+    return "'" + text + "': the direction DX,DY,DZ has no length";
+  if (v[3] < 0 || v[4] < 0 || v[5] < 0) return "'" + text + "': the irradiance R,G,B must be >= 0";
+  light.sun_direction = d / length;
+  light.sun_irradiance = Eigen::Vector3d(v[3], v[4], v[5]);
+  return "";
+}
+
 namespace {
 
 // The path as compared for collisions: absolute, with "." and ".." and symbolic links of the
@@ -204,6 +228,14 @@ Scene load_scene_file(const SceneArgs& args) {
   if (args.default_reflectance_given && !report.default_material_used)
     throw UsageError("--default-reflectance does not apply: every face of " + path +
                      " has a defined material");
+  if (!args.sky.empty()) {
+    LAMBERT_CHECK(args.sky.size() == 3, "--sky takes R,G,B");
+    scene.daylight.sky = Eigen::Vector3d(args.sky[0], args.sky[1], args.sky[2]);
+  }
+  if (!args.sun.empty()) {
+    const std::string why = parse_sun(args.sun, scene.daylight);
+    if (!why.empty()) throw UsageError("--sun: " + why);
+  }
   return scene;
 }
 
@@ -216,14 +248,15 @@ Scene load_checked_scene(const SceneArgs& args, const JobPlan& plan) {
   const bool emits = std::any_of(scene.surfaces.begin(), scene.surfaces.end(), [&](const auto& s) {
     return scene.materials[s.material].emits();
   });
-  if (args.require_emitter && !emits && !medium_emits) {
+  if (args.require_emitter && !emits && !medium_emits && !scene.daylight.any()) {
     const std::string path = args.scene.empty() ? builtin_cornell_box_path() : args.scene;
     throw UsageError(path +
-                     ": nothing emits (no material with Ke > 0, no --medium-emission): B would "
-                     "be zero everywhere; make surfaces emit with --emit NAME_OR_GLOB=R,G,B "
-                     "(`lambert info " +
+                     ": nothing emits (no material with Ke > 0, no --medium-emission, no --sky "
+                     "or --sun): B would be zero everywhere; make surfaces emit with --emit "
+                     "NAME_OR_GLOB=R,G,B (`lambert info " +
                      (args.scene.empty() ? std::string() : args.scene + " ") +
-                     "--list-surfaces` lists the names)");
+                     "--list-surfaces` lists the names) or light the scene with --sky R,G,B "
+                     "or --sun DX,DY,DZ,R,G,B");
   }
   std::vector<NamedFile> inputs = plan.inputs;
   for (size_t k = 0; k < scene.files.size(); ++k) {

@@ -30,6 +30,10 @@ std::string parse_rgb(const std::string& text, bool unit, Eigen::Vector3d& out);
 /// Reads --emit NAME_OR_GLOB=R,G,B (the last '=' separates: names may hold one). Returns the
 /// reason it is not one, empty on success.
 std::string parse_emit(const std::string& text, EmitRule& rule);
+/// Parses --sun DX,DY,DZ,R,G,B into `light` (its direction normalised); returns the reason
+/// it is not one ("" when it is): six finite numbers, a direction of non-zero length, an
+/// irradiance R,G,B >= 0.
+std::string parse_sun(const std::string& text, Daylight& light);
 
 /// Scene file, how to load it and meshing target.
 struct SceneArgs {
@@ -47,6 +51,8 @@ struct SceneArgs {
   /// participating medium of the job's plan emits) is refused when loaded, before any work
   /// (UsageError naming --emit), instead of a long run that ends in a black result.
   bool require_emitter = false;
+  std::vector<double> sky;  ///< --sky R,G,B (radiance); empty = no sky
+  std::string sun;          ///< --sun DX,DY,DZ,R,G,B; empty = no sun
 };
 
 /// Threads, seed and verbosity.

@@ -106,6 +106,21 @@ std::string emit_error(const std::string& text) {
   return parse_emit(text, r);
 }
 
+std::string sun_error(const std::string& text) {
+  Daylight light;
+  return parse_sun(text, light);
+}
+
+// Daylight is a first-bounce source of the matrix solve: read where B is solved here by the
+// solvers of one machine and drawn by Gouraud or flat shading (the view pass's rays and the
+// medium's zones do not meet the sky and the sun yet).
+const char* const kDaylightReader =
+    "--method matrix solved here on one machine, with Gouraud or flat shading and no medium";
+bool reads_daylight(const Selection& s) {
+  return s.method == "matrix" && !s.solvers.empty() && s.solvers.front() != "petsc" &&
+         s.shading != "raytrace" && !s.medium;
+}
+
 std::string size_error(const std::string& text) {
   return parse_size(text) ? "" : "'" + text + "' is not a size such as 512M or 8G";
 }
@@ -242,6 +257,17 @@ std::vector<OptionSpec> make_specs() {
                "Surfaces (or materials) matching the name or glob emit radiosity R,G,B "
                "(repeatable; later rules win)")
               .values(0));
+  add_row(real("--sky", 0.0, kInf, "",
+               "A uniform sky of radiance R,G,B (W m^-2 sr^-1) on every direction that escapes "
+               "the scene (docs/scenes.md, Daylight)")
+              .values(3, ',')
+              .on({"run", "solve", "render", "compare"})
+              .read_by(kDaylightReader, reads_daylight));
+  add_row(text("--sun", "DX,DY,DZ,R,G,B", sun_error, "",
+               "A sun: light travelling along DX,DY,DZ with irradiance R,G,B (W/m^2) on a "
+               "surface facing it, exact shadows (docs/scenes.md, Daylight)")
+              .on({"run", "solve", "render", "compare"})
+              .read_by(kDaylightReader, reads_daylight));
   add_row(real("--max-edge", 0.0, kInf, "", "Longest patch edge, in scene units", true)
               .by_method("matrix"));
   add_row(

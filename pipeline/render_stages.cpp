@@ -115,7 +115,7 @@ void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOpti
   r.ff_options = F.options;
   r.ff_entries = F.F.nonZeros();
   const Timer solve_timer;
-  const RadiosityProblem problem = make_problem(scene.mesh, F);
+  const RadiosityProblem problem = make_lit_problem(scene, F, run.seed, run.threads, &r.daylight);
   warn_about_lighting(scene.mesh, F.F);
   check_closed_lossless(scene.mesh, F);
   SolveOptions so = solver;
@@ -153,7 +153,13 @@ std::string resolve_vertex_interp(const ShadeArgs& args, const LoadedScene& scen
     throw UsageError(
         "--vertex-interp exact-direct computes direct light without mirrors and "
         "glass, and this scene has specular surfaces: use conservative");
+  // Nor does it see the sky and the sun (the renderer draws the sun's shadows per pixel).
+  if (args.vertex_interp == "exact-direct" && scene.scene.daylight.any())
+    throw UsageError(
+        "--vertex-interp exact-direct computes direct light from emitting surfaces only, and "
+        "--sky or --sun light this scene: use conservative");
   if (args.vertex_interp != "auto") return args.vertex_interp;
+  if (scene.scene.daylight.any()) return "conservative";
   return scene.discontinuity && indirect && !scene.mesh.has_specular() ? "exact-direct"
                                                                        : "conservative";
 }
@@ -192,6 +198,24 @@ Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const Ve
   settings.medium = medium;
   std::unique_ptr<DirectLight> direct;
   if (args.final_gather > 0) direct = std::make_unique<DirectLight>(scene.scene);
+  const Daylight& light = scene.scene.daylight;
+  if (light.any()) settings.daylight = &light;
+  if (light.has_sun()) {
+    // The sun's light is drawn per pixel with its exact shadow: B and the vertex field
+    // without each patch's mean sun part (the same shadow rays as the solve's).
+    DaylightSources sources;
+    sources.sun = sun_patch_part(scene, run.seed, run.threads);
+    const Eigen::MatrixX3d without_sun = B - sources.reflected_sun(mesh);
+    const VertexField field_without_sun = interpolate_to_vertices(
+        mesh, without_sun, parse_vertex_interpolation(resolve_vertex_interp(args, scene, nullptr)));
+    Image img = render(mesh, bvh, camera, without_sun, field_without_sun, settings, stats);
+    if (stats) stats->seconds = timer.seconds();
+    log_info("render: " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+             ", " + std::to_string(args.antialias * args.antialias) + " samples/pixel, " +
+             shading_settings(args, specular_depth) + ", sun shadows per pixel in " +
+             format_duration(timer.seconds()));
+    return img;
+  }
   Image img = render(mesh, bvh, camera, B, field, settings, stats, direct.get());
   if (stats) stats->seconds = timer.seconds();  // including the BVH build when not yet built
   log_info("render: " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + ", " +

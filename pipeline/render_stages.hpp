@@ -11,6 +11,7 @@
 #include "geometry/render/render.hpp"
 #include "geometry/render/vertex_field.hpp"
 #include "io/json.hpp"
+#include "pipeline/daylight_stage.hpp"
 #include "pipeline/ff_stage.hpp"
 #include "pipeline/job.hpp"
 #include "solvers/radiosity.hpp"
@@ -71,6 +72,7 @@ struct RadiosityResult {
                                  ///< file's own; see obtain_form_factors)
   /// I = F (B - E) per patch (N x 3) when solved (problem.hpp), for exact-direct vertices.
   Eigen::MatrixX3d indirect;
+  DaylightSources daylight;  ///< when solved: what the sky and the sun brought (daylight_stage)
   std::int64_t ff_entries = 0;
   double ff_seconds = 0.0;
   double solve_seconds = 0.0;

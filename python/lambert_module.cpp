@@ -43,6 +43,7 @@
 #include "io/obj_loader.hpp"
 #include "io/stl_loader.hpp"
 #include "io/tonemap.hpp"
+#include "pipeline/daylight_stage.hpp"
 #include "pipeline/heat_problem.hpp"
 #include "pipeline/hierarchical_stage.hpp"
 #include "pipeline/job.hpp"
@@ -180,6 +181,29 @@ py::dict ff_result(FormFactors&& ff, const MeshHandle& m) {
 Eigen::Vector3d vec3(const std::vector<double>& v, const char* what) {
   if (v.size() != 3) throw UsageError(std::string(what) + " must have 3 components");
   return {v[0], v[1], v[2]};
+}
+
+// The keywords sky=(R, G, B) and sun=(DX, DY, DZ, R, G, B) as the CLI's --sky and --sun, with
+// their checks and messages.
+Daylight daylight_from(const std::optional<std::vector<double>>& sky,
+                       const std::optional<std::vector<double>>& sun) {
+  Daylight light;
+  if (sky) {
+    if (sky->size() != 3) throw UsageError("sky must have 3 components (R, G, B)");
+    for (double v : *sky) check_option_value(option_spec("--sky", "run"), v, "sky");
+    light.sky = vec3(*sky, "sky");
+  }
+  if (sun) {
+    std::string text;
+    for (size_t k = 0; k < sun->size(); ++k) {
+      char buf[40];
+      std::snprintf(buf, sizeof buf, "%.17g", (*sun)[k]);
+      text += (k ? "," : "") + std::string(buf);
+    }
+    if (const std::string why = parse_sun(text, light); !why.empty())
+      throw UsageError("sun: " + why);
+  }
+  return light;
 }
 
 double face_area(const Scene& s, const Face& f) {  // Newell's formula (planar polygon)
@@ -339,12 +363,13 @@ void apply_keywords(const py::dict& settings, const std::string& group, const ch
 void refuse_unread_keywords(const py::dict& settings, const std::string& group,
                             const Selection& selection, const std::string& choice) {
   const OptionGiven given = [&](const std::string& name) {
-    const OptionSpec& row = option_spec(name);
-    return !row.keyword.empty() && row.group == group && settings.contains(row.keyword.c_str());
+    const OptionSpec* row = find_option_spec(name, selection.command);  // (none: not a keyword)
+    return row && !row->keyword.empty() && row->group == group &&
+           settings.contains(row->keyword.c_str());
   };
   const std::vector<std::string> unread = unread_options(given, selection);
   if (unread.empty()) return;
-  const OptionSpec& row = option_spec(unread.front());
+  const OptionSpec& row = option_spec(unread.front(), selection.command);
   throw UsageError(row.keyword + " does not apply to " + choice + " (read by " + row.reader + ")");
 }
 
@@ -715,14 +740,19 @@ PYBIND11_MODULE(_lambert, m) {
       "solve",
       [](const MeshHandle& h, const IndexArray& indptr, const IndexArray& indices,
          const ValueArray& data, const py::dict& settings, int threads,
-         std::optional<ValueArray> initial, const py::dict& medium_options) {
+         std::optional<ValueArray> initial, const py::dict& medium_options,
+         std::optional<std::vector<double>> sky, std::optional<std::vector<double>> sun) {
         SolveOptions o = solve_options_from_keywords(settings);
         const SparseRowMatrix F = csr_from_arrays(h.mesh.size(), indptr, indices, data, "F");
         o.threads = threads;
         if (initial) o.initial_guess = matrix_n3(*initial, h.mesh.size(), "initial_guess");
         const MediumArgs margs = medium_args(medium_options);
+        const Daylight light = daylight_from(sky, sun);
+        if (light.any() && h.mesh.has_specular())
+          throw UsageError("sky and sun do not follow light through mirrors and glass yet");
         if (margs.active()) {  // the extended solve of pipeline/medium_stage, as `lambert solve`
           if (initial) throw UsageError("initial_guess does not combine with a medium");
+          if (light.any()) throw UsageError("sky and sun do not combine with a medium");
           const std::shared_ptr<const Medium> medium = make_medium(margs);
           check_medium_scene(h.mesh, nullptr);
           RunArgs run;
@@ -744,16 +774,25 @@ PYBIND11_MODULE(_lambert, m) {
           return py::make_tuple(adopt_matrix(r.B), report);
         }
         RadiositySolution sol;
+        DaylightSources sources;
         {
           Released release;
-          const RadiosityProblem problem = make_problem(h.mesh, F);
+          RadiosityProblem problem = make_problem(h.mesh, F);
+          // Daylight as `lambert solve --sky/--sun` (the sun's shadow rays with seed 1).
+          sources = daylight_sources(light, h.mesh, h.get_bvh(), F, Eigen::VectorXd(), 1, threads);
+          if (light.any()) problem.emission += sources.reflected(h.mesh);
           validate_problem(problem);
           sol = solve_radiosity(problem, o);
         }
-        return py::make_tuple(adopt_matrix(sol.B), report_dict(sol));
+        py::dict report = report_dict(sol);
+        if (light.any())
+          report["daylight"] =
+              py::module_::import("json").attr("loads")(json_text(daylight_json(light, sources)));
+        return py::make_tuple(adopt_matrix(sol.B), report);
       },
       py::arg("mesh"), py::arg("indptr"), py::arg("indices"), py::arg("data"), py::arg("settings"),
-      py::arg("threads"), py::arg("initial_guess"), py::arg("medium"));
+      py::arg("threads"), py::arg("initial_guess"), py::arg("medium"), py::arg("sky"),
+      py::arg("sun"));
 
   m.def(
       "heat",
@@ -919,8 +958,10 @@ PYBIND11_MODULE(_lambert, m) {
          std::optional<std::vector<double>> look_at, std::optional<std::vector<double>> up,
          std::optional<double> fov, std::optional<int> width, std::optional<int> height,
          const std::string& shading, int antialias, std::uint64_t seed, int threads,
-         const std::string& exr, const std::string& png, std::optional<double> ev) {
-        const Eigen::MatrixX3d b = matrix_n3(B, h.mesh.size(), "B");
+         const std::string& exr, const std::string& png, std::optional<double> ev,
+         std::optional<std::vector<double>> sky, std::optional<std::vector<double>> sun) {
+        Eigen::MatrixX3d b = matrix_n3(B, h.mesh.size(), "B");
+        const Daylight light = daylight_from(sky, sun);
         Camera cam = h.scene.camera;
         if (!cam.defined) {
           const auto [lo, hi] = h.scene.bounds();
@@ -947,9 +988,19 @@ PYBIND11_MODULE(_lambert, m) {
         rs.seed = seed;
         rs.threads = threads;
         rs.progress = false;
+        if (light.any()) {
+          if (rs.shading == Shading::Raytrace)
+            throw UsageError("sky and sun are drawn with gouraud or flat shading only");
+          rs.daylight = &light;
+        }
         Image img;
         {
           Released release;
+          if (light.has_sun()) {  // drawn per pixel: B without the patches' sun part (seed 1)
+            DaylightSources sources;
+            sources.sun = sun_patch_irradiance(h.mesh, h.get_bvh(), light, 1, threads);
+            b -= sources.reflected_sun(h.mesh);
+          }
           const VertexField field = interpolate_to_vertices(h.mesh, b);
           img = render(h.mesh, h.get_bvh(), cam, b, field, rs);
           if (!exr.empty()) {
@@ -964,5 +1015,6 @@ PYBIND11_MODULE(_lambert, m) {
       },
       py::arg("mesh"), py::arg("B"), py::arg("eye"), py::arg("look_at"), py::arg("up"),
       py::arg("fov"), py::arg("width"), py::arg("height"), py::arg("shading"), py::arg("antialias"),
-      py::arg("seed"), py::arg("threads"), py::arg("exr"), py::arg("png"), py::arg("ev"));
+      py::arg("seed"), py::arg("threads"), py::arg("exr"), py::arg("png"), py::arg("ev"),
+      py::arg("sky"), py::arg("sun"));
 }

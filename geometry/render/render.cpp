@@ -40,11 +40,15 @@ bool on_wire(const PatchMesh& mesh, const Patch& p, const Eigen::Vector3d& eye,
 Sample trace(const PatchMesh& mesh, const Bvh& bvh, const Eigen::Vector3d& eye,
              const Eigen::Vector3d& dir, const Eigen::MatrixX3d& patch_B,
              const VertexField& vertices, Shading shading, double wire_angle,
-             const ViewTracer* tracer, std::uint64_t stream, std::int64_t& rays) {
+             const ViewTracer* tracer, const Daylight* daylight, std::uint64_t stream,
+             std::int64_t& rays) {
   Sample s;
   ++rays;
   const RayHit h = bvh.intersect(eye.cast<float>(), dir.cast<float>());
-  if (h.patch < 0) return s;
+  if (h.patch < 0) {
+    if (daylight) s.value = M_PI * daylight->sky;  // the sky's radiance L, as B = π L
+    return s;
+  }
   s.hit = true;
   s.t = h.t;
   const Patch& p = mesh.patches[h.patch];
@@ -56,11 +60,14 @@ Sample trace(const PatchMesh& mesh, const Bvh& bvh, const Eigen::Vector3d& eye,
     return s;
   }
   if (!front) return s;  // back face: no radiosity leaves it
-  if (shading == Shading::Flat) {
-    s.value = patch_B.row(h.patch).transpose();
-    return s;
+  const Eigen::Vector3d x = eye + h.t * dir;
+  s.value = shading == Shading::Flat ? Eigen::Vector3d(patch_B.row(h.patch).transpose())
+                                     : field_value(mesh, vertices, h.patch, x);
+  if (daylight && daylight->has_sun()) {
+    if (p.normal.dot(daylight->sun_direction) < 0.0) ++rays;  // the shadow ray
+    s.value += p.rho.cwiseProduct(
+        sun_irradiance_at(bvh, *daylight, x, p.normal, kSunRayOffset * mesh.scale));
   }
-  s.value = field_value(mesh, vertices, h.patch, eye + h.t * dir);
   return s;
 }
 
@@ -93,6 +100,8 @@ Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
       !options.medium || (options.shading != Shading::Raytrace &&
                           options.medium->voxel_B.rows() == options.medium->medium->voxels()),
       "render: a medium needs Gouraud or flat shading and one value per voxel");
+  LAMBERT_CHECK(!options.daylight || (options.shading != Shading::Raytrace && !options.medium),
+                "render: daylight needs Gouraud or flat shading and no medium");
   const bool flat = options.shading == Shading::Flat;
   const bool gathers = options.shading == Shading::Raytrace && options.view.final_gather > 0;
   LAMBERT_CHECK(flat || gathers ||
@@ -135,9 +144,9 @@ Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
             const double py = static_cast<double>(y) + (sy + jy) / K;
             const std::uint64_t stream =
                 hash_keys(options.seed ^ 0x76696577ull, pixel, sy * K + sx);  // "view"
-            const Sample s =
-                trace(mesh, bvh, camera.eye, camera.ray_direction(px, py), patch_B, vertices,
-                      options.shading, wire_angle, tracer.get(), stream, row_rays[y]);
+            const Sample s = trace(mesh, bvh, camera.eye, camera.ray_direction(px, py), patch_B,
+                                   vertices, options.shading, wire_angle, tracer.get(),
+                                   options.daylight, stream, row_rays[y]);
             sum += options.medium ? through_medium(*options.medium, camera.eye,
                                                    camera.ray_direction(px, py), s)
                                   : s.value;

@@ -24,6 +24,7 @@
 #include "geometry/render/raytrace.hpp"
 #include "geometry/render/vertex_field.hpp"
 #include "geometry/visibility/bvh.hpp"
+#include "geometry/visibility/daylight.hpp"
 #include "geometry/visibility/direct_light.hpp"
 
 namespace lambert {
@@ -73,6 +74,11 @@ struct RenderSettings {
   bool progress = true;    ///< draw a progress bar (when stderr is a terminal)
   /// Camera rays through a medium (Gouraud and flat shading; must outlive the render).
   const MediumView* medium = nullptr;
+  /// Daylight (Gouraud and flat shading; must outlive the render): samples that miss the
+  /// scene see the sky, and every front hit adds its reflected sun light ρ H_sun(x) with one
+  /// exact shadow ray (daylight.hpp), so `patch_B` and `vertices` must hold B without the
+  /// patches' own sun part (render_scene takes it out).
+  const Daylight* daylight = nullptr;
 };
 
 /// What the render did.

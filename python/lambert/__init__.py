@@ -218,7 +218,8 @@ _MEDIUM_KEYS = ("medium_box", "sigma_a", "sigma_s", "medium_emission", "medium_g
 
 
 def solve(mesh, F, solver="gauss-seidel", tol=1e-8, max_iterations=10000, omega=1.5,
-          preconditioner="diagonal", restart=30, threads=1, initial_guess=None, **medium):
+          preconditioner="diagonal", restart=30, threads=1, initial_guess=None, sky=None,
+          sun=None, **medium):
     """Solves (I - rho F) B = E per channel.
 
     Parameters
@@ -230,6 +231,13 @@ def solve(mesh, F, solver="gauss-seidel", tol=1e-8, max_iterations=10000, omega=
         Threads for the products with F (Gauss-Seidel, SOR and Southwell sweep in order).
     initial_guess : array (N, 3), optional
         A warm start for the iterative solvers (default: E).
+    sky : (R, G, B), optional
+        A uniform sky of this radiance (W m^-2 sr^-1) on every direction that escapes the
+        scene, as the CLI's --sky: each patch gets pi L (1 - sum_j F_ij).
+    sun : (DX, DY, DZ, R, G, B), optional
+        A sun, as the CLI's --sun: light travelling along (DX, DY, DZ) with irradiance R, G, B
+        (W/m^2) on a surface facing it; each patch's lit share from 16 x 16 shadow rays.
+        With either, report["daylight"] holds the power each brings.
     **medium
         A participating medium (the CLI's solve --medium-box ...): medium_box=(x0, y0, z0,
         x1, y1, z1) with sigma_a, sigma_s, medium_emission (R, G, B), voxels or voxel_size,
@@ -256,7 +264,8 @@ def solve(mesh, F, solver="gauss-seidel", tol=1e-8, max_iterations=10000, omega=
     # By name, only what differs from the declared default (what the CLI calls given).
     settings = {k: v for k, v in given.items() if not _is_default("solver", k, v)}
     return Solution(*_lambert.solve(mesh, indptr, indices, data, settings,
-                                    _int(threads, "threads"), initial_guess, medium))
+                                    _int(threads, "threads"), initial_guess, medium,
+                                    _daylight(sky, 3, "sky"), _daylight(sun, 6, "sun")))
 
 
 def heat(mesh, F, surfaces, ambient_temperature=0.0, length_unit="m", solver="gauss-seidel",
@@ -312,17 +321,30 @@ def write_vertex_exr(path, mesh, B, mode="conservative", settings=""):
 
 
 def render(mesh, B, eye=None, look_at=None, up=None, fov=None, width=None, height=None,
-           shading="gouraud", antialias=2, seed=1, threads=0, exr=None, png=None, ev=None):
+           shading="gouraud", antialias=2, seed=1, threads=0, exr=None, png=None, ev=None,
+           sky=None, sun=None):
     """Renders B (N, 3) with the scene's camera (or the given eye/look_at/up/fov/size):
     returns the linear radiance image, float32 (height, width, 3); also writes it as an EXR
-    and/or a tone-mapped PNG (exposure `ev` stops, automatic when None) when paths are given."""
+    and/or a tone-mapped PNG (exposure `ev` stops, automatic when None) when paths are given.
+    With the `sky` and `sun` that B was solved with (`solve`), rays that miss the scene see
+    the sky and the sun is drawn per pixel with exact shadows (docs/scenes.md, Daylight)."""
     _check_mesh(mesh)
     vec = lambda v, name: None if v is None else [float(x) for x in _vec3(v, name)]  # noqa: E731
     return _lambert.render(mesh, B, vec(eye, "eye"), vec(look_at, "look_at"), vec(up, "up"),
                            None if fov is None else float(fov), _opt_int(width, "width"),
                            _opt_int(height, "height"), str(shading), _int(antialias, "antialias"),
                            _int(seed, "seed"), _int(threads, "threads"), str(exr or ""),
-                           str(png or ""), None if ev is None else float(ev))
+                           str(png or ""), None if ev is None else float(ev),
+                           _daylight(sky, 3, "sky"), _daylight(sun, 6, "sun"))
+
+
+def _daylight(value, n, name):
+    if value is None:
+        return None
+    values = [float(x) for x in value]
+    if len(values) != n:
+        raise ValueError(f"{name} must have {n} components")
+    return values
 
 
 # --- the declared options' documentation (pipeline/option_specs.hpp) ---------------------------

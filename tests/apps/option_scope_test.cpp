@@ -120,6 +120,8 @@ std::map<std::string, Trial> trials(const std::string& ff_file, const std::strin
       {"--medium-rays", {{{"1024"}}, medium}},
       {"--transmittance-samples", {{{"2"}}, medium}},
       {"--seed", {{{"7"}}}},
+      {"--sky", {{{"1,2,3"}}}},
+      {"--sun", {{{"0,0,-1,5,5,5"}}}},
       {"--petsc-options", {{{"-ksp_type gmres"}}}},  // needs --distributed (not walked)
       // Leave B bitwise equal by design (see kNoEffect).
       {"--output", {{{scene + ".other.csv"}}}},
@@ -324,20 +326,32 @@ TEST(OptionScopeSlow, NoOptionOfSolveIsAcceptedAndIgnored) {
 namespace lambert {
 namespace {
 
-// A value the row accepts (its default where it has one; the bound or a choice otherwise).
+// A value of a text option without a default that its check accepts.
+const std::map<std::string, std::string> kTextExamples = {{"--sun", "0,0,-1,5,5,5"}};
+
+// A value the row accepts (its default where it has one; the bound or a choice otherwise;
+// `count` of them, joined by the row's delimiter where it has one).
 std::vector<std::string> value_of(const OptionSpec& s) {
+  std::string one;
   switch (s.kind) {
     case OptionKind::Flag:
       return {};
     case OptionKind::Choice:
-      return {s.default_text.empty() ? s.choices.front() : s.default_text};
+      one = s.default_text.empty() ? s.choices.front() : s.default_text;
+      break;
     case OptionKind::Integer:
     case OptionKind::Real:
-      return {s.default_text.empty() ? number_text(s.lo) : s.default_text};
+      one = s.default_text.empty() ? number_text(s.lo) : s.default_text;
+      break;
     case OptionKind::Text:
-      return {s.default_text};
+      one = kTextExamples.count(s.name) ? kTextExamples.at(s.name) : s.default_text;
+      break;
   }
-  return {};
+  if (s.count <= 1) return {one};
+  if (s.delimiter == 0) return std::vector<std::string>(static_cast<size_t>(s.count), one);
+  std::string joined = one;
+  for (int k = 1; k < s.count; ++k) joined += s.delimiter + one;
+  return {joined};
 }
 
 }  // namespace

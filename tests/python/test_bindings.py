@@ -251,7 +251,7 @@ def test_non_monotone_indptr_is_a_usage_error(cornell_mesh):
     indptr[1], indptr[2] = 3, 1  # row 0 would run past row 1's start
     with pytest.raises(lambert.UsageError, match="indptr"):
         ext.solve(cornell_mesh, indptr, indices, F.data.astype(np.float64),
-                  {"max_iterations": 100}, 1, None, {})
+                  {"max_iterations": 100}, 1, None, {}, None, None)
 
 
 def test_medium_solve_equals_the_cli(tmp_path, cornell):
@@ -476,3 +476,42 @@ def test_solver_keywords_the_solver_does_not_read_are_refused(cornell_mesh):
     a = lambert.solve(cornell_mesh, F, solver="direct")
     b = lambert.solve(cornell_mesh, F, solver="direct", tol=1e-8, omega=1.5)
     assert np.array_equal(a.B, b.B)
+
+
+def test_sky_and_sun_as_the_cli(tmp_path):
+    # Two facing unit squares 1 apart (z up) under a sky of radiance 1: each escapes to the
+    # sky with 1 - F, F = 0.19982, so B = rho pi (1 - F) / (1 - rho F) by symmetry. F from the
+    # analytic estimator to 1e-9: far below the 1e-6 asked.
+    bottom = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]
+    top = [(0, 0, 1), (0, 1, 1), (1, 1, 1), (1, 0, 1)]
+    path = write_obj(tmp_path / "plates.obj", {"bottom": [bottom], "top": [top]},
+                     {"bottom": ((0.5,) * 3, (0,) * 3), "top": ((0.5,) * 3, (0,) * 3)})
+    mesh = lambert.load_scene(path).mesh()
+    ff = lambert.form_factors(mesh, estimator="analytic", tol=1e-9)
+    B, report = lambert.solve(mesh, ff, sky=(1, 1, 1))
+    F, rho = parallel_squares_factor(1.0, 1.0), 0.5
+    expected = rho * math.pi * (1 - F) / (1 - rho * F)
+    assert np.allclose(B, expected, rtol=1e-6), (B, expected)
+    assert report["daylight"]["sky_radiance"] == [1.0, 1.0, 1.0]
+    # The sun straight down lights the top plate's back only: nothing reaches the faces.
+    B_sun, _ = lambert.solve(mesh, ff, sun=(0, 0, -1, 100, 100, 100))
+    assert np.all(B_sun == 0.0)
+    # From below it is hidden from the top plate's face by the bottom plate, but at 2 across
+    # for 1 up its rays pass beside it: the top plate is lit whole with H = S / sqrt(5), the
+    # bottom plate (the sun behind it) only by the top, so B_top = rho H / (1 - rho^2 F^2).
+    B_up, _ = lambert.solve(mesh, ff, sun=(0, 0, 1, 100, 100, 100), tol=1e-12)
+    assert np.all(B_up == 0.0)
+    B_side, _ = lambert.solve(mesh, ff, sun=(2, 0, 1, 100, 100, 100), tol=1e-12)
+    t = mesh.surface_ids == mesh.surface_names.index("top")
+    H = 100 / math.sqrt(5)
+    assert np.allclose(B_side[t], rho * H / (1 - rho * rho * F * F), rtol=1e-9)
+    with pytest.raises(lambert.UsageError, match="no length"):
+        lambert.solve(mesh, ff, sun=(0, 0, 0, 1, 1, 1))
+    with pytest.raises(lambert.UsageError, match="sky"):
+        lambert.solve(mesh, ff, sky=(1, -1, 1))
+    with pytest.raises(ValueError, match="3 components"):
+        lambert.solve(mesh, ff, sky=(1, 1))
+    # The picture: rays that miss see the sky's radiance.
+    img = lambert.render(mesh, B, eye=(0.5, -3, 0.5), look_at=(0.5, 0.5, 0.5), up=(0, 0, 1),
+                         width=16, height=16, antialias=1, sky=(1, 2, 3))
+    assert np.allclose(img[0, 0], [1, 2, 3])
