@@ -57,7 +57,7 @@ void render_and_write(const RenderOptions& opts, const LoadedScene& loaded,
   RenderStats stats;
   const Image image = render_scene(loaded, B, shaded.field, camera, opts.shade,
                                    opts.ff.specular_depth, opts.run, &stats, medium);
-  const double ev = choose_exposure(opts.shade, image);
+  const double ev = choose_exposure(opts.shade, image, loaded.scene.daylight.has_sky());
   OutputPaths paths;
   paths.image_exr = opts.output;
   paths.png = png_path(opts);

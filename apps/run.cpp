@@ -185,7 +185,7 @@ int finish_run(const RunOptions& opts, const RunPaths& paths, const MethodOutcom
   RenderStats rs;
   const Image image = render_scene(m.loaded, m.B, shaded.field, camera, opts.shade,
                                    opts.ff.specular_depth, opts.run, &rs, m.medium);
-  const double ev = choose_exposure(opts.shade, image);
+  const double ev = choose_exposure(opts.shade, image, m.loaded.scene.daylight.has_sky());
 
   stages.next("writing " + opts.output_dir + "/" + paths.name + ".*");
   const Timer timer;
@@ -330,6 +330,13 @@ int finish_matrix(const RunOptions& opts, const RunPaths& paths, const LoadedSce
     solver_line += line;
   }
   m.summary.push_back(solver_line);
+  if (loaded.scene.daylight.any()) {
+    std::snprintf(line, sizeof line,
+                  "daylight   sky %.6g W, sun %.6g W onto the patches (G); what they reflect of "
+                  "it is \"emitted\" below",
+                  r.daylight.sky_power[1], r.daylight.sun_power[1]);
+    m.summary.push_back(line);
+  }
   m.summary.push_back(
       "energy     emitted / absorbed / escaped (W), relative imbalance (its parts):");
   for (int c = 0; c < 3; ++c) {

@@ -695,7 +695,7 @@ Scene load_obj_stream(std::istream& in, const std::string& name, const MtlOpener
   if (!report.has_emitter && options.warn_without_emitter)
     diag.warn(name + ": no emitter (no material with Ke > 0): the radiosity is zero; add one with "
               "--emit SURFACE_OR_MATERIAL=R,G,B (lambert info lists the names)");
-  scene.camera = framing_camera(lo, hi);
+  scene.camera = three_quarter_camera(lo, hi, 1);  // OBJ: y up (a .camera sidecar wins)
   if (report_out) *report_out = std::move(report);
   return scene;
 }

@@ -123,7 +123,7 @@ class SceneBuilder {
       throw SceneError(name_ +
                        ": scene extent below 1e-50, where form factors underflow: "
                        "rescale the scene");
-    scene_.camera = framing_camera(lo, hi);
+    scene_.camera = three_quarter_camera(lo, hi, 2);  // CAD: z up
     return std::move(scene_);
   }
 

@@ -12,7 +12,7 @@ double srgb_oetf(double x) {
   return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
 }
 
-double auto_exposure(const Image& image) {
+double auto_exposure(const Image& image, bool surfaces_only) {
   double log_sum = 0.0;
   std::int64_t n = 0;
   const size_t count = image.alpha.size();
@@ -22,6 +22,7 @@ double auto_exposure(const Image& image) {
     // Pixels that see nothing lit (misses, back faces, unlit surfaces) carry no exposure
     // information; a log of 0 would drive the mean to -inf.
     if (!(lum > 0.0) || !std::isfinite(lum)) continue;
+    if (surfaces_only && !(image.alpha[k] > 0.0f)) continue;
     log_sum += std::log(lum);
     ++n;
   }

@@ -30,7 +30,9 @@ constexpr double kKey = 0.36;
 double srgb_oetf(double linear);
 
 /// Automatic exposure (stops) of an image by the key-value rule; 0 for a black image.
-double auto_exposure(const Image& image);
+/// `surfaces_only`: from the pixels that hit a surface (alpha > 0) alone, so that a sky
+/// behind the scene does not set the exposure of the scene in front of it.
+double auto_exposure(const Image& image, bool surfaces_only = false);
 
 /// Linear RGB times 2^ev, clipped and sRGB-encoded to bytes.
 std::array<std::uint8_t, 3> to_srgb8(const Eigen::Vector3d& linear, double ev);

@@ -224,8 +224,8 @@ Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const Ve
   return img;
 }
 
-double choose_exposure(const ShadeArgs& args, const Image& image) {
-  return args.exposure == "auto" ? auto_exposure(image)
+double choose_exposure(const ShadeArgs& args, const Image& image, bool sky) {
+  return args.exposure == "auto" ? auto_exposure(image, sky)
                                  : std::strtod(args.exposure.c_str(), nullptr);
 }
 

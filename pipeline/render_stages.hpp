@@ -112,8 +112,9 @@ Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const Ve
                    const Camera& camera, const ShadeArgs& args, int specular_depth,
                    const RunArgs& run, RenderStats* stats, const MediumView* medium = nullptr);
 
-/// The exposure (EV) to use: --exposure, or automatic from the image.
-double choose_exposure(const ShadeArgs& args, const Image& image);
+/// The exposure (EV) to use: --exposure, or automatic from the image (from the pixels that
+/// hit the scene alone when `sky`: a sky behind it shows but does not set the exposure).
+double choose_exposure(const ShadeArgs& args, const Image& image, bool sky = false);
 
 /// Where to write what (empty = skip).
 struct OutputPaths {

@@ -1008,7 +1008,8 @@ PYBIND11_MODULE(_lambert, m) {
             info.units = "radiance B/pi (W m^-2 sr^-1 in the scene's units)";
             write_image_exr(exr, img, info);
           }
-          if (!png.empty()) write_png_preview(png, img, ev ? *ev : auto_exposure(img));
+          if (!png.empty())
+            write_png_preview(png, img, ev ? *ev : auto_exposure(img, light.has_sky()));
         }
         const int w = img.width, hh = img.height;
         return adopt(std::move(img.rgb), {hh, w, 3});

@@ -47,4 +47,20 @@ Camera framing_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   return c;
 }
 
+Camera three_quarter_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up) {
+  Camera c = framing_camera(lo, hi);
+  const Eigen::Vector3d center = 0.5 * (lo + hi);
+  const double dist = (c.eye - center).norm();
+  const Eigen::Vector3d u = up == 2 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d front = up == 2 ? -Eigen::Vector3d::UnitY() : -Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d side = u.cross(front);  // front rotated 90° about u
+  const double azimuth = 35.0 * M_PI / 180.0, elevation = 30.0 * M_PI / 180.0;
+  const Eigen::Vector3d dir =
+      std::cos(elevation) * (std::cos(azimuth) * front + std::sin(azimuth) * side) +
+      std::sin(elevation) * u;
+  c.eye = center + dist * dir;
+  c.up = u;
+  return c;
+}
+
 }  // namespace lambert

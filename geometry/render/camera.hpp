@@ -34,4 +34,10 @@ Camera cornell_camera();
 /// A camera that frames the bounding box [lo, hi] from the -z side.
 Camera framing_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 
+/// A scene's default view when its file names none: the bounding box [lo, hi] framed from a
+/// three-quarter view, 35° around the `up` axis (1 = y, 2 = z) from the front and 30° above
+/// it, so a flat part is never seen edge-on and a box shows three faces. The front is -z for
+/// a y-up scene (OBJ's convention) and -y for a z-up one (STL's, CAD's).
+Camera three_quarter_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up);
+
 }  // namespace lambert

@@ -217,3 +217,35 @@ TEST(RenderMedium, CameraRaysAreAttenuatedAndCollectTheVoxelsExactly) {
 }
 
 }  // namespace lambert
+
+namespace lambert {
+
+TEST(Camera, TheDefaultViewIsAThreeQuarterViewThatFramesTheWholeBox) {
+  // Issue 35: a flat part framed head-on was seen edge-on. The default view looks down at 30°
+  // from 35° round the front, along the scene's up axis, and every corner of the box lies
+  // inside the image.
+  const Eigen::Vector3d lo(-5, 0, -5), hi(5, 0.2, 5);  // a thin y-up plate
+  for (int up : {1, 2}) {
+    const Camera c = three_quarter_camera(lo, hi, up);
+    EXPECT_EQ(camera_problem(c), "");
+    const Eigen::Vector3d u = up == 2 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();
+    const Eigen::Vector3d forward = (c.look_at - c.eye).normalized();
+    EXPECT_NEAR(-forward.dot(u), 0.5, 1e-12);  // sin 30°
+    EXPECT_EQ(c.up, u);
+    // Each corner's direction from the eye, in the camera's frame, is within the field of
+    // view (the frame's half-height tan(vfov/2) at unit depth; the image is square).
+    const Eigen::Vector3d right = forward.cross(c.up).normalized(), top = right.cross(forward);
+    const double half = std::tan(0.5 * c.vfov_degrees * M_PI / 180.0);
+    for (int k = 0; k < 8; ++k) {
+      const Eigen::Vector3d p(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(),
+                              k & 4 ? hi.z() : lo.z());
+      const Eigen::Vector3d d = p - c.eye;
+      const double depth = d.dot(forward);
+      ASSERT_GT(depth, 0.0);
+      EXPECT_LT(std::abs(d.dot(right)) / depth, half) << k;
+      EXPECT_LT(std::abs(d.dot(top)) / depth, half) << k;
+    }
+  }
+}
+
+}  // namespace lambert
