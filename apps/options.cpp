@@ -61,7 +61,7 @@ CLI::Option* add_declared_function(CLI::App* cmd, const std::string& names,
 void add_scene_options(CLI::App* cmd, SceneArgs& args) {
   cmd->add_option(
       "scene", args.scene,
-      "OBJ or STL scene file, told apart by content (default: the built-in Cornell box)");
+      "OBJ, STL or PLY scene file, told apart by content (default: the built-in Cornell box)");
   add_declared(cmd, "--strict", args.load.strict);
   add_declared_function(cmd, "--default-reflectance", [&args](const std::string& s) {
     parse_rgb(s, true, args.load.default_reflectance);

@@ -22,6 +22,8 @@
 #include "io/line_reader.hpp"
 #include "io/obj_loader.hpp"
 #include "io/obj_parser.hpp"
+#include "io/ply_loader.hpp"
+#include "io/soup_builder.hpp"
 #include "io/strict_number.hpp"
 
 namespace lambert {
@@ -61,98 +63,6 @@ float le_f32(const char* p) {
   float f;
   std::memcpy(&f, &bits, sizeof f);
   return f;
-}
-
-// Builds the scene: vertices shared by exact position, faces with their surface, the checks
-// every facet gets (zero area, stored normal against the winding).
-class SceneBuilder {
- public:
-  SceneBuilder(const std::string& name, LoadReport& report) : name_(name), report_(report) {
-    scene_.source = name;
-  }
-
-  // Adds a facet to `surface` (-1: assigned later) from source line `line` (0: binary).
-  void add_facet(const Corners& c, const Eigen::Vector3d& stored_normal, std::int32_t surface,
-                 int line) {
-    const std::vector<Eigen::Vector3d> poly(c.begin(), c.end());
-    if (is_degenerate_polygon(poly)) {
-      ++report_.degenerate_faces_dropped;
-      return;
-    }
-    // Only the side matters to radiosity (fronts emit and receive): a stored normal in the
-    // back half-space of the winding normal disagrees; a tilted one (rounded, or averaged by
-    // the exporter) does not. A zero normal means "not given".
-    if (stored_normal.dot(newell_normal(poly)) < 0.0) ++flipped_;
-    Face f;
-    f.surface = surface;
-    f.line = line;
-    for (const auto& p : c) f.vertices.push_back(vertex(p));
-    scene_.faces.push_back(std::move(f));
-  }
-
-  std::int32_t surface(const std::string& surface_name) {
-    auto [it, added] =
-        surface_of_.emplace(surface_name, static_cast<std::int32_t>(scene_.surfaces.size()));
-    if (added) scene_.surfaces.push_back({surface_name, 0});
-    return it->second;
-  }
-
-  Scene& scene() { return scene_; }
-
-  // Warnings, the default material, the emit rules, the camera; refuses an empty scene.
-  Scene finish(const LoadOptions& options) {
-    if (report_.degenerate_faces_dropped > 0)
-      warn(name_ + ": " + std::to_string(report_.degenerate_faces_dropped) +
-           " zero-area facet(s) dropped");
-    if (flipped_ > 0)
-      warn(name_ + ": " + std::to_string(flipped_) +
-           " facet(s) store a normal opposite to their vertex order; the vertex order "
-           "(counter-clockwise about the front) is used");
-    if (scene_.faces.empty())
-      throw SceneError(name_ + ": empty scene: no facets with positive area");
-    for (const std::string& w : coincident_face_warnings(scene_, name_, report_.coincident_faces))
-      warn(w);
-    scene_.materials.push_back({"default", options.default_reflectance, Eigen::Vector3d::Zero()});
-    report_.default_material_used = true;
-    apply_emit(options.emit, name_, scene_);
-    for (const auto& s : scene_.surfaces)
-      report_.has_emitter = report_.has_emitter || scene_.materials[s.material].emits();
-    const auto [lo, hi] = scene_.bounds();
-    // The OBJ loader's floor (io/obj_loader.cpp): distances^4 must stay normal doubles.
-    if ((hi - lo).norm() < 1e-50)
-      throw SceneError(name_ +
-                       ": scene extent below 1e-50, where form factors underflow: "
-                       "rescale the scene");
-    scene_.camera = three_quarter_camera(lo, hi, 2);  // CAD: z up
-    return std::move(scene_);
-  }
-
- private:
-  std::int32_t vertex(const Eigen::Vector3d& p) {
-    auto [it, added] = index_.emplace(key(p), static_cast<std::int32_t>(scene_.vertices.size()));
-    if (added) scene_.vertices.push_back(p);
-    return it->second;
-  }
-  static std::string key(const Eigen::Vector3d& p) {
-    Eigen::Vector3d q = p + Eigen::Vector3d::Zero();  // -0 and +0 are one position
-    return std::string(reinterpret_cast<const char*>(q.data()), sizeof(double) * 3);
-  }
-  void warn(const std::string& msg) {
-    log_warn(msg);
-    report_.warnings.push_back(msg);
-  }
-
-  std::string name_;
-  LoadReport& report_;
-  Scene scene_;
-  std::unordered_map<std::string, std::int32_t> index_;
-  std::map<std::string, std::int32_t> surface_of_;
-  int flipped_ = 0;
-};
-
-std::string stem_of(const std::string& name) {
-  const std::string stem = fs::path(name).stem().string();
-  return stem.empty() ? "stl" : stem;
 }
 
 // ASCII: solid NAME / facet normal N / outer loop / vertex x3 / endloop / endfacet / endsolid.
@@ -239,7 +149,7 @@ class AsciiReader {
   }
   std::string surface_name(const std::string& solid, int block) const {
     if (!solid.empty()) return solid;
-    return stem_of(name_) + (block > 1 ? "_" + std::to_string(block) : "");
+    return stem_of(name_, "stl") + (block > 1 ? "_" + std::to_string(block) : "");
   }
 
   LineReader lines_;
@@ -249,10 +159,6 @@ class AsciiReader {
 };
 
 // Union-find root with path halving.
-std::int32_t root(std::vector<std::int32_t>& parent, std::int32_t v) {
-  while (parent[v] != v) v = parent[v] = parent[parent[v]];
-  return v;
-}
 
 // Binary: one surface per connected component (shared corner positions), in facet order.
 void read_binary(const std::string& bytes, const std::string& name, SceneBuilder& out) {
@@ -286,34 +192,7 @@ void read_binary(const std::string& bytes, const std::string& name, SceneBuilder
                     Eigen::Vector3d(x[9], x[10], x[11])};
     out.add_facet(c, Eigen::Vector3d(x[0], x[1], x[2]), -1, 0);
   }
-  Scene& scene = out.scene();
-  std::vector<std::int32_t> parent(scene.vertices.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  for (const Face& f : scene.faces)
-    for (size_t k = 1; k < f.vertices.size(); ++k)
-      parent[root(parent, f.vertices[k])] = root(parent, f.vertices[0]);
-  std::map<std::int32_t, std::int32_t> component;  // root -> number, in first-facet order
-  for (const Face& f : scene.faces)
-    component.emplace(root(parent, f.vertices[0]), component.size());
-  const std::string stem = stem_of(name);
-  std::vector<std::int32_t> surface(component.size());
-  // Surfaces are created in first-facet order so that surface k is component k.
-  std::vector<std::int32_t> order(component.size());
-  for (const auto& [r, k] : component) order[k] = r;
-  for (size_t k = 0; k < order.size(); ++k)
-    surface[k] = out.surface(order.size() == 1 ? stem : stem + "_" + std::to_string(k + 1));
-  for (Face& f : scene.faces) f.surface = surface[component[root(parent, f.vertices[0])]];
-}
-
-std::string read_all(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw IoError(path + ": cannot open: file not found");
-  if (fs::is_directory(path, ec)) throw IoError(path + ": cannot open: is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open: " + std::strerror(errno));
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw IoError(path + ": read error");
-  return bytes;
+  out.assign_components("stl");
 }
 
 }  // namespace
@@ -344,20 +223,14 @@ Scene load_stl_bytes(const std::string& bytes, const std::string& name, LoadRepo
     std::istringstream in(bytes);
     AsciiReader(in, name, out).read();
   }
-  Scene scene = out.finish(options);
+  Scene scene = out.finish(options, 2);  // CAD: z up
   if (report_out) *report_out = std::move(report);
   return scene;
 }
 
 Scene load_stl(const std::string& path, LoadReport* report, const LoadOptions& options) {
-  Scene scene = load_stl_bytes(read_all(path), path, report, options);
-  scene.files = {path};
-  const fs::path camera_path = fs::path(path).replace_extension(".camera");
-  std::error_code ec;
-  if (fs::exists(camera_path, ec)) {
-    scene.camera = read_camera_file(camera_path.string());
-    scene.files.push_back(camera_path.string());
-  }
+  Scene scene = load_stl_bytes(read_file_bytes(path), path, report, options);
+  add_camera_sidecar(scene, path);
   return scene;
 }
 
@@ -369,6 +242,7 @@ Scene load_scene_path(const std::string& path, LoadReport* report, const LoadOpt
     head.resize(static_cast<size_t>(in.gcount()));
     std::error_code ec;
     const auto size = fs::file_size(path, ec);
+    if (looks_like_ply(head)) return load_ply(path, report, options);
     if (!ec && looks_like_stl(head, size)) return load_stl(path, report, options);
   }
   return load_obj(path, report, options);  // also reports a missing or unreadable file

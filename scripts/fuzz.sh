@@ -14,7 +14,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-30}"
 shift || true
 targets=("$@")
-others=(ff_fuzz csv_fuzz camera_fuzz medium_fuzz stl_fuzz heat_fuzz python_args_fuzz)
+others=(ff_fuzz csv_fuzz camera_fuzz medium_fuzz stl_fuzz ply_fuzz heat_fuzz python_args_fuzz)
 
 scripts/setup.sh asan >/dev/null
 mkdir -p build-asan/crashes

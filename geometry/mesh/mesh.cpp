@@ -423,14 +423,21 @@ MeshPlan plan_surfaces(const Scene& scene, const std::vector<SurfaceElements>& s
           worst_elements = elements;
         }
       }
-      plan.note = "meshing: the target of " + thousands(options.target_patches) +
-                  " patches grew to " + thousands(made) + ": " +
-                  (detailed == 1 ? std::string("a detailed surface keeps")
-                                 : thousands(static_cast<std::int64_t>(detailed)) +
-                                       " detailed surfaces keep") +
-                  " one patch per face (" + thousands(detail_faces) + " faces; the largest, '" +
-                  scene.surfaces[worst].name + "', has " + thousands(worst_elements) +
-                  "); the others get their area's share";
+      if (detailed == 0)  // the mesh's steps: no edge length gives closer to the target
+        plan.note = "meshing: " + thousands(made) + " patches for the target of " +
+                    thousands(options.target_patches) +
+                    ": the count near it that the uniform subdivision of these faces gives (" +
+                    thousands(static_cast<std::int64_t>(scene.faces.size())) +
+                    " faces; --max-edge or --patches to choose)";
+      else
+        plan.note = "meshing: the target of " + thousands(options.target_patches) +
+                    " patches grew to " + thousands(made) + ": " +
+                    (detailed == 1 ? std::string("a detailed surface keeps")
+                                   : thousands(static_cast<std::int64_t>(detailed)) +
+                                         " detailed surfaces keep") +
+                    " one patch per face (" + thousands(detail_faces) + " faces; the largest, '" +
+                    scene.surfaces[worst].name + "', has " + thousands(worst_elements) +
+                    "); the others get their area's share";
     }
   }
   plan.max_edge = max_edge;

@@ -45,7 +45,7 @@ set_verbosity = _lambert.set_verbosity
 
 
 def load_scene(path=None, strict=False, emit=None):
-    """Loads an OBJ or STL scene, told apart by content (None: the built-in Cornell box).
+    """Loads an OBJ, STL or PLY scene, told apart by content (None: the built-in Cornell box).
     `emit` maps a surface or material
     glob to an emission (R, G, B), as the CLI's --emit. Raises InputError for a bad file."""
     if path is None:
