@@ -296,13 +296,20 @@ constexpr std::uint32_t kWithErrors = 1u, kFloatValues = 2u, kContinued = 4u;
 constexpr double kFloatRounding = 0x1p-24;  // relative rounding of a double stored as f32
 
 // The byte count a binary F file with this header has: header, settings, row starts,
-// columns, values (and standard errors), checksum. Fits in 64 bits for n < 2^31, nnz <= n^2.
+// columns, values (and standard errors), checksum; INT64_MAX for a size beyond 4e18 bytes.
+// With n < 2^31 and nnz <= n^2 (< 2^62) a corrupt header's 20 nnz overflows 64 bits (ff_fuzz
+// found 12 nnz doing so): the size is first estimated in double (relative error ~1e-15), and
+// summed in 64 bits only when it is far below their limit (9.2e18).
 std::int64_t binary_size(std::uint32_t version, std::int64_t n, std::int64_t nnz,
                          std::uint32_t len, std::uint32_t flags) {
   const std::int64_t row_start_bytes = version == 1 ? 4 : 8;
   const std::int64_t value_bytes = flags & kFloatValues ? 4 : 8;
-  return kBinaryHeaderBytes + len + row_start_bytes * (n + 1) + (4 + value_bytes) * nnz +
-         (flags & kWithErrors ? value_bytes * nnz : 0) + (flags & kContinued ? 8 * n : 0) + 8;
+  const std::int64_t per_entry = 4 + value_bytes + (flags & kWithErrors ? value_bytes : 0);
+  const std::int64_t per_row = row_start_bytes + (flags & kContinued ? 8 : 0);
+  const double estimate = static_cast<double>(per_row) * static_cast<double>(n) +
+                          static_cast<double>(per_entry) * static_cast<double>(nnz);
+  if (estimate > 4e18) return INT64_MAX;
+  return kBinaryHeaderBytes + len + row_start_bytes + per_row * n + per_entry * nnz + 8;
 }
 
 FormFactors read_binary(std::istream& in, const std::string& path, std::uint64_t expected_hash,

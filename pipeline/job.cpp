@@ -258,6 +258,14 @@ Scene load_checked_scene(const SceneArgs& args, const JobPlan& plan) {
                      "--list-surfaces` lists the names) or light the scene with --sky R,G,B "
                      "or --sun DX,DY,DZ,R,G,B");
   }
+  // Refused before any work (daylight_sources refuses it again for the library's callers).
+  if (scene.daylight.any())
+    for (const Surface& s : scene.surfaces)
+      if (scene.materials[s.material].specular.any())
+        throw UsageError(
+            "--sky and --sun do not follow light through mirrors and glass yet, "
+            "and surface '" +
+            s.name + "' of " + scene.source + " is specular");
   std::vector<NamedFile> inputs = plan.inputs;
   for (size_t k = 0; k < scene.files.size(); ++k) {
     const std::string& f = scene.files[k];

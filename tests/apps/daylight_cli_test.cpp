@@ -162,6 +162,16 @@ TEST(Daylight, ASceneLitOnlyByDaylightRunsAndBadDaylightIsRefused) {
   refused({"run", obj, "--sky", "1,1,1", "--vertex-interp", "exact-direct", "-o", dir.file("o/")},
           "exact-direct");
   EXPECT_FALSE(std::filesystem::exists(dir.file("B.csv")));
+  // Mirrors and glass: refused when the scene is loaded, before its form factors.
+  {
+    const auto [code, err] = run_capturing(
+        {"solve",
+         std::string(LAMBERT_TEST_DATA_DIR) + "/cornell_box_specular/cornell_box_specular.obj",
+         "--sky", "1,1,1", "-o", dir.file("B.csv")});
+    EXPECT_EQ(code, kExitUsage) << err;
+    EXPECT_NE(err.find("mirrors and glass"), std::string::npos) << err;
+    EXPECT_EQ(err.find("form factors"), std::string::npos) << err;  // no F was computed
+  }
   const auto [code, err] = run_capturing(
       {"solve", obj, "--sun", "0,-1,0,1,1,1", "--max-edge", "1", "-o", dir.file("B.csv")});
   EXPECT_EQ(code, kExitOk) << err;

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <vector>
 
 #include "common/temp_dir.hpp"
@@ -517,6 +518,31 @@ TEST(FormFactorFile, MediumZonesFollowThePatchesAndMaySeeThemselves) {
   ASSERT_TRUE(parse_ff_settings(format_ff_settings(o), back));
   EXPECT_EQ(back.contents.medium_zones, 1);
   EXPECT_EQ(back.contents.medium_extinction, 77u);
+}
+
+}  // namespace lambert
+
+namespace lambert {
+
+TEST(FormFactorFile, AHeaderWhoseSizeOverflows64BitsIsRefusedAsTruncated) {
+  // ff_fuzz's find: n = 905,969,666 (< 2^31) and nnz = 7.9e17 (<= n^2) pass the header's
+  // bounds, but the implied size, 12 nnz bytes, overflowed int64 (UBSan: signed overflow).
+  std::string bytes("LMBRTFF\0", 8);
+  const auto put = [&](auto v) { bytes.append(reinterpret_cast<const char*>(&v), sizeof v); };
+  put(std::uint32_t{2});                  // version
+  put(std::uint32_t{0});                  // flags
+  put(std::int64_t{905969666});           // n
+  put(std::int64_t{792633541402651904});  // nnz
+  put(std::uint64_t{0});                  // mesh hash
+  put(std::uint32_t{0});                  // settings length
+  bytes.append(100, '\0');
+  std::istringstream in(bytes);
+  try {
+    read_form_factors(in, "huge.bin", 0, -1);
+    ADD_FAILURE() << "accepted";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("huge.bin: truncated"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace lambert
