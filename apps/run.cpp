@@ -330,12 +330,18 @@ int finish_matrix(const RunOptions& opts, const RunPaths& paths, const LoadedSce
     solver_line += line;
   }
   m.summary.push_back(solver_line);
-  if (loaded.scene.daylight.any()) {
-    std::snprintf(line, sizeof line,
-                  "daylight   sky %.6g W, sun %.6g W onto the patches (G); what they reflect of "
-                  "it is \"emitted\" below",
-                  r.daylight.sky_power[1], r.daylight.sun_power[1]);
-    m.summary.push_back(line);
+  if (const Daylight& light = loaded.scene.daylight; light.any()) {
+    std::string parts;
+    if (light.has_sky()) {
+      std::snprintf(line, sizeof line, "sky %.6g W", r.daylight.sky_power[1]);
+      parts = line;
+    }
+    if (light.has_sun()) {
+      std::snprintf(line, sizeof line, "sun %.6g W", r.daylight.sun_power[1]);
+      parts += (parts.empty() ? "" : ", ") + std::string(line);
+    }
+    m.summary.push_back("daylight   " + parts +
+                        " onto the patches (G); what they reflect of it is \"emitted\" below");
   }
   m.summary.push_back(
       "energy     emitted / absorbed / escaped (W), relative imbalance (its parts):");

@@ -116,6 +116,7 @@ class Body {
   }
 
   std::uint64_t remaining() const { return bytes_.size() - pos_; }
+  void set_line(int line) { line_ = line; }  // the ASCII body's first line
 
  private:
   double ascii(const Type& t, const std::string& what) {
@@ -153,9 +154,6 @@ class Body {
   Format format_;
   std::string name_;
   int line_ = 0;
-
- public:
-  void set_line(int line) { line_ = line; }
 };
 
 }  // namespace
@@ -240,8 +238,7 @@ Scene load_ply_bytes(const std::string& bytes, const std::string& name, LoadRepo
   std::vector<Eigen::Vector3d> vertices;
   std::vector<Eigen::Vector3d> colours;  // with --vertex-colors-as-reflectance
   std::vector<char> coloured;
-  bool faces_seen = false;
-  std::uint64_t face_number = 0;
+  std::uint64_t faces = 0;
   for (const Element& e : elements) {
     // Every instance takes at least one byte (or an ASCII token and a blank): a count above
     // what is left is refused before anything is allocated for it.
@@ -318,8 +315,7 @@ Scene load_ply_bytes(const std::string& bytes, const std::string& name, LoadRepo
         }
       }
       if (is_face) {
-        faces_seen = true;
-        ++face_number;
+        ++faces;
         std::vector<Eigen::Vector3d> poly;
         std::int64_t previous = -1;
         Eigen::Vector3d rho = Eigen::Vector3d::Zero();
@@ -347,7 +343,7 @@ Scene load_ply_bytes(const std::string& bytes, const std::string& name, LoadRepo
     }
   }
   body.expect_end();
-  if (!faces_seen || face_number == 0)
+  if (faces == 0)
     throw SceneError(name + ": no faces: a point cloud cannot be meshed into patches");
   if (!out.scene().faces.empty()) out.assign_components("ply");
   Scene scene = out.finish(options, 1);  // scanned and modelled meshes: y up

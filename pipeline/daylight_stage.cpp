@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/sampling.hpp"
 #include "geometry/visibility/daylight.hpp"
 #include "pipeline/problem.hpp"
 
@@ -42,19 +43,33 @@ Eigen::MatrixX3d DaylightSources::reflected_sun(const PatchMesh& mesh) const {
 Eigen::MatrixX3d sun_patch_part(const LoadedScene& scene, std::uint64_t seed, int threads) {
   const Daylight& light = scene.scene.daylight;
   if (!light.has_sun()) return Eigen::MatrixX3d::Zero(scene.mesh.size(), 3);
-  return sun_patch_irradiance(scene.mesh, scene_bvh(scene, threads), light, seed, threads);
+  const std::uint64_t key = hash_keys(mesh_hash(scene.mesh), seed);  // O(N), no rays
+  if (!scene.sun_part || scene.sun_part_key != key) {
+    scene.sun_part = std::make_shared<const Eigen::MatrixX3d>(
+        sun_patch_irradiance(scene.mesh, scene_bvh(scene, threads), light, seed, threads));
+    scene.sun_part_key = key;
+  }
+  return *scene.sun_part;
 }
 
 DaylightSources daylight_sources(const LoadedScene& scene, const FormFactors& F, std::uint64_t seed,
                                  int threads) {
   if (!scene.scene.daylight.any()) return {};
-  return daylight_sources(scene.scene.daylight, scene.mesh, scene_bvh(scene, threads), F.F,
-                          F.specular_continued, seed, threads);
+  return daylight_sources(scene.scene.daylight, scene.mesh, F.F, F.specular_continued,
+                          sun_patch_part(scene, seed, threads));
 }
 
 DaylightSources daylight_sources(const Daylight& light, const PatchMesh& mesh, const Bvh& bvh,
                                  const SparseRowMatrix& F, const Eigen::VectorXd& continued,
                                  std::uint64_t seed, int threads) {
+  if (!light.any()) return {};
+  return daylight_sources(light, mesh, F, continued,
+                          sun_patch_irradiance(mesh, bvh, light, seed, threads));
+}
+
+DaylightSources daylight_sources(const Daylight& light, const PatchMesh& mesh,
+                                 const SparseRowMatrix& F, const Eigen::VectorXd& continued,
+                                 Eigen::MatrixX3d sun) {
   DaylightSources d;
   if (!light.any()) return d;
   if (mesh.has_specular())
@@ -69,7 +84,7 @@ DaylightSources daylight_sources(const Daylight& light, const PatchMesh& mesh, c
     if (!(d.sky_power.maxCoeff() > 0.0))
       log_warn("--sky: no patch sees the sky (the scene is closed): it adds no light");
   }
-  d.sun = sun_patch_irradiance(mesh, bvh, light, seed, threads);
+  d.sun = std::move(sun);
   if (light.has_sun()) {
     d.sun_power = power(mesh, d.sun);
     if (!(d.sun_power.maxCoeff() > 0.0))

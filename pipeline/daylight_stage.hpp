@@ -33,7 +33,13 @@ DaylightSources daylight_sources(const Daylight& light, const PatchMesh& mesh, c
                                  const SparseRowMatrix& F, const Eigen::VectorXd& continued,
                                  std::uint64_t seed, int threads);
 
-/// The same for a loaded scene (its daylight and BVH) over the F its problem is solved with.
+/// The same with the patches' mean sun irradiance `sun` (N x 3) already computed.
+DaylightSources daylight_sources(const Daylight& light, const PatchMesh& mesh,
+                                 const SparseRowMatrix& F, const Eigen::VectorXd& continued,
+                                 Eigen::MatrixX3d sun);
+
+/// The same for a loaded scene (its daylight, and sun_patch_part's cached sun part) over the
+/// F its problem is solved with.
 /// Refuses (UsageError) a scene with mirrors or glass: light from outside does not follow specular
 /// paths yet. Warns when the sky or the sun lights no patch. The sun's shadow rays come from
 /// (`seed`, patch): bitwise the same for any thread count.
@@ -41,7 +47,8 @@ DaylightSources daylight_sources(const LoadedScene& scene, const FormFactors& F,
                                  int threads);
 
 /// The patches' mean sun irradiance (N x 3), the same as daylight_sources' `sun` (zeros
-/// without a sun): what render_scene takes out of B to draw the sun per pixel.
+/// without a sun): what render_scene takes out of B to draw the sun per pixel. Computed once
+/// per mesh and seed (cached in the LoadedScene: the solve's shadow rays serve the render).
 Eigen::MatrixX3d sun_patch_part(const LoadedScene& scene, std::uint64_t seed, int threads);
 
 /// make_problem with the daylight's sources added to E (`sources` filled; empty without

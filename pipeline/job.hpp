@@ -80,6 +80,11 @@ struct LoadedScene {
   bool discontinuity = false;  ///< meshed with --discontinuity (edges on the shadow lines)
   /// The mesh's BVH, built on first use by scene_bvh and shared by every stage of a run.
   mutable std::shared_ptr<const Bvh> bvh;
+  /// The patches' mean sun irradiance, computed on first use by sun_patch_part
+  /// (daylight_stage.hpp) for the solve and reused by the render; `sun_part_key` names the
+  /// mesh and seed it belongs to (recomputed when either changes, as adaptive meshing does).
+  mutable std::shared_ptr<const Eigen::MatrixX3d> sun_part;
+  mutable std::uint64_t sun_part_key = 0;
 };
 
 /// The BVH of the scene's mesh (built once, with `threads` Embree threads; 0 = all cores).
