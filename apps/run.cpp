@@ -21,6 +21,7 @@
 #include "pipeline/hierarchical_stage.hpp"
 #include "pipeline/problem.hpp"
 #include "pipeline/solve_stage.hpp"
+#include "pipeline/viewer_stage.hpp"
 
 namespace lambert {
 namespace {
@@ -41,6 +42,7 @@ class Stages {
 struct RunPaths {
   std::string name, dir;
   OutputPaths files;
+  std::string glb, page;  ///< NAME.glb and the viewer page index.html
   std::string report;
 };
 
@@ -65,6 +67,9 @@ struct MethodOutcome {
   std::vector<std::string> summary;  ///< stdout lines between rays and vertices
   SolveStatus status = SolveStatus::Converged;
   std::string not_converged;  ///< the warning when status is not Converged
+  const std::vector<EmitterBasis>* bases = nullptr;  ///< the solution per light source
+  double bases_seconds = 0.0;
+  std::string no_relighting;  ///< why there are no bases (when none)
 };
 
 std::vector<double> as_vector(const Eigen::Vector3d& v) { return {v[0], v[1], v[2]}; }
@@ -86,6 +91,7 @@ struct Tail {
   double write_seconds;
   const std::vector<std::string>& files;
   std::string settings;
+  Json viewer;  ///< the report's "viewer" section
 };
 
 double method_seconds(const MethodOutcome& m) {
@@ -95,7 +101,8 @@ double method_seconds(const MethodOutcome& m) {
 }
 
 double total_seconds(const MethodOutcome& m, const Tail& t) {
-  return method_seconds(m) + t.shaded.seconds + t.render.seconds + t.write_seconds;
+  return method_seconds(m) + m.bases_seconds + t.shaded.seconds + t.render.seconds +
+         t.write_seconds;
 }
 
 Json report_json(const RunOptions& opts, const MethodOutcome& m, const Tail& t) {
@@ -137,9 +144,11 @@ Json report_json(const RunOptions& opts, const MethodOutcome& m, const Tail& t) 
   for (const auto& [key, s] : m.seconds) seconds[key] = s;
   seconds["vertices"] = t.shaded.seconds;
   seconds["render"] = t.render.seconds;
+  seconds["bases"] = m.bases_seconds;
   seconds["write"] = t.write_seconds;
   seconds["total"] = total_seconds(m, t);
   j["rays_total"] = m.rays + t.render.rays;
+  j["viewer"] = t.viewer;
   j["files"] = t.files;
   return j;
 }
@@ -167,12 +176,56 @@ void print_summary(const RunOptions& opts, const MethodOutcome& m, const Tail& t
   std::string times;
   for (size_t k = 0; k < m.seconds.size(); ++k)
     times += m.time_labels[k] + " " + format_duration(m.seconds[k].second) + ", ";
+  if (m.bases_seconds > 0.0) times += "light sources " + format_duration(m.bases_seconds) + ", ";
   std::printf("time       %svertices %s, render %s, write %s; total %s\n", times.c_str(),
               format_duration(t.shaded.seconds).c_str(), format_duration(t.render.seconds).c_str(),
               format_duration(t.write_seconds).c_str(),
               format_duration(total_seconds(m, t)).c_str());
+  const Json& v = t.viewer;
+  if (v.contains("page")) {
+    const std::size_t sources = v["light_sources"].size();
+    std::printf("viewer     %s: %zu light source%s%s\n", v["page"].get<std::string>().c_str(),
+                sources, sources == 1 ? "" : "s",
+                v["relighting"].get<bool>() ? ", relit live" : ", no relighting (see report.json)");
+  }
   std::printf("files\n");
   for (const auto& f : t.files) std::printf("           %s\n", f.c_str());
+}
+
+// The .glb and the viewer page (added to `files`); returns the report's "viewer" section.
+// Warns when the bases do not sum to the solution within kLinearityTolerance.
+Json write_run_viewer(const RunPaths& paths, const MethodOutcome& m, const ShadedField& shaded,
+                      const Camera& camera, double ev, const std::string& settings,
+                      std::vector<std::string>& files) {
+  static const std::vector<EmitterBasis> kNone;
+  const std::vector<EmitterBasis>& bases = m.bases ? *m.bases : kNone;
+  double linearity = 0.0;
+  const GlbContent glb = viewer_glb({m.loaded.mesh, m.loaded.scene.daylight, m.loaded.scene.source,
+                                     m.B, shaded, bases, m.no_relighting, camera, ev, settings},
+                                    &linearity);
+  for (const std::string& f : write_viewer(glb, paths.glb, paths.page, paths.name))
+    files.push_back(f);
+  Json sources = Json::array();
+  for (const EmitterBasis& b : bases) sources.push_back(b.name);
+  Json j = {{"glb", paths.glb},
+            {"page", paths.page},
+            {"relighting", !bases.empty()},
+            {"light_sources", sources}};
+  if (bases.empty()) {
+    j["no_relighting"] = m.no_relighting;
+  } else {
+    j["linearity_error"] = linearity;
+    if (linearity > kLinearityTolerance) {
+      char line[240];
+      std::snprintf(line, sizeof line,
+                    "the %zu light sources' solutions sum to the solution within %.2g (above "
+                    "%.0e): the viewer at full intensities differs from the image by that much; "
+                    "a smaller --tol closes it",
+                    bases.size(), linearity, kLinearityTolerance);
+      log_warn(line);
+    }
+  }
+  return j;
 }
 
 // The stages every method shares: per-vertex radiosity, render, write, report, summary.
@@ -192,8 +245,9 @@ int finish_run(const RunOptions& opts, const RunPaths& paths, const MethodOutcom
   const std::string settings = m.settings + shade_settings(opts, shaded.interpolation, camera);
   std::vector<std::string> files =
       write_outputs(paths.files, m.loaded.mesh, shaded, image, ev, settings);
+  const Json viewer = write_run_viewer(paths, m, shaded, camera, ev, settings, files);
   files.push_back(paths.report);
-  const Tail tail{shaded, rs, camera, ev, timer.seconds(), files, settings};
+  const Tail tail{shaded, rs, camera, ev, timer.seconds(), files, settings, viewer};
   write_json_file(paths.report, report_json(opts, m, tail));
   print_summary(opts, m, tail);
   if (m.status != SolveStatus::Converged) {
@@ -224,12 +278,12 @@ RunPaths prepare_outputs(const RunOptions& opts, JobPlan& plan) {
   p.files.png = (dir / (p.name + ".png")).string();
   p.files.vertex_exr = (dir / (p.name + "_vertices.exr")).string();
   p.files.ply = (dir / (p.name + ".ply")).string();
+  p.glb = (dir / (p.name + ".glb")).string();
+  p.page = (dir / "index.html").string();
   p.report = (dir / "report.json").string();
   plan = job_plan(opts.run);
-  plan.outputs = {{"-o", p.files.image_exr},
-                  {"-o", p.files.png},
-                  {"-o", p.files.vertex_exr},
-                  {"-o", p.files.ply},
+  plan.outputs = {{"-o", p.files.image_exr}, {"-o", p.files.png}, {"-o", p.files.vertex_exr},
+                  {"-o", p.files.ply},       {"-o", p.glb},       {"-o", p.page},
                   {"-o", p.report}};
   return p;
 }
@@ -274,6 +328,11 @@ int finish_matrix(const RunOptions& opts, const RunPaths& paths, const LoadedSce
                   const MatrixExtras& x) {
   MethodOutcome m{"matrix", loaded, r.B};
   if (!x.medium) m.indirect = &r.indirect;
+  m.bases = &r.bases;
+  m.bases_seconds = r.bases_seconds;
+  m.no_relighting = x.medium ? "a participating medium's solution is not split by light source yet"
+                    : !x.distributed.is_null() ? "--distributed solves once, over the ranks"
+                                               : "";
   std::ostringstream settings;
   settings << "patches=" << loaded.mesh.size() << " max_edge=" << loaded.max_edge << ' '
            << ff_settings_text(r.ff_options, opts.ff.ff_file) << " solver=" << x.solver
@@ -441,6 +500,7 @@ int run_matrix(const RunOptions& opts) {
     r.daylight = daylight_sources(loaded, F, opts.run.seed, opts.run.threads);
     r.solved = true;
     warn_about_lighting(loaded.mesh, F.F);
+    solve_bases(loaded, F, so, opts.run, r);
   } else {
     const FormFactors F = obtain_form_factors(loaded, opts.ff, opts.run, false, medium.get());
     r.ff_seconds = timer.seconds();
@@ -451,7 +511,7 @@ int run_matrix(const RunOptions& opts) {
       r.ff_seconds += medium_result->seconds;  // the zones' exchange factors are form factors
     } else {
       stages.next("solving (I - rho F) B = E with " + opts.solver.solver);
-      solve_scene(loaded, F, opts.solver, opts.run, r);
+      solve_scene(loaded, F, opts.solver, opts.run, r, true);
     }
   }
 
@@ -483,6 +543,9 @@ int run_hierarchical(const RunOptions& opts) {
   const HierarchicalStats& st = h.stats;
 
   MethodOutcome m{"hierarchical", h.loaded, h.B};
+  m.no_relighting =
+      "hierarchical radiosity refines its links for the whole E: its solution is not split by "
+      "light source";
   m.settings = hierarchical_settings_text(h);
   m.sections["hierarchical"] = hierarchical_json(h);
   for (const auto& e : st.energy) m.energy.push_back(hierarchical_energy_json(e));

@@ -109,8 +109,22 @@ void check_vertex_interp(const ShadeArgs& args, bool has_form_factors, const std
                      why + " gives B without them)");
 }
 
+namespace {
+
+// The bases of r over `problem` (E with the daylight's parts), as solve_bases.
+void add_bases(const LoadedScene& scene, const RadiosityProblem& problem, const SolveOptions& so,
+               RadiosityResult& r) {
+  r.bases = emitter_sources(scene.mesh, r.daylight);
+  r.bases_seconds = solve_emitter_bases(problem, r.B, so, r.bases);
+  if (r.bases.size() > 1)
+    log_info("relighting: " + std::to_string(r.bases.size()) +
+             " light sources solved one by one in " + format_duration(r.bases_seconds));
+}
+
+}  // namespace
+
 void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOptions& solver,
-                 const RunArgs& run, RadiosityResult& r) {
+                 const RunArgs& run, RadiosityResult& r, bool bases) {
   r.ff_stats = F.stats;
   r.ff_options = F.options;
   r.ff_entries = F.F.nonZeros();
@@ -133,6 +147,15 @@ void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOpti
   if (r.solution.status != SolveStatus::Converged)
     log_warn("the solver did not converge (" + std::string(to_string(r.solution.status)) +
              "); results are written anyway");
+  if (bases) add_bases(scene, problem, so, r);
+}
+
+void solve_bases(const LoadedScene& scene, const FormFactors& F, const SolveOptions& solver,
+                 const RunArgs& run, RadiosityResult& r) {
+  SolveOptions so = solver;
+  so.threads = run.threads;
+  set_memory_limit(so, run.max_memory);
+  add_bases(scene, make_lit_problem(scene, F, run.seed, run.threads, nullptr), so, r);
 }
 
 RadiosityResult compute_radiosity(const LoadedScene& scene, const FormFactorArgs& ff,

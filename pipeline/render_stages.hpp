@@ -14,6 +14,7 @@
 #include "pipeline/daylight_stage.hpp"
 #include "pipeline/ff_stage.hpp"
 #include "pipeline/job.hpp"
+#include "pipeline/relight.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace lambert {
@@ -73,14 +74,23 @@ struct RadiosityResult {
   /// I = F (B - E) per patch (N x 3) when solved (problem.hpp), for exact-direct vertices.
   Eigen::MatrixX3d indirect;
   DaylightSources daylight;  ///< when solved: what the sky and the sun brought (daylight_stage)
+  /// When asked for: the solution per light source (relight.hpp), and their solves' time.
+  std::vector<EmitterBasis> bases;
+  double bases_seconds = 0.0;
   std::int64_t ff_entries = 0;
   double ff_seconds = 0.0;
   double solve_seconds = 0.0;
 };
 
 /// Records F's statistics in `r` and solves for B over F (fills B, solution, solve_seconds);
-/// logs one line on stderr, and a warning when the solver did not converge.
+/// logs one line on stderr, and a warning when the solver did not converge. With `bases`, also
+/// solves the per-emitter bases (r.bases, r.bases_seconds; relight.hpp).
 void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOptions& solver,
+                 const RunArgs& run, RadiosityResult& r, bool bases = false);
+
+/// The per-emitter bases of a solved `r` over F (r.bases, r.bases_seconds; relight.hpp), with
+/// the solver options B was solved with.
+void solve_bases(const LoadedScene& scene, const FormFactors& F, const SolveOptions& solver,
                  const RunArgs& run, RadiosityResult& r);
 
 /// Computes F (or loads --ff) and solves for B; logs one line per stage on stderr.

@@ -50,6 +50,8 @@
 #include "pipeline/medium_stage.hpp"
 #include "pipeline/option_specs.hpp"
 #include "pipeline/problem.hpp"
+#include "pipeline/relight.hpp"
+#include "pipeline/viewer_stage.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace py = pybind11;
@@ -204,6 +206,13 @@ Daylight daylight_from(const std::optional<std::vector<double>>& sky,
       throw UsageError("sun: " + why);
   }
   return light;
+}
+
+// The scene's camera, or one framing it (the CLI's default view).
+Camera default_camera(const Scene& scene) {
+  if (scene.camera.defined) return scene.camera;
+  const auto [lo, hi] = scene.bounds();
+  return framing_camera(lo, hi);
 }
 
 double face_area(const Scene& s, const Face& f) {  // Newell's formula (planar polygon)
@@ -953,6 +962,71 @@ PYBIND11_MODULE(_lambert, m) {
       py::arg("path"), py::arg("mesh"), py::arg("field"), py::arg("settings"));
 
   m.def(
+      "write_viewer",
+      [](const MeshHandle& h, const ValueArray& B, std::optional<IndexArray> indptr,
+         std::optional<IndexArray> indices, std::optional<ValueArray> data,
+         const py::dict& settings, int threads, std::optional<std::vector<double>> sky,
+         std::optional<std::vector<double>> sun, std::optional<double> ev,
+         const std::string& glb_path, const std::string& page_path, const std::string& title) {
+        const Eigen::MatrixX3d b = matrix_n3(B, h.mesh.size(), "B");
+        const Daylight light = daylight_from(sky, sun);
+        SolveOptions o = solve_options_from_keywords(settings);
+        o.threads = threads;
+        const Camera cam = default_camera(h.scene);
+        std::vector<EmitterBasis> bases;
+        double linearity = 0.0, exposure = 0.0;
+        {
+          Released release;
+          ShadedField shaded;
+          shaded.interpolation = "conservative";
+          shaded.field =
+              interpolate_to_vertices(h.mesh, b, VertexInterpolation::Conservative, &shaded.power);
+          if (indptr) {
+            const SparseRowMatrix F = csr_from_arrays(h.mesh.size(), *indptr, *indices, *data, "F");
+            RadiosityProblem problem = make_problem(h.mesh, F);
+            const DaylightSources sources =
+                daylight_sources(light, h.mesh, h.get_bvh(), F, Eigen::VectorXd(), 1, threads);
+            if (light.any()) problem.emission += sources.reflected(h.mesh);
+            validate_problem(problem);
+            bases = emitter_sources(h.mesh, sources);
+            solve_emitter_bases(problem, b, o, bases);
+          }
+          if (ev) {
+            exposure = *ev;
+          } else {  // automatic, as the CLI's: from a small render of the scene's surfaces
+            Camera small = cam;
+            const double scale = 128.0 / std::max(cam.width, cam.height);
+            small.width = std::max(1, static_cast<int>(cam.width * scale));
+            small.height = std::max(1, static_cast<int>(cam.height * scale));
+            RenderSettings rs;
+            rs.threads = threads;
+            rs.progress = false;
+            exposure = auto_exposure(render(h.mesh, h.get_bvh(), small, b, shaded.field, rs));
+          }
+          const std::string why =
+              indptr ? ""
+                     : "no form factors were given: write_glb(..., F=F) splits the solution "
+                       "by light source";
+          const GlbContent glb =
+              viewer_glb({h.mesh, light, h.scene.source, b, shaded, bases, why, cam, exposure, ""},
+                         &linearity);
+          write_viewer(glb, glb_path, page_path, title);
+        }
+        py::dict out;
+        out["glb"] = glb_path;
+        out["page"] = page_path;
+        py::list names;
+        for (const EmitterBasis& basis : bases) names.append(basis.name);
+        out["light_sources"] = names;
+        out["exposure_ev"] = exposure;
+        if (!bases.empty()) out["linearity_error"] = linearity;
+        return out;
+      },
+      py::arg("mesh"), py::arg("B"), py::arg("indptr"), py::arg("indices"), py::arg("data"),
+      py::arg("settings"), py::arg("threads"), py::arg("sky"), py::arg("sun"), py::arg("ev"),
+      py::arg("glb"), py::arg("page"), py::arg("title"));
+
+  m.def(
       "render",
       [](const MeshHandle& h, const ValueArray& B, std::optional<std::vector<double>> eye,
          std::optional<std::vector<double>> look_at, std::optional<std::vector<double>> up,
@@ -962,11 +1036,7 @@ PYBIND11_MODULE(_lambert, m) {
          std::optional<std::vector<double>> sky, std::optional<std::vector<double>> sun) {
         Eigen::MatrixX3d b = matrix_n3(B, h.mesh.size(), "B");
         const Daylight light = daylight_from(sky, sun);
-        Camera cam = h.scene.camera;
-        if (!cam.defined) {
-          const auto [lo, hi] = h.scene.bounds();
-          cam = framing_camera(lo, hi);
-        }
+        Camera cam = default_camera(h.scene);
         if (eye) cam.eye = vec3(*eye, "eye");
         if (look_at) cam.look_at = vec3(*look_at, "look_at");
         if (up) cam.up = vec3(*up, "up");

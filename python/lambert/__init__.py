@@ -35,7 +35,7 @@ __all__ = [
     "FormFactors", "Solution", "load_scene",
     "form_factors", "save_form_factors", "load_form_factors", "solve", "solve_hierarchical", "heat",
     "vertex_radiosity",
-    "write_vertex_exr", "render", "estimators", "solvers", "set_verbosity", "option_specs",
+    "write_vertex_exr", "render", "write_glb", "show", "estimators", "solvers", "set_verbosity", "option_specs",
 ]
 
 __version__ = _lambert.__version__  # the project's one version (CHANGELOG.md, "Version scheme")
@@ -263,9 +263,14 @@ def solve(mesh, F, solver="gauss-seidel", tol=1e-8, max_iterations=10000, omega=
                  preconditioner=str(preconditioner), restart=_int(restart, "restart"))
     # By name, only what differs from the declared default (what the CLI calls given).
     settings = {k: v for k, v in given.items() if not _is_default("solver", k, v)}
-    return Solution(*_lambert.solve(mesh, indptr, indices, data, settings,
-                                    _int(threads, "threads"), initial_guess, medium,
-                                    _daylight(sky, 3, "sky"), _daylight(sun, 6, "sun")))
+    solution = Solution(*_lambert.solve(mesh, indptr, indices, data, settings,
+                                        _int(threads, "threads"), initial_guess, medium,
+                                        _daylight(sky, 3, "sky"), _daylight(sun, 6, "sun")))
+    if not medium:  # what show() needs to split it by light source
+        solution._problem = dict(mesh=mesh, F=F, sky=sky, sun=sun, solver=solver, tol=tol,
+                                 max_iterations=max_iterations, omega=omega,
+                                 preconditioner=preconditioner, restart=restart)
+    return solution
 
 
 def heat(mesh, F, surfaces, ambient_temperature=0.0, length_unit="m", solver="gauss-seidel",
@@ -336,6 +341,63 @@ def render(mesh, B, eye=None, look_at=None, up=None, fov=None, width=None, heigh
                            _int(seed, "seed"), _int(threads, "threads"), str(exr or ""),
                            str(png or ""), None if ev is None else float(ev),
                            _daylight(sky, 3, "sky"), _daylight(sun, 6, "sun"))
+
+
+def write_glb(path, mesh, B, F=None, sky=None, sun=None, ev=None, page=None, solver="gauss-seidel",
+              tol=1e-8, max_iterations=10000, omega=1.5, preconditioner="diagonal", restart=30,
+              threads=0):
+    """Writes B (N, 3) on `mesh` as a glTF 2.0 binary file, as `lambert run`'s NAME.glb
+    (docs/viewer.md): the shading-vertex mesh with the solution as COLOR_0, the patch edges and
+    the scene's camera. With F (the form factors B was solved with, and the `sky`/`sun` it was
+    solved under), also one COLOR_k per light source: the solution for that source alone,
+    solved with the given solver settings (tolerance at most 1e-10), so that the viewer
+    relights live. `ev` is the viewer's initial exposure (default: automatic). With `page`,
+    also writes the viewer page there (one self-contained HTML file).
+
+    Returns a dict: glb, page, light_sources (names, in COLOR_1... order), exposure_ev and,
+    with F, linearity_error (how closely the bases sum to B, relative to its largest value)."""
+    _check_mesh(mesh)
+    arrays = (None, None, None) if F is None else _csr_arrays(F, mesh, "F")
+    given = dict(solver=str(solver), tol=float(tol),
+                 max_iterations=_int(max_iterations, "max_iterations"), omega=float(omega),
+                 preconditioner=str(preconditioner), restart=_int(restart, "restart"))
+    settings = {k: v for k, v in given.items() if not _is_default("solver", k, v)}
+    page = "" if page is None else str(page)
+    title = _os.path.splitext(_os.path.basename(str(path)))[0]
+    return _lambert.write_viewer(mesh, B, *arrays, settings, _int(threads, "threads"),
+                                 _daylight(sky, 3, "sky"), _daylight(sun, 6, "sun"),
+                                 None if ev is None else float(ev), str(path), page, title)
+
+
+def show(solution, mesh=None, F=None, path=None, open=True, **settings):
+    """Writes the viewer page of a solution and opens it in the browser (docs/viewer.md):
+    orbit and walk through the scene, one intensity slider per light source relighting it
+    live. `solution` is what `solve` returned (it remembers its mesh, F, sky and sun), or B
+    with `mesh` (and `F` for the sliders). `path`: the page to write (default: index.html in
+    a new temporary folder, beside its .glb). `open=False` only writes. Other keywords go to
+    write_glb (sky, sun, ev, solver settings). Returns the page's path."""
+    import tempfile
+    import webbrowser
+    problem = dict(getattr(solution, "_problem", None) or {})
+    B = solution.B if isinstance(solution, Solution) else solution
+    if mesh is not None:
+        problem["mesh"] = mesh
+    if F is not None:
+        problem["F"] = F
+    if problem.get("mesh") is None:
+        raise UsageError("show needs the mesh B lives on: show(solution) for what solve() "
+                         "returned, else show(B, mesh=mesh, F=F)")
+    problem.update(settings)
+    if path is None:
+        path = _os.path.join(tempfile.mkdtemp(prefix="lambert_view_"), "index.html")
+    path = _os.path.abspath(str(path))
+    _os.makedirs(_os.path.dirname(path), exist_ok=True)
+    glb = _os.path.splitext(path)[0] + ".glb"
+    mesh = problem.pop("mesh")
+    write_glb(glb, mesh, B, page=path, **problem)
+    if open:
+        webbrowser.open("file://" + path)
+    return path
 
 
 def _daylight(value, n, name):

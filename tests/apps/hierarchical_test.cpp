@@ -97,8 +97,8 @@ TEST(HierarchicalRun, CornellBoxWritesEveryFileWithABalancedReport) {
       run_quietly({"run", "--method", "hierarchical", "--epsilon", "1e-2", "-o", out, "--size",
                    "32x32", "--antialias", "1", "-q", "-j", "2"});
   ASSERT_EQ(code, kExitOk) << text;
-  for (const char* f :
-       {"cornell.exr", "cornell.png", "cornell_vertices.exr", "cornell.ply", "report.json"}) {
+  for (const char* f : {"cornell.exr", "cornell.png", "cornell_vertices.exr", "cornell.ply",
+                        "cornell.glb", "index.html", "report.json"}) {
     const std::string path = out + "/" + f;
     ASSERT_TRUE(std::filesystem::exists(path)) << path;
     EXPECT_GT(std::filesystem::file_size(path), 0u) << path;
@@ -106,7 +106,7 @@ TEST(HierarchicalRun, CornellBoxWritesEveryFileWithABalancedReport) {
   }
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(out),
                           std::filesystem::directory_iterator()),
-            5);  // no temporaries left
+            7);  // no temporaries left
   const nlohmann::json report = read_json(out + "/report.json");
   EXPECT_EQ(report.at("method"), "hierarchical");
   EXPECT_FALSE(report.contains("form_factors"));

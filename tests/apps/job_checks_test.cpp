@@ -184,8 +184,9 @@ TEST_F(JobChecks, RunReportListsItsOwnFilesAndStaleTemporariesGo) {
   const auto report = nlohmann::json::parse(slurp((out / "report.json").string()));
   std::vector<std::string> files;
   for (const auto& f : report.at("files")) files.push_back(fs::path(f.get<std::string>()).filename());
-  EXPECT_EQ(files, (std::vector<std::string>{"second.exr", "second.png", "second_vertices.exr",
-                                             "second.ply", "report.json"}));
+  EXPECT_EQ(files,
+            (std::vector<std::string>{"second.exr", "second.png", "second_vertices.exr",
+                                      "second.ply", "second.glb", "index.html", "report.json"}));
 }
 
 }  // namespace

@@ -64,7 +64,8 @@ TEST(RunCommand, TinySceneProducesEveryFile) {
                         "--size", "40x30", "-q", "-j", "2"});
   const std::string stdout_text = ::testing::internal::GetCapturedStdout();
   ASSERT_EQ(code, kExitOk) << stdout_text;
-  for (const char* f : {"tiny.exr", "tiny.png", "tiny_vertices.exr", "tiny.ply", "report.json"}) {
+  for (const char* f : {"tiny.exr", "tiny.png", "tiny_vertices.exr", "tiny.ply", "tiny.glb",
+                        "index.html", "report.json"}) {
     const std::string path = out + "/" + f;
     ASSERT_TRUE(std::filesystem::exists(path)) << path;
     EXPECT_GT(std::filesystem::file_size(path), 0u) << path;
@@ -73,7 +74,7 @@ TEST(RunCommand, TinySceneProducesEveryFile) {
   // Nothing else (no temporaries) is left in the output directory.
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(out),
                           std::filesystem::directory_iterator()),
-            5);
+            7);
   EXPECT_EQ(slurp(out + "/tiny.png").substr(1, 3), "PNG");
   EXPECT_EQ(slurp(out + "/tiny.ply").substr(0, 4), "ply\n");
   const nlohmann::json report = nlohmann::json::parse(slurp(out + "/report.json"));
@@ -107,7 +108,7 @@ TEST(RunCommand, TinySceneProducesEveryFile) {
   EXPECT_GE(report.at("seconds").at("total").get<double>(), 0.0);
   EXPECT_EQ(report.at("rays_total").get<std::int64_t>(),
             ff.at("rays").get<std::int64_t>() + report.at("render").at("rays").get<std::int64_t>());
-  EXPECT_EQ(report.at("files").size(), 5u);
+  EXPECT_EQ(report.at("files").size(), 7u);
   const Image img = read_image_exr(out + "/tiny.exr");
   EXPECT_EQ(img.width, 40);
   EXPECT_EQ(img.height, 30);

@@ -515,3 +515,62 @@ def test_sky_and_sun_as_the_cli(tmp_path):
     img = lambert.render(mesh, B, eye=(0.5, -3, 0.5), look_at=(0.5, 0.5, 0.5), up=(0, 0, 1),
                          width=16, height=16, antialias=1, sky=(1, 2, 3))
     assert np.allclose(img[0, 0], [1, 2, 3])
+
+
+def read_glb(path):
+    """A minimal GLB reader (the container, the JSON, float and uint32 accessors): the JSON and
+    a dict of the first primitive's attributes as numpy arrays."""
+    import json
+    import struct
+    data = open(path, "rb").read()
+    magic, version, length = struct.unpack_from("<4sII", data, 0)
+    assert (magic, version, length) == (b"glTF", 2, len(data))
+    json_length, = struct.unpack_from("<I", data, 12)
+    doc = json.loads(data[20:20 + json_length])
+    bin_start = 20 + json_length + 8
+    arrays = {}
+    for name, index in doc["meshes"][0]["primitives"][0]["attributes"].items():
+        a = doc["accessors"][index]
+        view = doc["bufferViews"][a["bufferView"]]
+        width = 3 if a["type"] == "VEC3" else 1
+        arrays[name] = np.frombuffer(data, np.float32, a["count"] * width,
+                                     bin_start + view["byteOffset"]).reshape(a["count"], width)
+    return doc, arrays
+
+
+def test_write_glb_splits_the_solution_by_light_source(cornell_mesh, tmp_path):
+    # The light and a sky: the glb holds the solution (COLOR_0, the conservative vertex field
+    # of B in float32) and one basis per source; they sum to it within kLinearityTolerance
+    # (1e-6 of the largest value; pipeline/relight.hpp derives it).
+    ff = lambert.form_factors(cornell_mesh, estimator="hybrid", samples=8, seed=1)
+    sol = lambert.solve(cornell_mesh, ff, sky=(0.3, 0.3, 0.4))
+    info = lambert.write_glb(tmp_path / "b.glb", cornell_mesh, sol.B, ff, sky=(0.3, 0.3, 0.4))
+    assert sorted(info["light_sources"]) == ["light", "sky"]
+    assert info["linearity_error"] <= 1e-6
+    doc, arrays = read_glb(tmp_path / "b.glb")
+    field = lambert.vertex_radiosity(cornell_mesh, sol.B)
+    assert np.array_equal(arrays["COLOR_0"], np.asarray(field.values, np.float32))
+    total = arrays["COLOR_1"].astype(float) + arrays["COLOR_2"]
+    assert np.abs(total - arrays["COLOR_0"]).max() <= 1e-6 * np.abs(arrays["COLOR_0"]).max()
+    extras = doc["asset"]["extras"]["lambert"]
+    assert extras["sky_radiance"] == [0.3, 0.3, 0.4]
+    assert [e["name"] for e in extras["emitters"]] == info["light_sources"]
+    # Without F: the solution alone, and why.
+    info = lambert.write_glb(tmp_path / "c.glb", cornell_mesh, sol.B)
+    assert info["light_sources"] == []
+    doc, arrays = read_glb(tmp_path / "c.glb")
+    assert set(arrays) == {"POSITION", "NORMAL", "COLOR_0"}
+    assert "F=F" in doc["asset"]["extras"]["lambert"]["no_relighting"]
+
+
+def test_show_writes_the_viewer_page_of_a_solution(cornell_mesh, tmp_path):
+    ff = lambert.form_factors(cornell_mesh, estimator="hybrid", samples=8, seed=1)
+    sol = lambert.solve(cornell_mesh, ff)
+    page = lambert.show(sol, path=tmp_path / "view" / "index.html", open=False)
+    assert page == str(tmp_path / "view" / "index.html")
+    html = open(page).read()
+    assert "window.LAMBERT_GLB_BASE64" in html and "LAMBERT_THREE" in html
+    doc, arrays = read_glb(tmp_path / "view" / "index.glb")
+    assert [e["name"] for e in doc["asset"]["extras"]["lambert"]["emitters"]] == ["light"]
+    with pytest.raises(lambert.UsageError, match="mesh"):
+        lambert.show(sol.B, open=False)
