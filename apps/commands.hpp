@@ -117,6 +117,7 @@ struct RenderOptions {
   std::string png;                      ///< sRGB preview; empty = output with .png
   std::string vertex_exr;               ///< per-vertex radiosity EXR (optional)
   std::string ply;                      ///< coloured patch mesh (optional)
+  std::string glb;  ///< glTF of the solution and its viewer page beside it (optional)
 };
 /// Registers `render` on the app.
 CLI::App* add_render_command(CLI::App& app, RenderOptions& opts);

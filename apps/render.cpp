@@ -11,6 +11,7 @@
 #include "io/radiosity_csv.hpp"
 #include "pipeline/hierarchical_stage.hpp"
 #include "pipeline/solve_stage.hpp"
+#include "pipeline/viewer_stage.hpp"
 
 namespace lambert {
 namespace {
@@ -43,16 +44,28 @@ std::string render_settings(const RenderOptions& o, const std::string& method_pa
   return ss.str();
 }
 
+// --glb FILE: the viewer page beside it, FILE with .html.
+std::string page_path(const RenderOptions& opts) {
+  return opts.glb.empty() ? ""
+                          : std::filesystem::path(opts.glb).replace_extension(".html").string();
+}
+
 std::string png_path(const RenderOptions& opts) {
   return opts.png.empty() ? std::filesystem::path(opts.output).replace_extension(".png").string()
                           : opts.png;
 }
 
+// What --glb carries besides B: the solution per light source, or why there is none.
+struct Relighting {
+  const std::vector<EmitterBasis>* bases = nullptr;
+  std::string why_not;
+};
+
 // Shades, renders and writes B on the loaded mesh; prints what was written.
 void render_and_write(const RenderOptions& opts, const LoadedScene& loaded,
                       const Eigen::MatrixX3d& B, const Eigen::MatrixX3d* indirect,
                       const Camera& camera, const std::string& method_settings,
-                      const MediumView* medium = nullptr) {
+                      const Relighting& relight, const MediumView* medium = nullptr) {
   const ShadedField shaded = shade_vertices(loaded, B, indirect, opts.shade, opts.run.threads);
   RenderStats stats;
   const Image image = render_scene(loaded, B, shaded.field, camera, opts.shade,
@@ -63,8 +76,24 @@ void render_and_write(const RenderOptions& opts, const LoadedScene& loaded,
   paths.png = png_path(opts);
   paths.vertex_exr = opts.vertex_exr;
   paths.ply = opts.ply;
-  const auto written = write_outputs(paths, loaded.mesh, shaded, image, ev,
-                                     render_settings(opts, method_settings, shaded.interpolation, camera));
+  const std::string settings = render_settings(opts, method_settings, shaded.interpolation, camera);
+  auto written = write_outputs(paths, loaded.mesh, shaded, image, ev, settings);
+  if (!opts.glb.empty()) {
+    static const std::vector<EmitterBasis> kNone;
+    const std::vector<EmitterBasis>& bases = relight.bases ? *relight.bases : kNone;
+    double linearity = 0.0;
+    const GlbContent glb = viewer_glb({loaded.mesh, loaded.scene.daylight, loaded.scene.source, B,
+                                       shaded, bases, relight.why_not, camera, ev, settings},
+                                      &linearity);
+    const std::string stem = std::filesystem::path(opts.glb).stem().string();
+    for (const std::string& f : write_viewer(glb, opts.glb, page_path(opts), stem))
+      written.push_back(f);
+    if (!bases.empty() && linearity > kLinearityTolerance)
+      log_warn("the " + std::to_string(bases.size()) +
+               " light sources' solutions sum to the solution within " + std::to_string(linearity) +
+               ": the viewer at full intensities differs from the image by that much; a smaller "
+               "--tol closes it");
+  }
   const auto [power_after, power_before] = worst_power_error(shaded.power);
   std::printf("rendered %dx%d, %lld rays in %.2fs, exposure %+.3f EV\n", image.width, image.height,
               static_cast<long long>(stats.rays), stats.seconds, ev);
@@ -75,10 +104,8 @@ void render_and_write(const RenderOptions& opts, const LoadedScene& loaded,
 
 JobPlan render_plan(const RenderOptions& opts) {
   JobPlan plan = job_plan(opts.run);
-  plan.outputs = {{"-o", opts.output},
-                  {"--png", png_path(opts)},
-                  {"--vertex-exr", opts.vertex_exr},
-                  {"--ply", opts.ply}};
+  plan.outputs = {{"-o", opts.output}, {"--png", png_path(opts)}, {"--vertex-exr", opts.vertex_exr},
+                  {"--ply", opts.ply}, {"--glb", opts.glb},       {"--glb", page_path(opts)}};
   return plan;
 }
 
@@ -111,8 +138,10 @@ int render_matrix(const RenderOptions& opts) {
     r.ff_seconds = timer.seconds();
     const MediumResult m =
         solve_scene_with_medium(loaded, F, medium, opts.medium, opts.solver, opts.run, r);
-    render_and_write(opts, loaded, r.B, nullptr, camera,
-                     matrix_settings(opts, loaded, r) + ' ' + medium_settings_text(m), &m.view);
+    render_and_write(
+        opts, loaded, r.B, nullptr, camera,
+        matrix_settings(opts, loaded, r) + ' ' + medium_settings_text(m),
+        {nullptr, "a participating medium's solution is not split by light source yet"}, &m.view);
     return r.solution.status != SolveStatus::Converged ? kExitNotConverged : kExitOk;
   }
   if (!opts.radiosity.empty()) {
@@ -120,10 +149,13 @@ int render_matrix(const RenderOptions& opts) {
     log_info("radiosity: read " + std::to_string(loaded.mesh.size()) + " patches from " +
              opts.radiosity);
   } else {
-    r = compute_radiosity(loaded, opts.ff, opts.solver, opts.run);
+    r = compute_radiosity(loaded, opts.ff, opts.solver, opts.run, !opts.glb.empty());
   }
   render_and_write(opts, loaded, r.B, r.solved ? &r.indirect : nullptr, camera,
-                   matrix_settings(opts, loaded, r));
+                   matrix_settings(opts, loaded, r),
+                   {r.solved ? &r.bases : nullptr,
+                    "--radiosity gives B without its form factors: nothing to split it by light "
+                    "source"});
   return r.solved && r.solution.status != SolveStatus::Converged ? kExitNotConverged : kExitOk;
 }
 
@@ -135,7 +167,10 @@ int render_hierarchical(const RenderOptions& opts) {
   const HierarchicalRun h = solve_scene_hierarchical(
       std::move(scene), make_hierarchical_options(opts.method, opts.method.hierarchical.epsilon,
                                                   opts.solver, opts.run));
-  render_and_write(opts, h.loaded, h.B, nullptr, camera, hierarchical_settings_text(h));
+  render_and_write(opts, h.loaded, h.B, nullptr, camera, hierarchical_settings_text(h),
+                   {nullptr,
+                    "hierarchical radiosity refines its links for the whole E: its solution is "
+                    "not split by light source"});
   return hierarchical_status(h.stats) != SolveStatus::Converged ? kExitNotConverged : kExitOk;
 }
 
@@ -160,6 +195,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opts) {
   add_declared(cmd, "--png", opts.png);
   add_declared(cmd, "--vertex-exr", opts.vertex_exr);
   add_declared(cmd, "--ply", opts.ply);
+  add_declared(cmd, "--glb", opts.glb);
   return cmd;
 }
 

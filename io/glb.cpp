@@ -121,7 +121,8 @@ Json camera_node(const GlbCamera& cam) {
           {"camera", 0},
           {"translation", {cam.eye.x(), cam.eye.y(), cam.eye.z()}},
           {"rotation", {q.x(), q.y(), q.z(), q.w()}},
-          {"extras", {{"target", {cam.look_at.x(), cam.look_at.y(), cam.look_at.z()}}}}};
+          {"extras",
+           Json{{"target", Json::array({cam.look_at.x(), cam.look_at.y(), cam.look_at.z()})}}}};
 }
 
 }  // namespace
@@ -131,7 +132,7 @@ std::string glb_bytes(const GlbContent& c) {
   Json gltf = Json::object();
   gltf["asset"] = {{"version", "2.0"}, {"generator", c.generator}};
   if (!c.asset_extras.is_null()) gltf["asset"]["extras"] = c.asset_extras;
-  gltf["extensionsUsed"] = {"KHR_materials_unlit"};
+  gltf["extensionsUsed"] = Json::array({"KHR_materials_unlit"});
   Buffers buffers(gltf);
 
   Json attributes = {{"POSITION", buffers.floats(c.positions, 3, true)}};
@@ -153,36 +154,37 @@ std::string glb_bytes(const GlbContent& c) {
                 {"doubleSided", double_sided},
                 {"extensions", {{"KHR_materials_unlit", Json::object()}}}};
   };
-  gltf["materials"] = {unlit("radiosity", 1.0, true)};
-  gltf["meshes"] = {{{"name", "radiosity"}, {"primitives", {triangles}}}};
-  gltf["nodes"] = {{{"name", "radiosity"}, {"mesh", 0}}};
+  // Every array is spelled Json::array: a braced list of one Json element is a copy of that
+  // element, not an array of it (list-initialisation picks the copy constructor).
+  gltf["materials"] = Json::array({unlit("radiosity", 1.0, true)});
+  gltf["meshes"] =
+      Json::array({Json{{"name", "radiosity"}, {"primitives", Json::array({triangles})}}});
+  gltf["nodes"] = Json::array({Json{{"name", "radiosity"}, {"mesh", 0}}});
   if (!c.edges.empty()) {
     gltf["materials"].push_back(unlit("patch edges", 0.0, false));
-    gltf["meshes"].push_back({{"name", "patch edges"},
-                              {"primitives",
-                               {{{"attributes", {{"POSITION", attributes["POSITION"]}}},
-                                 {"indices", buffers.indices(c.edges)},
-                                 {"material", 1},
-                                 {"mode", kModeLines}}}}});
+    const Json lines = {{"attributes", Json{{"POSITION", attributes["POSITION"]}}},
+                        {"indices", buffers.indices(c.edges)},
+                        {"material", 1},
+                        {"mode", kModeLines}};
+    gltf["meshes"].push_back(Json{{"name", "patch edges"}, {"primitives", Json::array({lines})}});
     gltf["nodes"].push_back(
-        {{"name", "patch edges"}, {"mesh", 1}, {"extras", {{"role", "patch edges"}}}});
+        Json{{"name", "patch edges"}, {"mesh", 1}, {"extras", Json{{"role", "patch edges"}}}});
   }
   if (c.camera) {
-    gltf["cameras"] = {{{"type", "perspective"},
-                        {"perspective",
-                         {{"yfov", c.camera->yfov_degrees * M_PI / 180.0},
-                          {"aspectRatio", c.camera->aspect},
-                          {"znear", c.camera->znear}}}}};
+    const Json perspective = {{"yfov", c.camera->yfov_degrees * M_PI / 180.0},
+                              {"aspectRatio", c.camera->aspect},
+                              {"znear", c.camera->znear}};
+    gltf["cameras"] = Json::array({Json{{"type", "perspective"}, {"perspective", perspective}}});
     gltf["nodes"].push_back(camera_node(*c.camera));
   }
   Json scene_nodes = Json::array();
   for (std::size_t k = 0; k < gltf["nodes"].size(); ++k) scene_nodes.push_back(k);
-  gltf["scenes"] = {{{"nodes", scene_nodes}}};
+  gltf["scenes"] = Json::array({Json{{"nodes", scene_nodes}}});
   gltf["scene"] = 0;
 
   std::string& bin = buffers.bin();
   while (bin.size() % 4 != 0) bin.push_back('\0');
-  gltf["buffers"] = {{{"byteLength", bin.size()}}};
+  gltf["buffers"] = Json::array({Json{{"byteLength", bin.size()}}});
   std::string json = gltf.dump(-1, ' ', false, Json::error_handler_t::replace);
   while (json.size() % 4 != 0) json.push_back(' ');
 

@@ -159,12 +159,12 @@ void solve_bases(const LoadedScene& scene, const FormFactors& F, const SolveOpti
 }
 
 RadiosityResult compute_radiosity(const LoadedScene& scene, const FormFactorArgs& ff,
-                                  const SolveOptions& solver, const RunArgs& run) {
+                                  const SolveOptions& solver, const RunArgs& run, bool bases) {
   RadiosityResult r;
   const Timer ff_timer;
   const FormFactors F = obtain_form_factors(scene, ff, run);
   r.ff_seconds = ff_timer.seconds();
-  solve_scene(scene, F, solver, run, r);
+  solve_scene(scene, F, solver, run, r, bases);
   return r;
 }
 

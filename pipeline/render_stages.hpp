@@ -93,9 +93,11 @@ void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOpti
 void solve_bases(const LoadedScene& scene, const FormFactors& F, const SolveOptions& solver,
                  const RunArgs& run, RadiosityResult& r);
 
-/// Computes F (or loads --ff) and solves for B; logs one line per stage on stderr.
+/// Computes F (or loads --ff) and solves for B (and with `bases` the per-emitter bases); logs
+/// one line per stage on stderr.
 RadiosityResult compute_radiosity(const LoadedScene& scene, const FormFactorArgs& ff,
-                                  const SolveOptions& solver, const RunArgs& run);
+                                  const SolveOptions& solver, const RunArgs& run,
+                                  bool bases = false);
 
 /// The per-vertex field of B and its per-surface power report.
 struct ShadedField {

@@ -350,6 +350,8 @@
     window.addEventListener('resize', resize);
     resize();
     update();
+    // Milliseconds from the start of navigation to the first picture (docs/viewer.md quotes it).
+    document.body.dataset.loadMs = String(Math.round(performance.now()));
     document.body.dataset.state = 'ready';
   }
 })();

@@ -198,5 +198,45 @@ TEST(Viewer, ManyEmittersShareTheLastBasisAndHierarchicalSaysWhyItCannotRelight)
             std::string::npos);
 }
 
+TEST(Viewer, RenderGlbWritesTheBasesAndThePageAndSaysWhyARadiosityFileHasNone) {
+  // `render --glb FILE` writes the same glb as `run` (here two sources: the light and a glowing
+  // block) and the page FILE with .html beside it; the bases sum to the solution within
+  // kLinearityTolerance (pipeline/relight.hpp). With --radiosity B.csv there is no F to split
+  // B by source: the glb holds the solution only and its extras say why.
+  testing::TempDir dir;
+  const std::string glb = dir.file("cb.glb");
+  const auto [code, err] =
+      run_capturing({"render", "-q", "--patches", "120", "--emit", "tall_block=5,1,1", "--glb", glb,
+                     "-o", dir.file("cb.exr")});
+  ASSERT_EQ(code, 0) << err;
+  const tinygltf::Model m = testing::parse_glb(testing::slurp(glb));
+  const auto& lambert = m.asset.extras.Get("lambert");
+  ASSERT_EQ(lambert.Get("emitters").ArrayLen(), 2u);
+  const std::vector<float> solution = glb_attribute(m, "COLOR_0");
+  std::vector<float> sum(solution.size(), 0.0f);
+  for (int k = 1; k <= 2; ++k) {
+    const std::vector<float> b = glb_attribute(m, "COLOR_" + std::to_string(k));
+    ASSERT_EQ(b.size(), sum.size());
+    for (size_t i = 0; i < sum.size(); ++i) sum[i] += b[i];
+  }
+  EXPECT_LE(relative_difference(sum, solution), kLinearityTolerance);
+  const std::string page = testing::slurp(dir.file("cb.html"));
+  EXPECT_NE(page.find("window.LAMBERT_GLB_BASE64"), std::string::npos);
+
+  // B from a file: the solution only, with the reason.
+  const std::string csv = dir.file("B.csv");
+  ASSERT_EQ(run_capturing({"solve", "-q", "--patches", "120", "-o", csv}).first, 0);
+  const std::string glb2 = dir.file("from_csv.glb");
+  const auto [code2, err2] = run_capturing({"render", "-q", "--patches", "120", "--radiosity", csv,
+                                            "--glb", glb2, "-o", dir.file("from_csv.exr")});
+  ASSERT_EQ(code2, 0) << err2;
+  const tinygltf::Model m2 = testing::parse_glb(testing::slurp(glb2));
+  EXPECT_FALSE(glb_attribute(m2, "COLOR_0").empty());
+  EXPECT_TRUE(glb_attribute(m2, "COLOR_1").empty());
+  EXPECT_NE(
+      m2.asset.extras.Get("lambert").Get("no_relighting").Get<std::string>().find("--radiosity"),
+      std::string::npos);
+}
+
 }  // namespace
 }  // namespace lambert
