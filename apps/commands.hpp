@@ -173,7 +173,9 @@ struct HeatOptions {
   std::string surfaces;              ///< --surfaces FILE.json (io/heat_surfaces.hpp)
   double ambient_temperature = 0.0;  ///< --ambient-temperature (K)
   std::string length_unit = "m";     ///< --length-unit: m, cm, mm or in
-  std::string output = "heat";       ///< -o: prefix (or DIR/) of the CSVs and the JSON
+  std::string output = "heat";       ///< -o: FILE.csv, or prefix (or DIR/) of the CSVs and JSON
+  std::string patches_csv;           ///< --patches-csv FILE (default: PREFIX_patches.csv)
+  std::string conductors;            ///< --conductors FILE.csv: the radiative conductors
   HeatImageArgs images;              ///< --vertex-exr, --ply, --image and the camera
 };
 /// Registers `heat` on the app.

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include "apps/cli.hpp"
 #include "apps/commands.hpp"
@@ -20,6 +21,7 @@
 #include "io/json.hpp"
 #include "pipeline/heat_problem.hpp"
 #include "pipeline/solve_stage.hpp"
+#include "solvers/gebhart.hpp"
 #include "solvers/thermal.hpp"
 
 namespace lambert {
@@ -36,10 +38,52 @@ CLI::App* add_heat_command(CLI::App& app, HeatOptions& opts) {
   add_declared(cmd, "--ambient-temperature", opts.ambient_temperature);
   add_declared(cmd, "--length-unit", opts.length_unit);
   add_declared(cmd, "-o,--output", opts.output);
+  add_declared(cmd, "--patches-csv", opts.patches_csv);
+  add_declared(cmd, "--conductors", opts.conductors);
   add_heat_output_options(cmd, opts.images);
   add_run_options(cmd, opts.run);
   return cmd;
 }
+
+namespace {
+
+// Writes the tables, the conductors, the images and the summary of `paths` that are asked
+// for; returns the files written, in order.
+std::vector<std::string> write_heat_outputs(const HeatPaths& paths, HeatReport& report,
+                                            const Timer& total) {
+  std::vector<std::string> written = {paths.surfaces_csv};
+  write_heat_surfaces_csv(paths.surfaces_csv, report);
+  if (!paths.patches_csv.empty()) {
+    write_heat_patches_csv(paths.patches_csv, report);
+    written.push_back(paths.patches_csv);
+  }
+  if (!paths.conductors_csv.empty()) {
+    write_heat_conductors_csv(paths.conductors_csv, report);
+    written.push_back(paths.conductors_csv);
+  }
+  const std::vector<std::string> images = write_heat_images(report);
+  written.insert(written.end(), images.begin(), images.end());
+  report.timings.total_seconds = total.seconds();
+  if (!paths.json.empty()) {
+    write_json_file(paths.json, heat_json(report));
+    written.push_back(paths.json);
+  }
+  return written;
+}
+
+// The exit code of the solves: 3 (with a warning) when the exchange or a conductor solve did
+// not converge.
+int heat_exit_code(const std::string& solver, const ThermalSolution& sol,
+                   const std::optional<RadiativeConductors>& conductors) {
+  SolveStatus status = sol.radiosity.status;
+  if (status == SolveStatus::Converged && conductors) status = conductors->status;
+  if (status == SolveStatus::Converged) return kExitOk;
+  log_warn("solver " + solver + " did not converge (" + to_string(status) +
+           "); results were written anyway");
+  return kExitNotConverged;
+}
+
+}  // namespace
 
 int run_heat(const HeatOptions& opts) {
   check_options_read(opts.run,
@@ -49,12 +93,10 @@ int run_heat(const HeatOptions& opts) {
         "--ambient (southwell's display term) does not apply to heat: it would "
         "change J; --ambient-temperature sets the environment");
   const Timer total;
-  const std::string prefix = output_prefix(opts.output, "heat");
-  const std::string surfaces_csv = prefix + "_surfaces.csv", patches_csv = prefix + "_patches.csv",
-                    json_path = prefix + ".json";
+  const HeatPaths paths = heat_paths(opts);
   JobPlan plan = job_plan(opts.run);
   plan.inputs.push_back({"--surfaces", opts.surfaces});
-  plan.outputs = {{"-o", surfaces_csv}, {"-o", patches_csv}, {"-o", json_path}};
+  add_heat_paths_to_plan(plan, paths);
   add_heat_outputs_to_plan(plan, opts.images);
   plan_form_factors(plan, opts.ff, opts.run);
   plan.direct = opts.solve.solver == "direct";
@@ -63,13 +105,12 @@ int run_heat(const HeatOptions& opts) {
   const std::vector<SurfaceCondition> cond =
       resolve_surface_conditions(conditions, loaded.mesh.surface_names);
   const double load_seconds = total.seconds();
-  const double metres = metres_per_unit(opts.length_unit);
 
   const Timer ff_timer;
   const FormFactors ff = obtain_form_factors(loaded, opts.ff, opts.run);
   const double ff_seconds = ff_timer.seconds();
-  const ThermalProblem problem =
-      make_heat_problem(loaded.mesh, cond, ff.F, metres, opts.ambient_temperature);
+  const ThermalProblem problem = make_heat_problem(
+      loaded.mesh, cond, ff.F, metres_per_unit(opts.length_unit), opts.ambient_temperature);
   refuse_floating_enclosure(loaded.mesh, problem, ff, opts.surfaces);
 
   SolveOptions so = opts.solve;
@@ -79,32 +120,23 @@ int run_heat(const HeatOptions& opts) {
   std::vector<std::int32_t> surface_of(loaded.mesh.size());
   for (std::int32_t i = 0; i < loaded.mesh.size(); ++i)
     surface_of[i] = loaded.mesh.patches[i].surface;
-  const auto surfaces = surface_heat(sol, problem.area, surface_of,
-                                     static_cast<std::int32_t>(loaded.mesh.surface_names.size()));
+  const auto n_surfaces = static_cast<std::int32_t>(loaded.mesh.surface_names.size());
+  const auto surfaces = surface_heat(sol, problem.area, surface_of, n_surfaces);
   if (sol.undefined_temperatures > 0)
     log_warn(std::to_string(sol.undefined_temperatures) +
              " known-flux patch(es) are asked to lose more than they can radiate at 0 K "
              "(J - (1 - e) H < 0): their temperature is reported as null");
+  std::optional<RadiativeConductors> conductors;
+  if (!opts.conductors.empty())
+    conductors = radiative_conductors(problem, surface_of, n_surfaces, so);
 
-  HeatReport report{&loaded, &problem, &sol, &surfaces, &cond, &ff, &opts, {}};
+  HeatReport report{&loaded, &problem, &sol, &surfaces, &cond, &ff, &opts, nullptr, {}};
+  if (conductors) report.conductors = &*conductors;
   report.timings = {load_seconds, ff_seconds, sol.radiosity.seconds, 0.0};
-  write_heat_surfaces_csv(surfaces_csv, report);
-  write_heat_patches_csv(patches_csv, report);
-  std::vector<std::string> written = {surfaces_csv, patches_csv};
-  const std::vector<std::string> images = write_heat_images(report);
-  written.insert(written.end(), images.begin(), images.end());
-  report.timings.total_seconds = total.seconds();
-  write_json_file(json_path, heat_json(report));
-  written.push_back(json_path);
-
+  const std::vector<std::string> written = write_heat_outputs(paths, report, total);
   print_heat_table(report);
   for (const auto& f : written) std::printf("wrote %s\n", f.c_str());
-  if (sol.radiosity.status != SolveStatus::Converged) {
-    log_warn("solver " + so.solver + " did not converge (" + to_string(sol.radiosity.status) +
-             "); results were written anyway");
-    return kExitNotConverged;
-  }
-  return kExitOk;
+  return heat_exit_code(so.solver, sol, conductors);
 }
 
 }  // namespace lambert

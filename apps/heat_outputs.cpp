@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 
 #include "apps/commands.hpp"
@@ -50,6 +51,38 @@ double unit_position(double v, std::pair<double, double> range) {
   return (v - range.first) / (range.second - range.first);
 }
 
+// The conductors' section of the summary: the matrix up to kJsonConductorSurfaces surfaces,
+// its reciprocity max |GR − GRᵀ| / max |GR| (F's non-reciprocity and the solver's tolerance).
+Json conductors_json(const HeatReport& r) {
+  const RadiativeConductors& c = *r.conductors;
+  const double scale = c.GR.cwiseAbs().maxCoeff();
+  Json j = {{"units", "m^2 (multiply by sigma (T_i^4 - T_j^4) for W)"},
+            {"file", r.options->conductors},
+            {"status", to_string(c.status)},
+            {"solves", c.solves},
+            {"residual", c.residual},
+            {"seconds", c.seconds},
+            {"reciprocity_error",
+             scale > 0.0 ? (c.GR - c.GR.transpose()).cwiseAbs().maxCoeff() / scale : 0.0}};
+  if (c.GR.rows() > kJsonConductorSurfaces) return j;
+  Json rows = Json::array();
+  for (Eigen::Index s = 0; s < c.GR.rows(); ++s) {
+    Json row = Json::array();
+    for (Eigen::Index t = 0; t < c.GR.cols(); ++t) row.push_back(c.GR(s, t));
+    rows.push_back(row);
+  }
+  Json env = Json::array(), emittance = Json::array();
+  for (Eigen::Index s = 0; s < c.GR.rows(); ++s) {
+    env.push_back(c.environment[s]);
+    emittance.push_back(c.emittance[s]);
+  }
+  j["surfaces"] = r.loaded->mesh.surface_names;
+  j["GR_m2"] = rows;
+  j["environment_m2"] = env;
+  j["emittance_m2"] = emittance;
+  return j;
+}
+
 }  // namespace
 
 void add_heat_output_options(CLI::App* cmd, HeatImageArgs& args) {
@@ -64,6 +97,49 @@ void add_heat_outputs_to_plan(JobPlan& plan, const HeatImageArgs& args) {
   plan.outputs.push_back({"--vertex-exr", args.vertex_exr});
   plan.outputs.push_back({"--ply", args.ply});
   plan.outputs.push_back({"--image", args.image});
+}
+
+HeatPaths heat_paths(const HeatOptions& o) {
+  namespace fs = std::filesystem;
+  HeatPaths p;
+  p.conductors_csv = o.conductors;
+  const OutputPrefix prefix = plan_output_prefix(o.output, "heat");
+  std::error_code ec;
+  const bool folder = !prefix.folder.empty() || fs::is_directory(o.output, ec);
+  if (!folder && (writes_in_place(o.output) || fs::path(o.output).extension() == ".csv")) {
+    p.surfaces_csv = o.output;
+    p.json = summary_beside(o.output);
+    p.patches_csv = o.patches_csv;
+    return p;
+  }
+  p.folder = prefix.folder;
+  p.surfaces_csv = prefix.prefix + "_surfaces.csv";
+  p.patches_csv = o.patches_csv.empty() ? prefix.prefix + "_patches.csv" : o.patches_csv;
+  p.json = prefix.prefix + ".json";
+  return p;
+}
+
+void add_heat_paths_to_plan(JobPlan& plan, const HeatPaths& paths) {
+  plan.outputs.push_back({"-o", paths.surfaces_csv});
+  plan.outputs.push_back({"--patches-csv", paths.patches_csv});
+  plan.outputs.push_back({"the summary", paths.json});
+  plan.outputs.push_back({"--conductors", paths.conductors_csv});
+  if (!paths.folder.empty()) plan.folders.push_back(paths.folder);
+}
+
+void write_heat_conductors_csv(const std::string& path, const HeatReport& r) {
+  const auto& names = r.loaded->mesh.surface_names;
+  const RadiativeConductors& c = *r.conductors;
+  write_stream_atomically(path, [&](std::ostream& out) {
+    out << "GR_m2";
+    for (const auto& n : names) out << ',' << csv_field(n);
+    out << ",environment\n";
+    for (Eigen::Index s = 0; s < c.GR.rows(); ++s) {
+      out << csv_field(names[s]);
+      for (Eigen::Index t = 0; t < c.GR.cols(); ++t) out << ',' << csv_number(c.GR(s, t));
+      out << ',' << csv_number(c.environment[s]) << '\n';
+    }
+  });
 }
 
 void write_heat_surfaces_csv(const std::string& path, const HeatReport& r) {
@@ -120,32 +196,34 @@ Json heat_json(const HeatReport& r) {
   }
   double surface_sum = 0.0;
   for (const auto& h : *r.surfaces) surface_sum += h.Q;
-  return Json{{"scene", r.loaded->scene.source},
-              {"surfaces_file", o.surfaces},
-              {"patches", r.loaded->mesh.size()},
-              {"settings",
-               {{"length_unit", o.length_unit},
-                {"ambient_temperature_K", r.problem->ambient_temperature},
-                {"stefan_boltzmann", kStefanBoltzmann},
-                {"solver", o.solve.solver},
-                {"tol", o.solve.tol},
-                {"max_iterations", o.solve.max_iterations},
-                {"form_factors", ff_settings_json(r.ff->options, o.ff.ff_file)}}},
-              {"status", to_string(s.radiosity.status)},
-              {"iterations", ch.iterations},
-              {"residual", ch.residual},
-              {"closure",
-               {{"surfaces_W", surface_sum},
-                {"environment_W", s.environment_power},
-                {"sum_W", s.closure},
-                {"max_flux_mismatch_W_m2", s.max_flux_mismatch}}},
-              {"undefined_temperatures", s.undefined_temperatures},
-              {"surfaces", surfaces},
-              {"timings",
-               {{"load_and_mesh_seconds", r.timings.load_seconds},
-                {"form_factors_seconds", r.timings.form_factors_seconds},
-                {"solve_seconds", r.timings.solve_seconds},
-                {"total_seconds", r.timings.total_seconds}}}};
+  Json j{{"scene", r.loaded->scene.source},
+         {"surfaces_file", o.surfaces},
+         {"patches", r.loaded->mesh.size()},
+         {"settings",
+          {{"length_unit", o.length_unit},
+           {"ambient_temperature_K", r.problem->ambient_temperature},
+           {"stefan_boltzmann", kStefanBoltzmann},
+           {"solver", o.solve.solver},
+           {"tol", o.solve.tol},
+           {"max_iterations", o.solve.max_iterations},
+           {"form_factors", ff_settings_json(r.ff->options, o.ff.ff_file)}}},
+         {"status", to_string(s.radiosity.status)},
+         {"iterations", ch.iterations},
+         {"residual", ch.residual},
+         {"closure",
+          {{"surfaces_W", surface_sum},
+           {"environment_W", s.environment_power},
+           {"sum_W", s.closure},
+           {"max_flux_mismatch_W_m2", s.max_flux_mismatch}}},
+         {"undefined_temperatures", s.undefined_temperatures},
+         {"surfaces", surfaces},
+         {"timings",
+          {{"load_and_mesh_seconds", r.timings.load_seconds},
+           {"form_factors_seconds", r.timings.form_factors_seconds},
+           {"solve_seconds", r.timings.solve_seconds},
+           {"total_seconds", r.timings.total_seconds}}}};
+  if (r.conductors != nullptr) j["conductors"] = conductors_json(r);
+  return j;
 }
 
 void print_heat_table(const HeatReport& r) {

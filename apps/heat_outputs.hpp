@@ -11,11 +11,16 @@
 #include "io/json.hpp"
 #include "pipeline/job.hpp"
 #include "pipeline/render_stages.hpp"
+#include "solvers/gebhart.hpp"
 #include "solvers/thermal.hpp"
 
 namespace lambert {
 
 struct HeatOptions;
+
+/// The summary carries the conductor matrix up to this many surfaces (64² numbers, ~80 kB of
+/// JSON); above it, only where the CSV is and the totals.
+constexpr std::int32_t kJsonConductorSurfaces = 64;
 
 /// --vertex-exr, --ply, --image, --image-quantity and the camera options of `heat`.
 struct HeatImageArgs {
@@ -29,6 +34,19 @@ struct HeatImageArgs {
 void add_heat_output_options(CLI::App* cmd, HeatImageArgs& args);
 /// Adds those outputs to the job plan (collision and folder checks).
 void add_heat_outputs_to_plan(JobPlan& plan, const HeatImageArgs& args);
+
+/// Where `heat` writes its tables and its summary (empty: not written).
+struct HeatPaths {
+  std::string surfaces_csv, patches_csv, json, conductors_csv;
+  std::string folder;  ///< the folder -o DIR/ creates (JobPlan::folders), empty if none
+};
+/// -o FILE.csv, or a device or pipe (/dev/null, /dev/stdout): the per-surface table goes to
+/// it, the summary beside it (FILE.json; none for a device), the per-patch table only with
+/// --patches-csv. -o PREFIX or DIR/ (compatible with earlier versions): PREFIX_surfaces.csv,
+/// PREFIX_patches.csv (or --patches-csv) and PREFIX.json. --conductors as given.
+HeatPaths heat_paths(const HeatOptions& o);
+/// Adds the paths to the plan as outputs, and the folder -o DIR/ creates.
+void add_heat_paths_to_plan(JobPlan& plan, const HeatPaths& paths);
 
 /// Seconds spent per stage.
 struct HeatTimings {
@@ -44,6 +62,7 @@ struct HeatReport {
   const std::vector<SurfaceCondition>* conditions = nullptr;  ///< per surface
   const FormFactors* ff = nullptr;
   const HeatOptions* options = nullptr;
+  const RadiativeConductors* conductors = nullptr;  ///< computed for --conductors, else null
   HeatTimings timings;
 };
 
@@ -52,8 +71,12 @@ struct HeatReport {
 void write_heat_surfaces_csv(const std::string& path, const HeatReport& r);
 /// patch,surface,area_m2,emissivity,T_K,J_W_m2,H_W_m2,q_W_m2,Q_W, atomically.
 void write_heat_patches_csv(const std::string& path, const HeatReport& r);
+/// The conductors as a matrix: header `GR_m2,<surface>...,environment`, one row per emitting
+/// surface (GR_ST in m², then GR_S,env), atomically.
+void write_heat_conductors_csv(const std::string& path, const HeatReport& r);
 /// The JSON summary: settings (scene, surfaces file, length unit, ambient, σ, form factors,
-/// solver), status, closure, environment, per-surface results, timings.
+/// solver), status, closure, environment, per-surface results, the conductors when computed
+/// (the matrix itself up to kJsonConductorSurfaces surfaces), timings.
 Json heat_json(const HeatReport& r);
 /// The per-surface table and the closure on stdout.
 void print_heat_table(const HeatReport& r);

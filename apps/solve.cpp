@@ -19,11 +19,17 @@
 namespace lambert {
 namespace {
 
-// B.csv -> B.json; a name without .csv gets .json appended.
-std::string summary_path(const std::string& csv) {
-  std::filesystem::path p(csv);
-  if (p.extension() == ".csv") return p.replace_extension(".json").string();
-  return csv + ".json";
+// B.csv -> B.json, another name gets .json appended; none beside a device such as /dev/null.
+std::string summary_path(const std::string& csv) { return summary_beside(csv); }
+
+// Writes the summary unless -o is a device (no path); prints what was written.
+void write_summary(const std::string& csv, const std::string& json_path, const Json& j) {
+  if (json_path.empty()) {
+    std::printf("wrote %s\n", csv.c_str());
+    return;
+  }
+  write_json_file(json_path, j);
+  std::printf("wrote %s and %s\n", csv.c_str(), json_path.c_str());
 }
 
 void write_radiosity_csv(const std::string& path, const PatchMesh& mesh,
@@ -145,7 +151,6 @@ int run_solve_hierarchical(const SolveCommandOptions& opts) {
                         {"status", to_string(status)},
                         {"energy", hierarchical_energy_json(st.energy[c])}});
   j["surfaces"] = surface_averages_json(surface_averages(h.loaded.mesh, h.B));
-  write_json_file(json_path, j);
 
   std::printf(
       "method hierarchical: %s; %lld leaves, %lld links, %d passes, %d sweeps (change "
@@ -157,7 +162,7 @@ int run_solve_hierarchical(const SolveCommandOptions& opts) {
     std::printf("  %s: energy emitted %.6g absorbed %.6g escaped %.6g (imbalance %.2e)\n",
                 channel_name(c), e.emitted, e.absorbed, e.escaped, e.relative_imbalance);
   }
-  std::printf("wrote %s and %s\n", opts.output.c_str(), json_path.c_str());
+  write_summary(opts.output, json_path, j);
   if (status != SolveStatus::Converged) {
     log_warn(std::string("hierarchical status ") + to_string(status) +
              ": results were written anyway");
@@ -210,7 +215,6 @@ int write_solve_outputs(const SolveCommandOptions& opts, const LoadedScene& load
   if (!r.rounds.empty()) j["adapt"] = adapt_json(r.rounds);
   if (loaded.scene.daylight.any()) j["daylight"] = daylight_json(loaded.scene.daylight, r.daylight);
   if (!r.distributed.is_null()) j["distributed"] = r.distributed;
-  write_json_file(json_path, j);
 
   std::printf("solver %s: %s\n", so.solver.c_str(), to_string(sol.status));
   for (int c = 0; c < 3; ++c) {
@@ -228,7 +232,7 @@ int write_solve_outputs(const SolveCommandOptions& opts, const LoadedScene& load
       std::printf("  %s: absorbed by surfaces %.6g, by the medium %.6g (%d zones)\n",
                   channel_name(c), medium_result->absorbed_surfaces[c],
                   medium_result->absorbed_medium[c], medium_result->zones.size());
-  std::printf("wrote %s and %s\n", opts.output.c_str(), json_path.c_str());
+  write_summary(opts.output, json_path, j);
   if (sol.status != SolveStatus::Converged) {
     log_warn("solver " + so.solver + " did not converge (" + to_string(sol.status) +
              "); results were written anyway");

@@ -121,9 +121,20 @@ void remove_stale_temporaries(const std::string& directory) {
   }
 }
 
+bool writes_in_place(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  return !ec && fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st);
+}
+
 void write_atomically(const std::string& path,
                       const std::function<void(const std::string&)>& write) {
   namespace fs = std::filesystem;
+  if (writes_in_place(path)) {  // a device or a pipe: nothing to stage, nothing to rename
+    write(path);
+    return;
+  }
   const fs::path target(path);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   std::error_code ec;

@@ -22,8 +22,15 @@ std::optional<long> stale_temporary_pid(const std::string& file_name);
 /// longer running (never this process's, nor a live one's). Errors are ignored.
 void remove_stale_temporaries(const std::string& directory);
 
+/// True for an existing file that is neither a regular file nor a folder: a device such as
+/// /dev/null or /dev/stdout, or a pipe. Such a file is written in place (it cannot be
+/// replaced, and renaming a temporary over /dev/null would destroy the device), and a
+/// command writes nothing beside it (no summary named after it).
+bool writes_in_place(const std::string& path);
+
 /// Calls write(tmp_path) to produce the file, then renames tmp_path to `path`.
 /// On any exception the temporary is removed and the exception propagates.
+/// A `path` that writes_in_place is written directly (write(path)), outside any OutputSet.
 void write_atomically(const std::string& path,
                       const std::function<void(const std::string& tmp_path)>& write);
 

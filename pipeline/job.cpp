@@ -13,6 +13,7 @@
 #include <limits>
 #include <sstream>
 
+#include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/memory.hpp"
@@ -89,7 +90,10 @@ namespace {
 // existing part resolved.
 std::string canonical_text(const std::string& path) {
   std::error_code ec;
-  const std::filesystem::path p = std::filesystem::weakly_canonical(path, ec);
+  // absolute first: weakly_canonical leaves a relative path none of whose parts exists
+  // relative ("out/a.csv" for a folder out/ still to be created).
+  const std::filesystem::path p =
+      std::filesystem::weakly_canonical(std::filesystem::absolute(path, ec), ec);
   return ec ? std::filesystem::absolute(path).lexically_normal().string() : p.string();
 }
 
@@ -131,14 +135,17 @@ JobPlan job_plan(const RunArgs& run) {
   return plan;
 }
 
-void check_job_files(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs) {
-  namespace fs = std::filesystem;
+namespace {
+
+// Refuses an output that is an input or another output (a device or pipe may take several).
+void refuse_collisions(const std::vector<NamedFile>& inputs,
+                       const std::vector<NamedFile>& outputs) {
   std::vector<std::pair<std::string, const NamedFile*>> seen;  // canonical path, its file
   for (const NamedFile& in : inputs)
     if (!in.path.empty()) seen.emplace_back(canonical_text(in.path), &in);
   const size_t n_inputs = seen.size();
   for (const NamedFile& out : outputs) {
-    if (out.path.empty()) continue;
+    if (out.path.empty() || writes_in_place(out.path)) continue;
     const std::string key = canonical_text(out.path);
     for (size_t k = 0; k < seen.size(); ++k) {
       if (seen[k].first != key) continue;
@@ -149,18 +156,57 @@ void check_job_files(const std::vector<NamedFile>& inputs, const std::vector<Nam
     }
     seen.emplace_back(key, &out);
     std::error_code ec;
-    if (fs::is_directory(out.path, ec))
+    if (std::filesystem::is_directory(out.path, ec))
       throw IoError(out.path + ": cannot write " + out.option + ": it is a folder");
+  }
+}
+
+// The folder to probe for an output into `parent`: itself when it exists; for one the job
+// creates (in or under `folders`), its nearest existing ancestor; empty when it is neither.
+std::filesystem::path probe_target(const std::filesystem::path& parent,
+                                   const std::vector<std::filesystem::path>& folders) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(parent, ec)) return parent;
+  const bool planned = std::any_of(folders.begin(), folders.end(), [&](const fs::path& f) {
+    const auto [end, rest] = std::mismatch(f.begin(), f.end(), parent.begin(), parent.end());
+    return end == f.end();  // parent is f or lies under it
+  });
+  if (!planned) return {};
+  fs::path p = parent;
+  while (!p.empty() && p != p.parent_path() && !fs::exists(p, ec)) p = p.parent_path();
+  return p;
+}
+
+}  // namespace
+
+void check_job_files(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs,
+                     const std::vector<std::string>& folders) {
+  namespace fs = std::filesystem;
+  refuse_collisions(inputs, outputs);
+  std::vector<fs::path> planned;
+  for (const auto& f : folders) {
+    const fs::path p = fs::path(canonical_text(f)).lexically_normal();
+    planned.push_back(p.has_filename() ? p : p.parent_path());  // "out/" is "out"
   }
   std::vector<fs::path> probed;
   for (const NamedFile& out : outputs) {
     if (out.path.empty()) continue;
+    if (writes_in_place(out.path)) {
+      if (::access(out.path.c_str(), W_OK) != 0)
+        throw IoError(out.path + ": cannot write " + out.option + ": " + std::strerror(errno));
+      continue;
+    }
     const fs::path parent = fs::path(canonical_text(out.path)).parent_path();
-    if (std::find(probed.begin(), probed.end(), parent) != probed.end()) continue;
-    probed.push_back(parent);
-    const std::string why = probe_directory(parent);
+    const fs::path target = probe_target(parent, planned);
+    if (target.empty())
+      throw UsageError("cannot write '" + out.path + "' (" + out.option + "): directory '" +
+                       parent.string() + "' does not exist");
+    if (std::find(probed.begin(), probed.end(), target) != probed.end()) continue;
+    probed.push_back(target);
+    const std::string why = probe_directory(target);
     if (!why.empty())
-      throw IoError(out.path + ": cannot write " + out.option + " into '" + parent.string() +
+      throw IoError(out.path + ": cannot write " + out.option + " into '" + target.string() +
                     "': " + why);
   }
 }
@@ -203,15 +249,36 @@ void apply_run_options(const RunArgs& args) {
   set_log_level(args.quiet ? LogLevel::Quiet : args.verbose ? LogLevel::Verbose : LogLevel::Normal);
 }
 
-std::string output_prefix(const std::string& output, const std::string& name) {
+OutputPrefix plan_output_prefix(const std::string& output, const std::string& name) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  if (!output.empty() && (output.back() == '/' || fs::is_directory(output, ec))) {
-    fs::create_directories(output, ec);
-    if (ec) throw IoError(output + ": cannot create directory: " + ec.message());
-    return (fs::path(output) / name).string();
-  }
-  return output;
+  const bool exists = fs::is_directory(output, ec);
+  if (!output.empty() && (output.back() == '/' || exists))
+    return {(fs::path(output) / name).string(), exists ? "" : output};
+  return {output, ""};
+}
+
+namespace {
+
+void create_folder(const std::string& folder) {
+  std::error_code ec;
+  std::filesystem::create_directories(folder, ec);
+  if (ec) throw IoError(folder + ": cannot create directory: " + ec.message());
+}
+
+}  // namespace
+
+std::string output_prefix(const std::string& output, const std::string& name) {
+  const OutputPrefix p = plan_output_prefix(output, name);
+  if (!p.folder.empty()) create_folder(p.folder);
+  return p.prefix;
+}
+
+std::string summary_beside(const std::string& file) {
+  if (writes_in_place(file)) return "";
+  std::filesystem::path p(file);
+  if (p.extension() == ".csv") return p.replace_extension(".json").string();
+  return file + ".json";
 }
 
 Scene load_scene_file(const SceneArgs& args) {
@@ -272,7 +339,8 @@ Scene load_checked_scene(const SceneArgs& args, const JobPlan& plan) {
     const bool camera = std::filesystem::path(f).extension() == ".camera";
     inputs.push_back({k == 0 ? "scene" : camera ? "camera sidecar" : "material library", f});
   }
-  check_job_files(inputs, plan.outputs);
+  check_job_files(inputs, plan.outputs, plan.folders);
+  for (const auto& folder : plan.folders) create_folder(folder);
   return scene;
 }
 

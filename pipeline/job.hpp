@@ -90,9 +90,20 @@ struct LoadedScene {
 /// The BVH of the scene's mesh (built once, with `threads` Embree threads; 0 = all cores).
 const Bvh& scene_bvh(const LoadedScene& scene, int threads);
 
-/// Where a command writing several files puts them: for -o DIR (an existing directory, or
-/// a name ending in '/', created if needed) the prefix DIR/<name>; otherwise -o is the prefix.
+/// Where a command writing several files puts them, and the folder it creates for them.
+struct OutputPrefix {
+  std::string prefix;  ///< DIR/<name> for -o DIR, else -o itself
+  std::string folder;  ///< DIR when it does not exist yet (JobPlan::folders), else empty
+};
+/// The prefix of -o `output`: for DIR (an existing directory, or a name ending in '/') the
+/// prefix DIR/<name>; otherwise -o is the prefix. Creates nothing.
+OutputPrefix plan_output_prefix(const std::string& output, const std::string& name);
+/// plan_output_prefix's prefix, with its folder created now (IoError if it cannot be).
 std::string output_prefix(const std::string& output, const std::string& name);
+
+/// The JSON summary written beside a table -o FILE: FILE.csv gives FILE.json, another name
+/// FILE gives FILE.json; empty for a device or pipe (writes_in_place: nothing beside it).
+std::string summary_beside(const std::string& file);
 
 /// A file a command reads or writes, with the option that names it (for messages).
 struct NamedFile {
@@ -105,6 +116,9 @@ struct NamedFile {
 struct JobPlan {
   std::vector<NamedFile> inputs;        ///< besides the scene's own files (Scene::files)
   std::vector<NamedFile> outputs;       ///< every file the command may write
+  /// Folders the job creates (-o DIR/): outputs may go into them; load_scene creates them
+  /// once the files are checked.
+  std::vector<std::string> folders;
   std::optional<FormFactorOptions> ff;  ///< F that will be computed here (none: loaded or unused)
   std::string max_memory;               ///< RunArgs::max_memory
   bool direct = false;  ///< the job solves with `direct`: its factorisation is counted (for a
@@ -128,9 +142,13 @@ std::optional<MemoryLimit> job_memory_limit(const std::string& max_memory);
 JobPlan job_plan(const RunArgs& run);
 
 /// Refuses (UsageError) an output that is an input or another output (paths compared after
-/// std::filesystem::weakly_canonical, so ./a/../s.obj is s.obj), then checks that every
-/// output directory accepts a new file by creating and removing a probe file (IoError).
-void check_job_files(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs);
+/// std::filesystem::weakly_canonical, so ./a/../s.obj is s.obj; a device or pipe may take
+/// several), or whose directory neither exists nor is in (or under) `folders`, the folders
+/// the job will create; then checks that every output directory (for one to be created, its
+/// nearest existing ancestor) accepts a new file by creating and removing a probe file, and
+/// that a device or pipe is writable (IoError).
+void check_job_files(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs,
+                     const std::vector<std::string>& folders = {});
 
 /// Refuses (UsageError) a job whose estimated peak memory (mesh_peak_bytes, and
 /// form_factor_peak_bytes for plan.ff, and direct_memory_bytes at the all-pairs bound for

@@ -530,7 +530,7 @@ std::vector<OptionSpec> make_specs() {
               .on({"run"}));
   add_row(text("--output", "FILE", output_file_error, "radiosity.csv",
                "Per-patch radiosity CSV (patch,surface,area,R,G,B); the summary goes to the "
-               "same name with .json")
+               "same name with .json (none beside a device such as /dev/null)")
               .on({"solve"}));
   add_row(text("--output", "FILE", output_file_error, "render.exr",
                "Rendered linear HDR image (OpenEXR)")
@@ -590,19 +590,28 @@ std::vector<OptionSpec> make_specs() {
   std::vector<std::string> units;
   for (const auto& [name, metres] : length_units()) units.push_back(name);
   add_row(choice("--length-unit", units, "m", "Unit of the scene's coordinates").on({"heat"}));
-  add_row(text("--output", "DIR/|PREFIX", output_prefix_error, "heat",
-               "Output prefix: PREFIX_surfaces.csv, PREFIX_patches.csv, PREFIX.json (a folder "
-               "DIR/ gives DIR/heat_*)")
+  // heat's files may go into the folder its -o DIR/ creates: their folders are checked by
+  // the job's plan (check_job_files), which knows it, not when the line is parsed.
+  add_row(text("--output", "FILE.csv|DIR/|PREFIX", output_prefix_error, "heat",
+               "FILE.csv: the per-surface table, its summary FILE.json (none for a device "
+               "such as /dev/null); PREFIX: PREFIX_surfaces.csv, PREFIX_patches.csv, "
+               "PREFIX.json (a folder DIR/ gives DIR/heat_*)")
               .on({"heat"}));
-  add_row(text("--vertex-exr", "FILE", output_file_error, "",
+  add_row(text("--patches-csv", "FILE", nullptr, "",
+               "Per-patch table (T, J, H, q, Q); with -o PREFIX instead of PREFIX_patches.csv")
+              .on({"heat"}));
+  add_row(text("--conductors", "FILE", nullptr, "",
+               "Radiative conductors GR_ij = e_i A_i B_ij (m^2, Gebhart factors B) per "
+               "surface pair, and to the environment, as a CSV matrix (also in the summary)")
+              .on({"heat"}));
+  add_row(text("--vertex-exr", "FILE", nullptr, "",
                "Per-vertex EXR with channels temperature (K), heat_flux (W/m^2), radiosity")
               .on({"heat"}));
-  add_row(text("--ply", "FILE", output_file_error, "",
+  add_row(text("--ply", "FILE", nullptr, "",
                "PLY mesh coloured by --image-quantity, with temperature, heat_flux, radiosity")
               .on({"heat"}));
-  add_row(
-      text("--image", "FILE", output_file_error, "", "Colour-mapped rendering (PNG) with a legend")
-          .on({"heat"}));
+  add_row(text("--image", "FILE", nullptr, "", "Colour-mapped rendering (PNG) with a legend")
+              .on({"heat"}));
   add_row(choice("--image-quantity", {"temperature", "flux"}, "temperature",
                  "What --image and --ply colour")
               .on({"heat"}));
