@@ -80,7 +80,8 @@ struct MeshPlanStats {
   std::int64_t terms = 0;  ///< terms summed by those evaluations (edge classes and their products)
 };
 
-/// What mesh_scene will build, computed without building it (O(faces) per trial edge).
+/// What mesh_scene will build, computed without building it (O(faces log faces) once, then
+/// O(surfaces + edge classes) per trial edge).
 struct MeshPlan {
   double max_edge = 0.0;     ///< the edge bound mesh_scene will use
   std::int64_t patches = 0;  ///< the exact patch count it will produce
