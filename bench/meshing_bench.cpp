@@ -20,10 +20,19 @@
 // Log-log slopes of error against patches are printed per method; --plot FILE.svg writes
 // error versus patches (both errors, log-log).
 //
+// Plan (issue 35, item 2): the time of the meshing plan (plan_mesh: the edge bound for a patch
+// target) against input size, on two generated families of about n triangles: the bumpy grid
+// (tests/common/bumpy_grid.hpp: one connected surface, like a scanned model) and the Cornell
+// box with tessellated objects (bench/scene_generator.hpp: sqrt(n)/2 surfaces). Per size the
+// median of 3 runs of the plan for 2,000 patches and for n patches, and of plan + mesh_scene
+// for n (what `lambert info --patches n` does after loading); then the cost exponent p of
+// each column, fitted as time ~ c n^p in log-log (bench/power_law.hpp).
+//
 // Usage: meshing_bench [--targets 300,1000,3000] [--samples 64] [--ref-patches 48000]
-//   [--sections shadow,cornell] [--plot meshing.svg]
+//   [--sizes 10000,20000,40000,80000] [--sections shadow,cornell,plan] [--plot meshing.svg]
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -32,6 +41,9 @@
 #include <tuple>
 #include <vector>
 
+#include "bench/power_law.hpp"
+#include "bench/scene_generator.hpp"
+#include "common/bumpy_grid.hpp"
 #include "core/timer.hpp"
 #include "geometry/analytic.hpp"
 #include "geometry/formfactors/formfactors.hpp"
@@ -134,18 +146,67 @@ double slope(const std::vector<Run>& runs, const std::string& method, bool line)
   return (n * sxy - sx * sy) / (n * sxx - sx * sx);
 }
 
+// The median of 3 timings of f() (seconds).
+template <class F>
+double median_of_3(F&& f) {
+  std::vector<double> t;
+  for (int k = 0; k < 3; ++k) {
+    Timer timer;
+    f();
+    t.push_back(timer.seconds());
+  }
+  std::sort(t.begin(), t.end());
+  return t[1];
+}
+
+// The plan section: plan and plan + mesh times against input size, and their exponents.
+void plan_section(const std::vector<long>& sizes) {
+  std::printf("\nmeshing plan against input size (medians of 3)\n");
+  std::printf("%-8s %9s %8s %12s %12s %14s %11s %9s\n", "family", "triangles", "surfaces",
+              "plan 2000 s", "plan n s", "plan+mesh n s", "evaluations", "terms");
+  for (const std::string family : {"grid", "objects"}) {
+    std::vector<std::pair<double, double>> coarse, fine, meshed;
+    for (const long n : sizes) {
+      const Scene scene = family == "grid"
+                              ? test::bumpy_grid(static_cast<int>(std::lround(std::sqrt(n / 2.0))))
+                              : bench::cornell_with_objects(n);
+      const auto tris = static_cast<double>(bench::triangle_count(scene));
+      const MeshOptions to_2000{0, 2000}, to_n{0, n};
+      MeshPlan plan;
+      coarse.emplace_back(tris, median_of_3([&] { plan_mesh(scene, to_2000); }));
+      fine.emplace_back(tris, median_of_3([&] { plan = plan_mesh(scene, to_n); }));
+      meshed.emplace_back(tris, median_of_3([&] {
+                            MeshOptions o = to_n;
+                            o.max_edge = plan_mesh(scene, to_n).max_edge;
+                            mesh_scene(scene, o);
+                          }));
+      std::printf("%-8s %9.0f %8zu %12.4f %12.4f %14.4f %11lld %9lld\n", family.c_str(), tris,
+                  scene.surfaces.size(), coarse.back().second, fine.back().second,
+                  meshed.back().second, static_cast<long long>(plan.stats.evaluations),
+                  static_cast<long long>(plan.stats.terms));
+      std::fflush(stdout);
+    }
+    std::printf(
+        "cost exponent (time ~ n^p) %-8s plan 2000 p %5.2f  plan n p %5.2f  plan+mesh n p %5.2f\n",
+        family.c_str(), fit_power_law(coarse).p, fit_power_law(fine).p, fit_power_law(meshed).p);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<long> targets = {300, 1000, 3000};
+  std::vector<long> sizes = {10000, 20000, 40000, 80000};
   int samples = 64;
   long ref_patches = 48000;
-  std::string sections = "shadow,cornell", plot;
+  std::string sections = "shadow,cornell,plan", plot;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i], v = argv[i + 1];
     if (a == "--targets") targets = parse_list(v);
     else if (a == "--samples") samples = std::stoi(v);
     else if (a == "--ref-patches") ref_patches = std::stol(v);
+    else if (a == "--sizes")
+      sizes = parse_list(v);
     else if (a == "--sections") sections = v;
     else if (a == "--plot") plot = v;
     else {
@@ -208,6 +269,7 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
       }
   }
+  if (sections.find("plan") != std::string::npos) plan_section(sizes);
   if (!plot.empty() && !runs.empty()) {
     Plot l1{"partial shadow: floor L1 error", "patches", "error (W/m^2)", true, true, true, {}};
     Plot line{"partial shadow: max error on y = 1.75", "patches", "error (W/m^2)", true, true, true, {}};

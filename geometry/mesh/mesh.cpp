@@ -146,21 +146,23 @@ EdgeClasses edge_classes(const SurfaceElements& s) {
   return c;
 }
 
-// Segments per class for `max_edge` (1 when max_edge <= 0: one element per face). Capped at
-// 1e9 segments so that counts and their products stay inside int64; any such mesh is refused
-// by mesh_scene's patch limit anyway.
+// Segments on an edge class whose longest edge is `longest`, for `max_edge` (1 when max_edge
+// <= 0: one element per face). Capped at 1e9 segments so that counts and their products stay
+// inside int64; any such mesh is refused by mesh_scene's patch limit anyway.
+std::int64_t segments(double longest, double max_edge) {
+  if (max_edge <= 0) return 1;
+  return static_cast<std::int64_t>(std::clamp(std::ceil(longest / max_edge), 1.0, 1e9));
+}
+
+// Segments per class for `max_edge`.
 std::vector<std::int64_t> class_counts(const EdgeClasses& c, double max_edge) {
-  std::vector<std::int64_t> n(c.longest.size(), 1);
-  if (max_edge > 0)
-    for (std::size_t k = 0; k < n.size(); ++k)
-      n[k] = static_cast<std::int64_t>(std::clamp(std::ceil(c.longest[k] / max_edge), 1.0, 1e9));
+  std::vector<std::int64_t> n(c.longest.size());
+  for (std::size_t k = 0; k < n.size(); ++k) n[k] = segments(c.longest[k], max_edge);
   return n;
 }
 
 // Segment counts per edge satisfying the conformity constraints (see mesh_scene).
-std::unordered_map<std::uint64_t, std::int64_t> edge_counts(const SurfaceElements& s,
-                                                            double max_edge) {
-  const EdgeClasses c = edge_classes(s);
+std::unordered_map<std::uint64_t, std::int64_t> edge_counts(const EdgeClasses& c, double max_edge) {
   const std::vector<std::int64_t> n = class_counts(c, max_edge);
   std::unordered_map<std::uint64_t, std::int64_t> count;
   count.reserve(c.edge.size());
@@ -168,15 +170,60 @@ std::unordered_map<std::uint64_t, std::int64_t> edge_counts(const SurfaceElement
   return count;
 }
 
-// Patches of one surface at `max_edge`, from its edge classes (O(elements)).
-std::int64_t count_patches(const SurfaceElements& s, const EdgeClasses& c, double max_edge) {
-  const std::vector<std::int64_t> n = class_counts(c, max_edge);
-  std::int64_t total = 0;
+// total + w a b, saturating at INT64_MAX (a plan for an absurd edge bound must still be
+// refused by the patch limit, not wrap around).
+std::int64_t add_product(std::int64_t total, std::int64_t w, std::int64_t a, std::int64_t b) {
+  std::int64_t p = 0;
+  if (__builtin_mul_overflow(w, a, &p) || __builtin_mul_overflow(p, b, &p) ||
+      __builtin_add_overflow(total, p, &p))
+    return INT64_MAX;
+  return p;
+}
+
+// The patch count of one surface as a function of the edge bound h, in closed form over its
+// edge classes. With n_c(h) = segments(L_c, h) on class c (L_c its longest edge), a triangle
+// of class c makes n_c² patches and a quad whose opposite-edge pairs are classes a and b
+// makes n_a n_b, so
+//   count(h) = sum_c T_c n_c(h)² + sum_(a,b) Q_ab n_a(h) n_b(h),
+// T_c and Q_ab the numbers of such elements: exactly the sum over elements that subdivide
+// makes, in integers. Built once per surface in O(elements) (hashing); an evaluation costs
+// O(terms), the distinct classes of triangles and class pairs of quads, instead of a hash
+// lookup per element: a connected triangle mesh (a scan) is one class, one term.
+struct SurfaceCount {
+  struct Term {
+    double la = 0.0, lb = 0.0;  ///< the longest edges of the term's classes (la = lb: triangles)
+    std::int64_t elements = 0;  ///< T_c or Q_ab
+  };
+  std::vector<Term> terms;
+  std::int64_t elements = 0;  ///< the surface's elements (one patch each when h is coarse)
+  double area = 0.0;          ///< their area (scene units²)
+};
+
+// The closed form of the surface's count (O(elements)).
+SurfaceCount surface_count(const SurfaceElements& s, const EdgeClasses& c, double area) {
+  SurfaceCount out;
+  out.elements = static_cast<std::int64_t>(s.elements.size());
+  out.area = area;
+  const auto classes = static_cast<std::uint64_t>(c.longest.size());
+  std::unordered_map<std::uint64_t, std::int32_t> term;  // a * classes + b (a = b: triangles)
   for (const auto& e : s.elements) {
-    const auto n0 = n[c.edge.at(edge_key(e.v[0], e.v[1]))];
-    const auto n1 = n[c.edge.at(edge_key(e.v[1], e.v[2]))];
-    total += e.n == 3 ? n0 * n0 : n0 * n1;
+    const std::uint64_t a = static_cast<std::uint64_t>(c.edge.at(edge_key(e.v[0], e.v[1])));
+    const std::uint64_t b =
+        e.n == 3 ? a : static_cast<std::uint64_t>(c.edge.at(edge_key(e.v[1], e.v[2])));
+    const auto [it, added] =
+        term.emplace(a * classes + b, static_cast<std::int32_t>(out.terms.size()));
+    if (added) out.terms.push_back({c.longest[a], c.longest[b], 0});
+    ++out.terms[it->second].elements;
   }
+  return out;
+}
+
+// Patches of one surface at `max_edge` (O(terms); counted in `stats`).
+std::int64_t count_patches(const SurfaceCount& s, double max_edge, MeshPlanStats& stats) {
+  std::int64_t total = 0;
+  for (const auto& t : s.terms)
+    total = add_product(total, t.elements, segments(t.la, max_edge), segments(t.lb, max_edge));
+  stats.terms += static_cast<std::int64_t>(s.terms.size());
   return total;
 }
 
@@ -211,9 +258,9 @@ Patch make_patch(const PatchMesh& mesh, std::array<std::int32_t, 4> v, int n) {
 namespace {
 
 // Emits the patches of one surface into `mesh`.
-void subdivide(const SurfaceElements& s, double max_edge, std::int32_t surface, const Material& mat,
-               PatchMesh& mesh) {
-  const auto count = edge_counts(s, max_edge);
+void subdivide(const SurfaceElements& s, const EdgeClasses& classes, double max_edge,
+               std::int32_t surface, const Material& mat, PatchMesh& mesh) {
+  const auto count = edge_counts(classes, max_edge);
   auto new_vertex = [&](const Eigen::Vector3d& p) {
     mesh.vertices.push_back(p);
     mesh.vertex_surface.push_back(surface);
@@ -361,94 +408,125 @@ std::string thousands(std::int64_t n) {  // 69938 -> "69,938"
   return out;
 }
 
-MeshPlan plan_surfaces(const Scene& scene, const std::vector<SurfaceElements>& surfaces,
-                       const MeshOptions& options) {
-  LAMBERT_CHECK(options.max_edge >= 0 && options.target_patches >= 0, "negative mesh target");
-  std::vector<EdgeClasses> classes;  // once per surface, reused by every step of the search
-  classes.reserve(surfaces.size());
-  for (const auto& s : surfaces) classes.push_back(edge_classes(s));
-  auto total = [&](double h) {
-    std::int64_t t = 0;
-    for (std::size_t k = 0; k < surfaces.size(); ++k)
-      t += count_patches(surfaces[k], classes[k], h);
-    return t;
-  };
-  double max_edge = options.max_edge;
-  MeshPlan plan;
-  if (max_edge <= 0 && options.target_patches > 0) {
-    // The target is met by area: a surface that the edge h subdivides counts its patches;
-    // one that h leaves as its own elements (a detailed object finer than h, or a small
-    // face) counts its area share A_s / h², not its element count. So a 3,000-triangle
-    // bunny in a box takes its area's share of the budget and the walls keep theirs (it
-    // took 3,000 of 3,020 and left every wall one patch); the mesh then exceeds the target
-    // by the detail it cannot drop, and the plan says so. Non-increasing in h: bisection.
-    std::vector<double> area(surfaces.size());
-    for (std::size_t k = 0; k < surfaces.size(); ++k) area[k] = elements_area(surfaces[k]);
-    auto budget = [&](double h) {
-      double t = 0.0;
-      for (std::size_t k = 0; k < surfaces.size(); ++k) {
-        const std::int64_t c = count_patches(surfaces[k], classes[k], h);
-        const auto elements = static_cast<std::int64_t>(surfaces[k].elements.size());
-        t += c > elements ? static_cast<double>(c)
-                          : std::min(static_cast<double>(elements), area[k] / (h * h));
-      }
-      return t;
-    };
-    const auto [lo_corner, hi_corner] = scene.bounds();
-    double hi = (hi_corner - lo_corner).norm();  // one element per edge or fewer
-    double lo = hi * 1e-4;
-    const double target = static_cast<double>(options.target_patches);
-    if (budget(lo) < target) {
-      max_edge = lo;
-    } else {
-      for (int it = 0; it < 60; ++it) {
-        const double mid = std::sqrt(lo * hi);
-        (budget(mid) > target ? lo : hi) = mid;
-      }
-      // Pick whichever bracket is closer to the target.
-      max_edge = std::abs(budget(lo) - target) < std::abs(budget(hi) - target) ? lo : hi;
-    }
-    // Where the mesh exceeds the target by more than 10 %, name the detail that made it.
-    const std::int64_t made = total(max_edge);
-    if (static_cast<double>(made) > 1.1 * target) {
-      std::size_t worst = 0, detailed = 0;
-      std::int64_t worst_elements = -1, detail_faces = 0;
-      for (std::size_t k = 0; k < surfaces.size(); ++k) {
-        const auto elements = static_cast<std::int64_t>(surfaces[k].elements.size());
-        if (count_patches(surfaces[k], classes[k], max_edge) != elements || elements < 2) continue;
-        ++detailed;
-        detail_faces += elements;
-        if (elements > worst_elements) {
-          worst = k;
-          worst_elements = elements;
-        }
-      }
-      if (detailed == 0)  // the mesh's steps: no edge length gives closer to the target
-        plan.note = "meshing: " + thousands(made) + " patches for the target of " +
-                    thousands(options.target_patches) +
-                    ": the count near it that the uniform subdivision of these faces gives (" +
-                    thousands(static_cast<std::int64_t>(scene.faces.size())) +
-                    " faces; --max-edge or --patches to choose)";
-      else
-        plan.note = "meshing: the target of " + thousands(options.target_patches) +
-                    " patches grew to " + thousands(made) + ": " +
-                    (detailed == 1 ? std::string("a detailed surface keeps")
-                                   : thousands(static_cast<std::int64_t>(detailed)) +
-                                         " detailed surfaces keep") +
-                    " one patch per face (" + thousands(detail_faces) + " faces; the largest, '" +
-                    scene.surfaces[worst].name + "', has " + thousands(worst_elements) +
-                    "); the others get their area's share";
+// Every surface's closed-form count (SurfaceCount), from its elements and edge classes.
+std::vector<SurfaceCount> surface_counts(const std::vector<SurfaceElements>& surfaces,
+                                         const std::vector<EdgeClasses>& classes) {
+  std::vector<SurfaceCount> counts;
+  counts.reserve(surfaces.size());
+  for (std::size_t k = 0; k < surfaces.size(); ++k)
+    counts.push_back(surface_count(surfaces[k], classes[k], elements_area(surfaces[k])));
+  return counts;
+}
+
+// The scene's patches at edge bound h (saturating at INT64_MAX): one evaluation.
+std::int64_t scene_patches(const std::vector<SurfaceCount>& counts, double h,
+                           MeshPlanStats& stats) {
+  ++stats.evaluations;
+  std::int64_t t = 0;
+  for (const auto& c : counts) t = add_product(t, 1, count_patches(c, h, stats), 1);
+  return t;
+}
+
+// The patch target is met by area: a surface that the edge h subdivides counts its patches;
+// one that h leaves as its own elements (a detailed object finer than h, or a small face)
+// counts its area share A_s / h², not its element count. So a 3,000-triangle bunny in a box
+// takes its area's share of the budget and the walls keep theirs (it took 3,000 of 3,020 and
+// left every wall one patch); the mesh then exceeds the target by the detail it cannot drop,
+// and the plan says so. Non-increasing in h. One evaluation, O(surfaces + terms).
+double scene_budget(const std::vector<SurfaceCount>& counts, double h, MeshPlanStats& stats) {
+  ++stats.evaluations;
+  double t = 0.0;
+  for (const auto& s : counts) {
+    const std::int64_t c = count_patches(s, h, stats);
+    t += c > s.elements ? static_cast<double>(c)
+                        : std::min(static_cast<double>(s.elements), s.area / (h * h));
+  }
+  return t;
+}
+
+// The edge bound whose budget is closest to `target`: 60 geometric bisection steps between
+// 1e-4 and 1 scene diagonal, so 63 evaluations of scene_budget whatever the input size
+// (O(63 (surfaces + terms)) in all).
+double search_edge(const Scene& scene, const std::vector<SurfaceCount>& counts, double target,
+                   MeshPlanStats& stats) {
+  const auto [lo_corner, hi_corner] = scene.bounds();
+  double hi = (hi_corner - lo_corner).norm();  // one element per edge or fewer
+  double lo = hi * 1e-4;
+  if (scene_budget(counts, lo, stats) < target) return lo;
+  for (int it = 0; it < 60; ++it) {
+    const double mid = std::sqrt(lo * hi);
+    (scene_budget(counts, mid, stats) > target ? lo : hi) = mid;
+  }
+  // Pick whichever bracket is closer to the target.
+  const double at_lo = scene_budget(counts, lo, stats), at_hi = scene_budget(counts, hi, stats);
+  return std::abs(at_lo - target) < std::abs(at_hi - target) ? lo : hi;
+}
+
+// The log line for a mesh of `made` patches that exceeds `target` by more than 10 %: the
+// detail that made it (surfaces that keep one patch per face), or the mesh's steps.
+std::string detail_note(const Scene& scene, const std::vector<SurfaceCount>& counts,
+                        std::int64_t target, double max_edge, std::int64_t made,
+                        MeshPlanStats& stats) {
+  ++stats.evaluations;  // every surface's count at max_edge
+  std::size_t worst = 0, detailed = 0;
+  std::int64_t worst_elements = -1, detail_faces = 0;
+  for (std::size_t k = 0; k < counts.size(); ++k) {
+    const std::int64_t elements = counts[k].elements;
+    if (count_patches(counts[k], max_edge, stats) != elements || elements < 2) continue;
+    ++detailed;
+    detail_faces += elements;
+    if (elements > worst_elements) {
+      worst = k;
+      worst_elements = elements;
     }
   }
-  plan.max_edge = max_edge;
-  plan.patches = total(max_edge);
+  if (detailed == 0)  // the mesh's steps: no edge length gives closer to the target
+    return "meshing: " + thousands(made) + " patches for the target of " + thousands(target) +
+           ": the count near it that the uniform subdivision of these faces gives (" +
+           thousands(static_cast<std::int64_t>(scene.faces.size())) +
+           " faces; --max-edge or --patches to choose)";
+  return "meshing: the target of " + thousands(target) + " patches grew to " + thousands(made) +
+         ": " +
+         (detailed == 1
+              ? std::string("a detailed surface keeps")
+              : thousands(static_cast<std::int64_t>(detailed)) + " detailed surfaces keep") +
+         " one patch per face (" + thousands(detail_faces) + " faces; the largest, '" +
+         scene.surfaces[worst].name + "', has " + thousands(worst_elements) +
+         "); the others get their area's share";
+}
+
+// The plan from every surface's closed-form count: one evaluation, O(surfaces + terms), for
+// an edge bound; for a patch target 63 for the search, 2 for the count (3 with the note).
+MeshPlan plan_counts(const Scene& scene, const std::vector<SurfaceCount>& counts,
+                     const MeshOptions& options) {
+  LAMBERT_CHECK(options.max_edge >= 0 && options.target_patches >= 0, "negative mesh target");
+  MeshPlan plan;
+  plan.max_edge = options.max_edge;
+  if (plan.max_edge <= 0 && options.target_patches > 0) {
+    const double target = static_cast<double>(options.target_patches);
+    plan.max_edge = search_edge(scene, counts, target, plan.stats);
+    const std::int64_t made = scene_patches(counts, plan.max_edge, plan.stats);
+    if (static_cast<double>(made) > 1.1 * target)
+      plan.note =
+          detail_note(scene, counts, options.target_patches, plan.max_edge, made, plan.stats);
+  }
+  plan.patches = scene_patches(counts, plan.max_edge, plan.stats);
   return plan;
+}
+
+// Every surface's edge classes (O(elements) hashing).
+std::vector<EdgeClasses> all_edge_classes(const std::vector<SurfaceElements>& surfaces) {
+  std::vector<EdgeClasses> classes;
+  classes.reserve(surfaces.size());
+  for (const auto& s : surfaces) classes.push_back(edge_classes(s));
+  return classes;
 }
 
 }  // namespace
 
 MeshPlan plan_mesh(const Scene& scene, const MeshOptions& options) {
-  return plan_surfaces(scene, collect_all(scene), options);
+  const std::vector<SurfaceElements> surfaces = collect_all(scene);
+  return plan_counts(scene, surface_counts(surfaces, all_edge_classes(surfaces)), options);
 }
 
 double mesh_peak_bytes(std::int64_t patches) {
@@ -462,7 +540,8 @@ double mesh_peak_bytes(std::int64_t patches) {
 
 PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options) {
   const std::vector<SurfaceElements> surfaces = collect_all(scene);
-  const MeshPlan plan = plan_surfaces(scene, surfaces, options);
+  const std::vector<EdgeClasses> classes = all_edge_classes(surfaces);
+  const MeshPlan plan = plan_counts(scene, surface_counts(surfaces, classes), options);
   const double max_edge = plan.max_edge;
   if (plan.patches > kMaxPatches)
     throw UsageError("meshing with max edge " + shortest(max_edge) + " would make " +
@@ -491,7 +570,7 @@ PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options) {
   mesh.max_edge = max_edge;
   mesh.scale = scene.faces.empty() ? 1.0 : std::max((hi - lo).norm(), 1e-300);
   for (size_t s = 0; s < surfaces.size(); ++s) {
-    subdivide(surfaces[s], max_edge, static_cast<std::int32_t>(s),
+    subdivide(surfaces[s], classes[s], max_edge, static_cast<std::int32_t>(s),
               scene.material_of(static_cast<std::int32_t>(s)), mesh);
   }
   LAMBERT_CHECK(mesh.patches.size() < static_cast<size_t>(INT32_MAX), "too many patches");

@@ -74,13 +74,21 @@ struct MeshOptions {
   int threads = 0;  ///< for the discontinuity lines' visibility rays (0 = all cores)
 };
 
-/// What mesh_scene will build, computed without building it (O(faces) per trial edge).
+/// The work of a plan's search for the edge bound (for tests and benchmarks).
+struct MeshPlanStats {
+  std::int64_t evaluations = 0;  ///< whole-scene patch counts evaluated (one per trial edge)
+  std::int64_t terms = 0;  ///< terms summed by those evaluations (edge classes and their products)
+};
+
+/// What mesh_scene will build, computed without building it (O(faces log faces) once, then
+/// O(surfaces + edge classes) per trial edge).
 struct MeshPlan {
   double max_edge = 0.0;     ///< the edge bound mesh_scene will use
   std::int64_t patches = 0;  ///< the exact patch count it will produce
   /// For a patch target: a line for the log when the mesh exceeds the target by more than
   /// 10 % (detail that keeps a patch per face), naming the largest such surface; else "".
   std::string note;
+  MeshPlanStats stats;  ///< what the search cost
 };
 /// The edge bound and patch count mesh_scene(scene, options) will use and produce.
 MeshPlan plan_mesh(const Scene& scene, const MeshOptions& options);

@@ -3,10 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <map>
 #include <set>
+#include <utility>
 
+#include "common/bumpy_grid.hpp"
 #include "core/error.hpp"
+#include "core/sampling.hpp"
 #include "geometry/polygon.hpp"
 
 namespace lambert {
@@ -244,6 +250,170 @@ TEST(Mesh, APatchTargetIsSharedByAreaBesideADetailedObject) {
       << plan.note;
   // Without detail the target is met as before, and nothing is said.
   EXPECT_EQ(plan_mesh(mixed_scene(), {0, 1000}).note, "");
+}
+
+}  // namespace lambert
+
+namespace lambert {
+namespace {
+
+// Small scenes for the plan's reference: per surface a jittered planar grid (z = its index)
+// whose cells are convex quads or pairs of triangles at random, so that triangles and quads
+// share edges and their conformity classes couple; some surfaces are a single face.
+Scene plan_reference_scene(std::uint64_t seed) {
+  Scene s;
+  Rng rng(seed);
+  const int surfaces = 2 + static_cast<int>(rng.next_u64() % 4);
+  for (int k = 0; k < surfaces; ++k) {
+    const std::string name = "s" + std::to_string(k);
+    const int nx = 1 + static_cast<int>(rng.next_u64() % 5),
+              ny = 1 + static_cast<int>(rng.next_u64() % 4);
+    const double size = 0.2 + 3.0 * rng.uniform();  // a wide range of scales
+    std::vector<Eigen::Vector3d> p;
+    for (int i = 0; i <= nx; ++i)
+      for (int j = 0; j <= ny; ++j)
+        p.emplace_back(size * (i + 0.3 * (rng.uniform() - 0.5)),
+                       size * (j + 0.3 * (rng.uniform() - 0.5)), k);
+    auto at = [&](int i, int j) { return p[i * (ny + 1) + j]; };
+    for (int i = 0; i < nx; ++i)
+      for (int j = 0; j < ny; ++j) {
+        const auto a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+        if (rng.uniform() < 0.5) {
+          add_polygon(s, name, white(), {a, b, c, d});
+        } else {
+          add_polygon(s, name, white(), {a, b, c});
+          add_polygon(s, name, white(), {a, c, d});
+        }
+      }
+  }
+  return s;
+}
+
+// The plan by brute force, as it was defined before its closed form: per trial edge h, every
+// element edge gets ceil(L / h) segments (clamped to [1, 1e9]), raised to a fixpoint of the
+// conformity rules (a triangle's three edges equal, a quad's opposite edges equal, a shared
+// edge one count), and the patches are summed over the elements; the budget and the 60-step
+// bisection are mesh.cpp's. Only for triangles and convex quads (no faces to triangulate).
+struct PlanReference {
+  struct Surface {
+    std::vector<std::vector<Eigen::Vector3d>> elements;
+    double area = 0.0;
+  };
+  std::vector<Surface> surfaces;
+  double diagonal = 0.0;
+
+  explicit PlanReference(const Scene& s) {
+    surfaces.resize(s.surfaces.size());
+    for (const auto& f : s.faces) {
+      std::vector<Eigen::Vector3d> e;
+      for (auto v : f.vertices) e.push_back(s.vertices[v]);
+      Surface& out = surfaces[f.surface];
+      out.area += 0.5 * (e[1] - e[0]).cross(e[2] - e[0]).norm();
+      if (e.size() == 4) out.area += 0.5 * (e[2] - e[0]).cross(e[3] - e[0]).norm();
+      out.elements.push_back(e);
+    }
+    const auto [lo, hi] = s.bounds();
+    diagonal = (hi - lo).norm();
+  }
+  static std::int64_t count(const Surface& s, double h) {
+    using Key = std::pair<std::array<double, 3>, std::array<double, 3>>;
+    auto key = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+      std::array<double, 3> x{a.x(), a.y(), a.z()}, y{b.x(), b.y(), b.z()};
+      return x < y ? Key{x, y} : Key{y, x};
+    };
+    std::map<Key, std::int64_t> n;
+    auto edge = [&](const std::vector<Eigen::Vector3d>& e, std::size_t k) -> std::int64_t& {
+      const auto& a = e[k % e.size()];
+      const auto& b = e[(k + 1) % e.size()];
+      auto [it, added] = n.emplace(key(a, b), 1);
+      if (added && h > 0)
+        it->second = static_cast<std::int64_t>(std::clamp(std::ceil((a - b).norm() / h), 1.0, 1e9));
+      return it->second;
+    };
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (const auto& e : s.elements) {
+        const std::vector<std::vector<std::size_t>> groups =
+            e.size() == 3 ? std::vector<std::vector<std::size_t>>{{0, 1, 2}}
+                          : std::vector<std::vector<std::size_t>>{{0, 2}, {1, 3}};
+        for (const auto& g : groups) {
+          std::int64_t m = 0;
+          for (auto k : g) m = std::max(m, edge(e, k));
+          for (auto k : g) changed = std::exchange(edge(e, k), m) != m || changed;
+        }
+      }
+    }
+    std::int64_t total = 0;
+    for (const auto& e : s.elements)
+      total += edge(e, 0) * (e.size() == 3 ? edge(e, 0) : edge(e, 1));
+    return total;
+  }
+  std::int64_t patches(double h) const {
+    std::int64_t t = 0;
+    for (const auto& s : surfaces) t += count(s, h);
+    return t;
+  }
+  double budget(double h) const {
+    double t = 0.0;
+    for (const auto& s : surfaces) {
+      const std::int64_t c = count(s, h);
+      const auto elements = static_cast<std::int64_t>(s.elements.size());
+      t += c > elements ? static_cast<double>(c)
+                        : std::min(static_cast<double>(elements), s.area / (h * h));
+    }
+    return t;
+  }
+  double edge_for(double target) const {
+    double hi = diagonal, lo = hi * 1e-4;
+    if (budget(lo) < target) return lo;
+    for (int it = 0; it < 60; ++it) {
+      const double mid = std::sqrt(lo * hi);
+      (budget(mid) > target ? lo : hi) = mid;
+    }
+    return std::abs(budget(lo) - target) < std::abs(budget(hi) - target) ? lo : hi;
+  }
+};
+
+}  // namespace
+
+// Issue 35, item 2: the plan counts patches in closed form over edge classes; its edge bound
+// and patch count are the brute-force definition's exactly (the same doubles), for patch
+// targets and edge bounds, on random mixed scenes; and mesh_scene makes the planned count.
+TEST(MeshPlan, EqualsABruteForceReferenceOnSmallScenes) {
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+    const Scene scene = plan_reference_scene(seed);
+    const PlanReference ref(scene);
+    for (std::int64_t target : {1, 7, 40, 300, 2000}) {
+      const MeshPlan plan = plan_mesh(scene, {0, target});
+      const double h = ref.edge_for(static_cast<double>(target));
+      ASSERT_EQ(plan.max_edge, h) << "seed " << seed << " target " << target;
+      ASSERT_EQ(plan.patches, ref.patches(h)) << "seed " << seed << " target " << target;
+      ASSERT_EQ(mesh_scene(scene, {h, 0}).size(), plan.patches) << "seed " << seed;
+    }
+    for (double h : {0.05, 0.3, 1.0, 10.0})
+      ASSERT_EQ(plan_mesh(scene, {h, 0}).patches, ref.patches(h)) << "seed " << seed;
+  }
+}
+
+// Issue 35, item 2 (info on a 70k-triangle scan took seconds): the plan's search evaluates
+// the scene's count 63 times whatever the input size (66 with the final count and the note),
+// and each evaluation sums the closed form's terms, not the elements: a connected triangle
+// mesh is one edge class, so one term per evaluation. The old search visited every element
+// per evaluation (65 x 20,000 here); asserted on the work counter, not on time.
+TEST(MeshPlan, SearchWorkDoesNotGrowWithTheElementsOfAConnectedSurface) {
+  for (int m : {20, 100}) {  // 800 and 20,000 triangles
+    const Scene scene = test::bumpy_grid(m);
+    for (std::int64_t target : {2000, 2 * m * m}) {
+      const MeshPlan plan = plan_mesh(scene, {0, target});
+      EXPECT_LE(plan.stats.evaluations, 66) << m;
+      EXPECT_EQ(plan.stats.terms, plan.stats.evaluations) << m;  // one term each
+    }
+  }
+  // With several surfaces, a term per surface and class (pair) at most, never per element.
+  const Scene scene = plan_reference_scene(3);
+  const MeshPlan plan = plan_mesh(scene, {0, 500});
+  EXPECT_LE(plan.stats.terms,
+            plan.stats.evaluations * static_cast<std::int64_t>(scene.faces.size()));
 }
 
 }  // namespace lambert
