@@ -3,7 +3,7 @@
 //     and an off-centre mid-plane blocker, perpendicular squares with a fin on the shared
 //     edge, the partial-shadow scene): per --tol, the median time of one pair integral over
 //     5 runs, its true error, the stated error estimate and their ratio, point factors
-//     evaluated and how many went through the polygon booleans;
+//     evaluated and how many were computed from the blockers directly (no cell pattern);
 //  2. a closed room with 0..19 boxes (--room-boxes; 101 polygons with 19, one patch per
 //     face): full F per --tol, time, the largest |row sum - exact| (1; the floor's is
 //     1 - footprint / area, since under the boxes it sees only their backs) and the largest
@@ -77,7 +77,7 @@ std::vector<Case> cases() {
 void few_polygons(const std::vector<double>& tols) {
   std::printf("1. few-polygon cases: one pair integral (median of 5 runs)\n");
   std::printf("%-20s %8s %10s %10s %10s %6s %8s %8s %6s\n", "case", "tol", "ms", "error",
-              "estimate", "ratio", "points", "boolean", "cells");
+              "estimate", "ratio", "points", "direct", "cells");
   for (const Case& c : cases()) {
     for (double tol : tols) {
       std::vector<double> ms;

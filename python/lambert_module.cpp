@@ -52,6 +52,7 @@
 #include "pipeline/problem.hpp"
 #include "pipeline/relight.hpp"
 #include "pipeline/viewer_stage.hpp"
+#include "solvers/gebhart.hpp"
 #include "solvers/radiosity.hpp"
 
 namespace py = pybind11;
@@ -104,6 +105,13 @@ py::array_t<double> adopt_matrix(const Eigen::MatrixX3d& m) {  // N x 3, row-maj
   for (Eigen::Index i = 0; i < m.rows(); ++i)
     for (int c = 0; c < 3; ++c) v[3 * i + c] = m(i, c);
   return adopt(std::move(v), {m.rows(), 3});
+}
+
+py::array_t<double> adopt_dense(const Eigen::MatrixXd& m) {  // rows x cols, row-major copy
+  std::vector<double> v(static_cast<size_t>(m.rows() * m.cols()));
+  for (Eigen::Index i = 0; i < m.rows(); ++i)
+    for (Eigen::Index j = 0; j < m.cols(); ++j) v[i * m.cols() + j] = m(i, j);
+  return adopt(std::move(v), {m.rows(), m.cols()});
 }
 
 using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
@@ -807,7 +815,7 @@ PYBIND11_MODULE(_lambert, m) {
       "heat",
       [](const MeshHandle& h, const IndexArray& indptr, const IndexArray& indices,
          const ValueArray& data, const std::string& surfaces_json, double ambient,
-         const std::string& unit, const py::dict& settings, int threads) {
+         const std::string& unit, const py::dict& settings, int threads, bool conductors) {
         SolveOptions o = solve_options_from_keywords(settings);
         if (!(ambient >= 0.0) || !std::isfinite(ambient))
           throw UsageError("ambient_temperature must be finite and >= 0 K");
@@ -860,11 +868,27 @@ PYBIND11_MODULE(_lambert, m) {
         out["closure"] = sol.closure;
         out["max_flux_mismatch"] = sol.max_flux_mismatch;
         out["undefined_temperatures"] = sol.undefined_temperatures;
+        if (conductors) {  // as `lambert heat --conductors` (solvers/gebhart.hpp)
+          RadiativeConductors c;
+          {
+            Released release;
+            c = radiative_conductors(problem, surface_of,
+                                     static_cast<std::int32_t>(h.mesh.surface_names.size()), o);
+          }
+          py::dict d;
+          d["surfaces"] = h.mesh.surface_names;
+          d["GR_m2"] = adopt_dense(c.GR);
+          d["environment_m2"] = vec(c.environment);
+          d["emittance_m2"] = vec(c.emittance);
+          d["status"] = to_string(c.status);
+          d["residual"] = c.residual;
+          out["conductors"] = d;
+        }
         return out;
       },
       py::arg("mesh"), py::arg("indptr"), py::arg("indices"), py::arg("data"),
       py::arg("surfaces_json"), py::arg("ambient_temperature"), py::arg("length_unit"),
-      py::arg("settings"), py::arg("threads"));
+      py::arg("settings"), py::arg("threads"), py::arg("conductors"));
 
   m.def(
       "solve_hierarchical",

@@ -274,15 +274,18 @@ def solve(mesh, F, solver="gauss-seidel", tol=1e-8, max_iterations=10000, omega=
 
 
 def heat(mesh, F, surfaces, ambient_temperature=0.0, length_unit="m", solver="gauss-seidel",
-         tol=1e-8, max_iterations=10000, threads=1):
+         tol=1e-8, max_iterations=10000, threads=1, conductors=False):
     """The CLI's `lambert heat` on a mesh and its view factors F: gray-diffuse radiative
     exchange. `surfaces` maps surface names (or "*") to {"emissivity": e, "temperature": T}
     (kelvin) or {"emissivity": e, "heat_flux": q} (W/m^2), as the --surfaces file;
     `length_unit` ("m", "cm", "mm", "in") the mesh's unit. Returns a dict: per patch T (K), J,
     H, q (W/m^2), Q (W) and area_m2 arrays; `surfaces` (name, area, T, T_min, T_max, J, q, Q);
     environment_power, closure (sum of Q + environment power: ~0), and the solver's report
-    (status, iterations, residual, ...). Bad conditions raise InputError (naming the surface),
-    bad arguments UsageError."""
+    (status, iterations, residual, ...). With `conductors=True` also `conductors`, as
+    `lambert heat --conductors` (docs/thermal.md): surfaces (names), GR_m2 (surfaces x
+    surfaces radiative conductors eps_i A_i B_ij, m^2), environment_m2, emittance_m2 (eps A:
+    each row of a closed enclosure sums to it), status and residual of its solves. Bad
+    conditions raise InputError (naming the surface), bad arguments UsageError."""
     import json
     _check_mesh(mesh)
     if not isinstance(surfaces, dict):
@@ -294,7 +297,7 @@ def heat(mesh, F, surfaces, ambient_temperature=0.0, length_unit="m", solver="ga
     settings = {k: v for k, v in given.items() if not _is_default("solver", k, v)}
     return _lambert.heat(mesh, indptr, indices, data, json.dumps(surfaces),
                          float(ambient_temperature), str(length_unit), settings,
-                         _int(threads, "threads"))
+                         _int(threads, "threads"), bool(conductors))
 
 
 def solve_hierarchical(scene, epsilon=1e-4, min_area=0.0, link_rays=16, tol=1e-6,

@@ -364,6 +364,39 @@ def test_heat_equals_the_cli_on_the_stl_example(tmp_path):
         lambert.heat(mesh, F, [("heater", 800)])
 
 
+def test_heat_conductors_equal_the_cli_and_are_reciprocal(tmp_path):
+    """lambert.heat(conductors=True) gives `lambert heat --conductors`' matrix bit for bit
+    (the same F and solver; the CSV holds 17 significant digits), GR is symmetric to the
+    conductor solves' tolerance (1e-10 relative: each J^(S) is solved to it), and each row
+    plus its environment share is eps A (every emitted watt ends somewhere)."""
+    root = os.path.join(os.path.dirname(__file__), "..", "..", "data", "thermal_box")
+    stl = os.path.join(root, "thermal_box.stl")
+    conditions = {"heater": {"emissivity": 0.9, "temperature": 800},
+                  "cold_plate": {"emissivity": 0.8, "temperature": 300},
+                  "walls": {"emissivity": 0.5, "heat_flux": 0}}
+    import csv
+    import json
+    surfaces_file = tmp_path / "surfaces.json"
+    surfaces_file.write_text(json.dumps(conditions))
+    run_cli("heat", stl, "--surfaces", surfaces_file, "--length-unit", "mm", "--patches", 120,
+            "--estimator", "hybrid", "--samples", 8, "--seed", 5, "--tol", 1e-10, "-q",
+            "-o", tmp_path / "h.csv", "--conductors", tmp_path / "gr.csv")
+    mesh = lambert.load_scene(stl).mesh(patches=120)
+    F = lambert.form_factors(mesh, estimator="hybrid", samples=8, seed=5)
+    r = lambert.heat(mesh, F, conditions, length_unit="mm", tol=1e-10, conductors=True)
+    c = r["conductors"]
+    with open(tmp_path / "gr.csv") as f:
+        rows = list(csv.reader(f))
+    assert rows[0][1:-1] == c["surfaces"]
+    cli = np.array([[float(v) for v in row[1:-1]] for row in rows[1:]])
+    assert np.array_equal(cli, c["GR_m2"])
+    assert np.array_equal(np.array([float(row[-1]) for row in rows[1:]]), c["environment_m2"])
+    GR = c["GR_m2"]
+    assert np.abs(GR - GR.T).max() <= 1e-9 * np.abs(GR).max()
+    assert np.allclose(GR.sum(axis=1) + c["environment_m2"], c["emittance_m2"], rtol=1e-9)
+    assert "conductors" not in lambert.heat(mesh, F, conditions, length_unit="mm")
+
+
 def test_heat_isothermal_enclosure_has_no_net_flux(tmp_path):
     """Every surface of a closed cube at the same T: J* = sigma T^4 solves the system when the
     rows of F sum to 1, so every q = J - H is 0 up to F's and the solver's errors. Rows of the
