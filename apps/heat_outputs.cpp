@@ -11,6 +11,7 @@
 #include "io/exr.hpp"
 #include "io/ply.hpp"
 #include "pipeline/solve_stage.hpp"
+#include "pipeline/viewer_stage.hpp"
 
 namespace lambert {
 namespace {
@@ -90,13 +91,26 @@ void add_heat_output_options(CLI::App* cmd, HeatImageArgs& args) {
   add_declared(cmd, "--ply", args.ply);
   add_declared(cmd, "--image", args.image);
   add_declared(cmd, "--image-quantity", args.quantity);
+  add_declared(cmd, "--glb", args.glb);
   add_camera_options(cmd, args.camera);
 }
+
+namespace {
+
+// --glb FILE: the viewer page beside it, FILE with .html.
+std::string heat_page_path(const HeatImageArgs& args) {
+  return args.glb.empty() ? ""
+                          : std::filesystem::path(args.glb).replace_extension(".html").string();
+}
+
+}  // namespace
 
 void add_heat_outputs_to_plan(JobPlan& plan, const HeatImageArgs& args) {
   plan.outputs.push_back({"--vertex-exr", args.vertex_exr});
   plan.outputs.push_back({"--ply", args.ply});
   plan.outputs.push_back({"--image", args.image});
+  plan.outputs.push_back({"--glb", args.glb});
+  plan.outputs.push_back({"--glb", heat_page_path(args)});
 }
 
 HeatPaths heat_paths(const HeatOptions& o) {
@@ -249,6 +263,15 @@ void print_heat_table(const HeatReport& r) {
 std::vector<std::string> write_heat_images(const HeatReport& r) {
   const HeatImageArgs& a = r.options->images;
   std::vector<std::string> written;
+  if (!a.glb.empty()) {
+    const Camera camera = make_camera(r.loaded->scene, a.camera);
+    const GlbContent glb =
+        heat_viewer_glb({r.loaded->mesh, r.solution->T, r.solution->q, r.solution->J, camera,
+                         r.loaded->scene.source, "lambert heat --surfaces " + r.options->surfaces});
+    const std::string stem = std::filesystem::path(a.glb).stem().string();
+    for (const std::string& f : write_viewer(glb, a.glb, heat_page_path(a), stem))
+      written.push_back(f);
+  }
   if (a.vertex_exr.empty() && a.ply.empty() && a.image.empty()) return written;
   const VertexField field = heat_vertex_field(r);
   const int column = a.quantity == "temperature" ? 0 : 1;

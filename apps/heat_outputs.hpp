@@ -28,6 +28,7 @@ struct HeatImageArgs {
   std::string ply;                       ///< coloured by --image-quantity
   std::string image;                     ///< colour-mapped PNG with a legend
   std::string quantity = "temperature";  ///< temperature or flux
+  std::string glb;                       ///< glTF of T, q and J, the viewer page beside it
   CameraArgs camera;
 };
 /// Adds the image and per-vertex output options to `heat`.

@@ -543,10 +543,11 @@ std::vector<OptionSpec> make_specs() {
           .on({"render"}));
   add_row(text("--ply", "FILE", output_file_error, "", "Also write the coloured patch mesh as PLY")
               .on({"render"}));
-  add_row(text("--glb", "FILE", output_file_error, "",
-               "Also write the solution as glTF 2.0 with one colour set per light source, and "
-               "the viewer page (FILE with .html; docs/viewer.md)")
-              .on({"render"}));
+  add_row(text("--glb", "FILE", nullptr, "",
+               "Also write the solution as glTF 2.0 (render: one colour set per light source; "
+               "heat: temperature and flux per vertex) and the viewer page (FILE with .html; "
+               "docs/viewer.md)")
+              .on({"render", "heat"}));
   add_row(text("--output", "FILE", output_file_error, "",
                "Output: F.mtx (Matrix Market), F.bin (binary), or JSON with --by-surface/--point")
               .on({"formfactors"}));

@@ -1,6 +1,7 @@
 #include "pipeline/viewer_stage.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <utility>
 
@@ -110,6 +111,43 @@ GlbContent viewer_glb(const ViewerInputs& in, double* linearity_error) {
     lambert["linearity_error"] = error;
   c.asset_extras = {{"lambert", lambert}};
   c.primitive_extras = {{"emitters", names}};
+  return c;
+}
+
+GlbContent heat_viewer_glb(const HeatViewerInputs& in) {
+  const std::int32_t n = in.mesh.size();
+  Eigen::MatrixX3d J(n, 3), Tq(n, 3);
+  J.col(0) = J.col(1) = J.col(2) = in.J;
+  Tq.col(0) = in.T;
+  Tq.col(1) = in.q;
+  Tq.col(2).setZero();
+  ShadedField shaded;
+  shaded.field = interpolate_to_vertices(in.mesh, J, VertexInterpolation::AreaWeighted);
+  shaded.interpolation = "area";
+  const VertexField tq = interpolate_to_vertices(in.mesh, Tq, VertexInterpolation::AreaWeighted);
+  // The picture of J: the PNG's key-value exposure of its mean radiance (J / pi).
+  const double mean = in.J.size() ? in.J.cwiseAbs().mean() / M_PI : 0.0;
+  const double ev = mean > 0.0 ? std::log2(0.36 / mean) : 0.0;
+  static const std::vector<EmitterBasis> kNone;
+  const Daylight none;
+  GlbContent c =
+      viewer_glb({in.mesh, none, in.scene, J, shaded, kNone,
+                  "a heat result is shown by temperature and flux", in.camera, ev, in.settings});
+  std::vector<float> T(static_cast<std::size_t>(tq.size())), q(T.size());
+  std::int64_t undefined = 0;
+  for (std::int32_t k = 0; k < tq.size(); ++k) {
+    const bool ok = std::isfinite(tq.values(k, 0));
+    undefined += ok ? 0 : 1;
+    T[k] = ok ? static_cast<float>(tq.values(k, 0)) : 0.0f;
+    q[k] = std::isfinite(tq.values(k, 1)) ? static_cast<float>(tq.values(k, 1)) : 0.0f;
+  }
+  c.attributes.push_back({"_TEMPERATURE", 1, std::move(T)});
+  c.attributes.push_back({"_HEAT_FLUX", 1, std::move(q)});
+  Json& lambert = c.asset_extras["lambert"];
+  lambert["quantity"] = "heat";
+  lambert["units"] = "temperature K, heat flux W/m^2 (net, leaving), radiosity W/m^2";
+  lambert["default_mode"] = "temperature";
+  lambert["undefined_temperature_vertices"] = undefined;
   return c;
 }
 

@@ -35,6 +35,22 @@ struct ViewerInputs {
 /// bases can follow; the glb then carries conservative ones.
 GlbContent viewer_glb(const ViewerInputs& in, double* linearity_error = nullptr);
 
+/// A heat result for the viewer: the patches' temperature T (K, NaN where undefined), net
+/// flux q and radiosity J (W/m²).
+struct HeatViewerInputs {
+  const PatchMesh& mesh;
+  const Eigen::VectorXd &T, &q, &J;
+  const Camera& camera;
+  std::string scene;     ///< the scene's file (asset.extras)
+  std::string settings;  ///< the settings line
+};
+
+/// The .glb of a heat result: the shading-vertex mesh with _TEMPERATURE (K) and _HEAT_FLUX
+/// (W/m², net, leaving) per vertex, area-weighted like heat's vertex EXR (an undefined
+/// temperature as 0 K, counted in asset.extras), COLOR_0 the thermal radiosity J, the patch
+/// edges and the camera; the viewer opens it on the temperature.
+GlbContent heat_viewer_glb(const HeatViewerInputs& in);
+
 /// Writes `glb` to `glb_path` and the viewer page embedding it to `page_path` (either may be
 /// empty), atomically. Returns the paths written.
 std::vector<std::string> write_viewer(const GlbContent& glb, const std::string& glb_path,

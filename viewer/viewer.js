@@ -90,7 +90,7 @@
     if (attribute('_heat_flux')) modes.push(['flux', 'net heat flux (false colour)']);
     if (!modes.length) return fail('The .glb has no radiosity, temperature or flux per vertex.');
     for (const [value, text] of modes) $('mode').add(new Option(text, value));
-    const wanted = hash.get('mode');
+    const wanted = hash.get('mode') || info.default_mode;  // heat results: the temperature
     $('mode').value = modes.some(([v]) => v === wanted) ? wanted : modes[0][0];
 
     const ramp = rampTexture();

@@ -238,5 +238,38 @@ TEST(Viewer, RenderGlbWritesTheBasesAndThePageAndSaysWhyARadiosityFileHasNone) {
       std::string::npos);
 }
 
+TEST(Viewer, HeatGlbCarriesTheVertexExrsTemperatureAndFluxAndOpensOnTheTemperature) {
+  // `heat --glb FILE` (issue 38: false colour of temperature and flux for heat outputs): the
+  // thermal box, 200 patches. _TEMPERATURE and _HEAT_FLUX are the vertex EXR's temperature
+  // and heat_flux channels (the same area-weighted field, stored as float: equal exactly);
+  // the page beside the glb embeds it and opens on the temperature (default_mode).
+  testing::TempDir dir;
+  const std::string root = std::string(LAMBERT_TEST_DATA_DIR) + "/thermal_box/";
+  const auto [code, err] =
+      run_capturing({"heat", root + "thermal_box.stl", "--surfaces", root + "surfaces.json",
+                     "--length-unit", "mm", "--patches", "200", "-q", "-o", dir.file("out/"),
+                     "--glb", dir.file("out/h.glb"), "--vertex-exr", dir.file("out/h.exr")});
+  ASSERT_EQ(code, 0) << err;
+  const tinygltf::Model m = testing::parse_glb(testing::slurp(dir.file("out/h.glb")));
+  const std::vector<float> T = glb_attribute(m, "_TEMPERATURE");
+  const std::vector<float> q = glb_attribute(m, "_HEAT_FLUX");
+  const VertexExr exr =
+      read_vertex_exr(dir.file("out/h.exr"), {"temperature", "heat_flux", "radiosity"});
+  ASSERT_EQ(static_cast<std::int64_t>(T.size()), exr.vertex_count);
+  ASSERT_EQ(q.size(), T.size());
+  for (std::int64_t k = 0; k < exr.vertex_count; ++k) {
+    ASSERT_EQ(T[k], static_cast<float>(exr.radiosity(k, 0))) << k;
+    ASSERT_EQ(q[k], static_cast<float>(exr.radiosity(k, 1))) << k;
+  }
+  // The heater (800 K) and the cold plate (300 K) bound the walls' temperatures.
+  EXPECT_EQ(*std::max_element(T.begin(), T.end()), 800.0f);
+  EXPECT_EQ(*std::min_element(T.begin(), T.end()), 300.0f);
+  const auto& lambert = m.asset.extras.Get("lambert");
+  EXPECT_EQ(lambert.Get("default_mode").Get<std::string>(), "temperature");
+  EXPECT_EQ(lambert.Get("quantity").Get<std::string>(), "heat");
+  EXPECT_NE(testing::slurp(dir.file("out/h.html")).find("window.LAMBERT_GLB_BASE64"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace lambert

@@ -140,3 +140,29 @@ def test_patch_edges_and_false_colour(cornell_run, tmp_path):
                            for k in range(len(stops) - 1) for t in [np.linspace(0, 1, 32)]])
     distance = np.sqrt(((false[::7, None, :] - ramp[None]) ** 2).sum(axis=2)).min(axis=1)
     assert (distance < 0.03).mean() > 0.97
+
+
+def test_a_heat_page_opens_on_the_temperature_in_false_colour(tmp_path):
+    """`lambert heat --glb` (the thermal box): the page is ready, opens on the temperature
+    (no #mode given) and draws it in viridis with the colour bar; the hot heater (800 K) is
+    the ramp's top, yellow, and the cold plate (300 K) its bottom, purple."""
+    root = os.path.join(os.path.dirname(__file__), "..", "..", "data", "thermal_box")
+    out = tmp_path / "heat"
+    run_cli("heat", os.path.join(root, "thermal_box.stl"), "--surfaces",
+            os.path.join(root, "surfaces.json"), "--length-unit", "mm", "--patches", 200, "-q",
+            "-o", f"{out}/", "--glb", out / "h.glb")
+    dom = chromium(tmp_path, f"file://{out / 'h.html'}")
+    assert 'data-state="ready"' in dom, dom[-2000:]
+    path = tmp_path / "heat.png"
+    chromium(tmp_path, f"file://{out / 'h.html'}#ui=0", screenshot=path)
+    pixels = png(path).reshape(-1, 3)
+    pixels = pixels[pixels.max(axis=1) > 0.1]  # the scene, not the black background
+    stops = np.array(VIRIDIS) / 255.0
+    ramp = np.concatenate([stops[k] + (stops[k + 1] - stops[k]) * t[:, None]
+                           for k in range(len(stops) - 1) for t in [np.linspace(0, 1, 32)]])
+    distance = np.sqrt(((pixels[::7, None, :] - ramp[None]) ** 2).sum(axis=2)).min(axis=1)
+    # Viridis throughout (8-bit rounding and edge blending: as the radiosity test above),
+    # and both ends of the ramp present: the heater's yellow and the cold plate's purple.
+    assert (distance < 0.03).mean() > 0.97
+    assert (np.abs(pixels - stops[-1]).max(axis=1) < 0.03).any()
+    assert (np.abs(pixels - stops[0]).max(axis=1) < 0.03).any()
