@@ -70,7 +70,8 @@ struct RunGlb {
 };
 
 RunGlb run_glb(const testing::TempDir& dir, const std::string& out, std::vector<std::string> args) {
-  args.insert(args.begin(), {"run", "-o", dir.file(out), "--patches", "200", "-q"});
+  args.insert(args.begin(),
+              {"run", "-o", dir.file(out), "--patches", "120", "--size", "128x128", "-q"});
   const auto [code, err] = run_capturing(args);
   EXPECT_EQ(code, 0) << err;
   RunGlb r;
@@ -207,7 +208,7 @@ TEST(Viewer, RenderGlbWritesTheBasesAndThePageAndSaysWhyARadiosityFileHasNone) {
   const std::string glb = dir.file("cb.glb");
   const auto [code, err] =
       run_capturing({"render", "-q", "--patches", "120", "--emit", "tall_block=5,1,1", "--glb", glb,
-                     "-o", dir.file("cb.exr")});
+                     "--size", "128x128", "-o", dir.file("cb.exr")});
   ASSERT_EQ(code, 0) << err;
   const tinygltf::Model m = testing::parse_glb(testing::slurp(glb));
   const auto& lambert = m.asset.extras.Get("lambert");
@@ -227,8 +228,9 @@ TEST(Viewer, RenderGlbWritesTheBasesAndThePageAndSaysWhyARadiosityFileHasNone) {
   const std::string csv = dir.file("B.csv");
   ASSERT_EQ(run_capturing({"solve", "-q", "--patches", "120", "-o", csv}).first, 0);
   const std::string glb2 = dir.file("from_csv.glb");
-  const auto [code2, err2] = run_capturing({"render", "-q", "--patches", "120", "--radiosity", csv,
-                                            "--glb", glb2, "-o", dir.file("from_csv.exr")});
+  const auto [code2, err2] =
+      run_capturing({"render", "-q", "--patches", "120", "--radiosity", csv, "--glb", glb2,
+                     "--size", "128x128", "-o", dir.file("from_csv.exr")});
   ASSERT_EQ(code2, 0) << err2;
   const tinygltf::Model m2 = testing::parse_glb(testing::slurp(glb2));
   EXPECT_FALSE(glb_attribute(m2, "COLOR_0").empty());
