@@ -1,6 +1,6 @@
 // `lambert heat`: gray-diffuse radiative exchange (solvers/thermal.hpp) on a meshed scene with
-// per-surface conditions from a JSON file (io/heat_surfaces.hpp); CSV, JSON, vertex EXR, PLY
-// and a colour-mapped image.
+// per-surface conditions from a JSON file (io/heat_surfaces.hpp); CSV, JSON, vertex EXR, PLY,
+// VTU and a colour-mapped image.
 
 #include <cmath>
 #include <cstdio>
@@ -51,8 +51,15 @@ namespace {
 // for; returns the files written, in order.
 std::vector<std::string> write_heat_outputs(const HeatPaths& paths, HeatReport& report,
                                             const Timer& total) {
-  std::vector<std::string> written = {paths.surfaces_csv};
-  write_heat_surfaces_csv(paths.surfaces_csv, report);
+  std::vector<std::string> written;
+  if (!paths.surfaces_csv.empty()) {
+    write_heat_surfaces_csv(paths.surfaces_csv, report);
+    written.push_back(paths.surfaces_csv);
+  }
+  if (!paths.vtu.empty()) {
+    write_heat_vtu(paths.vtu, report);
+    written.push_back(paths.vtu);
+  }
   if (!paths.patches_csv.empty()) {
     write_heat_patches_csv(paths.patches_csv, report);
     written.push_back(paths.patches_csv);

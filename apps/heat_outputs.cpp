@@ -10,6 +10,7 @@
 #include "io/colormap.hpp"
 #include "io/exr.hpp"
 #include "io/ply.hpp"
+#include "io/vtu.hpp"
 #include "pipeline/solve_stage.hpp"
 #include "pipeline/viewer_stage.hpp"
 
@@ -120,6 +121,12 @@ HeatPaths heat_paths(const HeatOptions& o) {
   const OutputPrefix prefix = plan_output_prefix(o.output, "heat");
   std::error_code ec;
   const bool folder = !prefix.folder.empty() || fs::is_directory(o.output, ec);
+  if (!folder && fs::path(o.output).extension() == ".vtu") {
+    p.vtu = o.output;
+    p.json = fs::path(o.output).replace_extension(".json").string();
+    p.patches_csv = o.patches_csv;
+    return p;
+  }
   if (!folder && (writes_in_place(o.output) || fs::path(o.output).extension() == ".csv")) {
     p.surfaces_csv = o.output;
     p.json = summary_beside(o.output);
@@ -135,6 +142,7 @@ HeatPaths heat_paths(const HeatOptions& o) {
 
 void add_heat_paths_to_plan(JobPlan& plan, const HeatPaths& paths) {
   plan.outputs.push_back({"-o", paths.surfaces_csv});
+  plan.outputs.push_back({"-o", paths.vtu});
   plan.outputs.push_back({"--patches-csv", paths.patches_csv});
   plan.outputs.push_back({"the summary", paths.json});
   plan.outputs.push_back({"--conductors", paths.conductors_csv});
@@ -184,6 +192,65 @@ void write_heat_patches_csv(const std::string& path, const HeatReport& r) {
           << csv_number(s.T[i]) << ',' << csv_number(s.J[i]) << ',' << csv_number(s.H[i]) << ','
           << csv_number(s.q[i]) << ',' << csv_number(s.Q[i]) << '\n';
   });
+}
+
+void write_heat_vtu(const std::string& path, const HeatReport& r) {
+  const PatchMesh& mesh = r.loaded->mesh;
+  const ThermalSolution& s = *r.solution;
+  const auto column = [](const Eigen::VectorXd& v) {
+    return std::vector<double>(v.data(), v.data() + v.size());
+  };
+  VtuContent c;
+  std::vector<std::int32_t> surface(mesh.size());
+  for (std::int32_t i = 0; i < mesh.size(); ++i) surface[i] = mesh.patches[i].surface;
+  c.cell_data = {{"T_K", column(s.T)},
+                 {"q_W_m2", column(s.q)},
+                 {"Q_W", column(s.Q)},
+                 {"J_W_m2", column(s.J)},
+                 {"H_W_m2", column(s.H)},
+                 {"emissivity", column(r.problem->emissivity)},
+                 {"area_m2", column(r.problem->area)},
+                 {"surface", surface}};
+  const auto& names = mesh.surface_names;
+  const auto n = names.size();
+  std::vector<double> eps(n), given(n), area(n), t(n), t_min(n), t_max(n), j(n), q(n), big_q(n);
+  std::vector<std::int32_t> known_t(n), patches(n);
+  for (size_t k = 0; k < n; ++k) {
+    const SurfaceHeat& h = (*r.surfaces)[k];
+    const SurfaceCondition& cond = (*r.conditions)[k];
+    eps[k] = cond.emissivity;
+    known_t[k] = cond.known_temperature ? 1 : 0;
+    given[k] = cond.value;
+    area[k] = h.area;
+    patches[k] = h.patches;
+    t[k] = h.T;
+    t_min[k] = h.T_min;
+    t_max[k] = h.T_max;
+    j[k] = h.J;
+    q[k] = h.q;
+    big_q[k] = h.Q;
+  }
+  c.field_data = {vtu_string_array("surface_names", names),
+                  {"surface_emissivity", eps},
+                  {"surface_known_temperature", known_t},
+                  {"surface_given", given},
+                  {"surface_area_m2", area},
+                  {"surface_patches", patches},
+                  {"surface_T_mean_K", t},
+                  {"surface_T_min_K", t_min},
+                  {"surface_T_max_K", t_max},
+                  {"surface_J_W_m2", j},
+                  {"surface_q_W_m2", q},
+                  {"surface_Q_W", big_q},
+                  {"environment_W", std::vector<double>{s.environment_power}},
+                  {"closure_W", std::vector<double>{s.closure}}};
+  c.comments = {"lambert heat of " + r.loaded->scene.source + ", conditions " + r.options->surfaces,
+                "points in the scene's unit (" + r.options->length_unit +
+                    "); T K, q J H W/m^2 (q net, leaving), Q W, area m^2; NaN: undefined T",
+                "surface_known_temperature 1: surface_given is T (K), 0: q (W/m^2)"};
+  for (size_t k = 0; k < n; ++k)
+    c.comments.push_back("surface " + std::to_string(k) + ": " + names[k]);
+  write_vtu(path, mesh, c);
 }
 
 Json heat_json(const HeatReport& r) {

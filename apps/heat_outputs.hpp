@@ -1,7 +1,7 @@
 #pragma once
-// The files and the table `lambert heat` writes: per-surface and per-patch CSV, the JSON
-// summary, the per-vertex EXR and PLY (temperature, heat flux, radiosity) and the
-// colour-mapped image with its legend.
+// The files and the table `lambert heat` writes: per-surface and per-patch CSV, the VTU of
+// per-patch results, the JSON summary, the per-vertex EXR and PLY (temperature, heat flux,
+// radiosity) and the colour-mapped image with its legend.
 
 #include <CLI/CLI.hpp>
 #include <string>
@@ -39,12 +39,15 @@ void add_heat_outputs_to_plan(JobPlan& plan, const HeatImageArgs& args);
 /// Where `heat` writes its tables and its summary (empty: not written).
 struct HeatPaths {
   std::string surfaces_csv, patches_csv, json, conductors_csv;
+  std::string vtu;     ///< -o FILE.vtu: per-patch cell data, per-surface field data
   std::string folder;  ///< the folder -o DIR/ creates (JobPlan::folders), empty if none
 };
 /// -o FILE.csv, or a device or pipe (/dev/null, /dev/stdout): the per-surface table goes to
 /// it, the summary beside it (FILE.json; none for a device), the per-patch table only with
-/// --patches-csv. -o PREFIX or DIR/ (compatible with earlier versions): PREFIX_surfaces.csv,
-/// PREFIX_patches.csv (or --patches-csv) and PREFIX.json. --conductors as given.
+/// --patches-csv. -o FILE.vtu: the VTU (no per-surface CSV: the table is its field data), the
+/// summary FILE.json, the per-patch table only with --patches-csv. -o PREFIX or DIR/ (compatible
+/// with earlier versions): PREFIX_surfaces.csv, PREFIX_patches.csv (or --patches-csv) and
+/// PREFIX.json. --conductors as given.
 HeatPaths heat_paths(const HeatOptions& o);
 /// Adds the paths to the plan as outputs, and the folder -o DIR/ creates.
 void add_heat_paths_to_plan(JobPlan& plan, const HeatPaths& paths);
@@ -72,6 +75,11 @@ struct HeatReport {
 void write_heat_surfaces_csv(const std::string& path, const HeatReport& r);
 /// patch,surface,area_m2,emissivity,T_K,J_W_m2,H_W_m2,q_W_m2,Q_W, atomically.
 void write_heat_patches_csv(const std::string& path, const HeatReport& r);
+/// The mesh with per-patch T_K, q_W_m2, Q_W, J_W_m2, H_W_m2, emissivity, area_m2 and surface
+/// (index) as cell data and the per-surface table as field data (surface_names, then
+/// surface_<column> of the per-surface CSV, environment_W, closure_W), atomically; undefined
+/// temperatures are NaN.
+void write_heat_vtu(const std::string& path, const HeatReport& r);
 /// The conductors as a matrix: header `GR_m2,<surface>...,environment`, one row per emitting
 /// surface (GR_ST in m², then GR_S,env), atomically.
 void write_heat_conductors_csv(const std::string& path, const HeatReport& r);

@@ -593,10 +593,11 @@ std::vector<OptionSpec> make_specs() {
   add_row(choice("--length-unit", units, "m", "Unit of the scene's coordinates").on({"heat"}));
   // heat's files may go into the folder its -o DIR/ creates: their folders are checked by
   // the job's plan (check_job_files), which knows it, not when the line is parsed.
-  add_row(text("--output", "FILE.csv|DIR/|PREFIX", output_prefix_error, "heat",
+  add_row(text("--output", "FILE.csv|FILE.vtu|DIR/|PREFIX", output_prefix_error, "heat",
                "FILE.csv: the per-surface table, its summary FILE.json (none for a device "
-               "such as /dev/null); PREFIX: PREFIX_surfaces.csv, PREFIX_patches.csv, "
-               "PREFIX.json (a folder DIR/ gives DIR/heat_*)")
+               "such as /dev/null); FILE.vtu: per-patch results as VTK cell data, the "
+               "per-surface table as field data, FILE.json; PREFIX: PREFIX_surfaces.csv, "
+               "PREFIX_patches.csv, PREFIX.json (a folder DIR/ gives DIR/heat_*)")
               .on({"heat"}));
   add_row(text("--patches-csv", "FILE", nullptr, "",
                "Per-patch table (T, J, H, q, Q); with -o PREFIX instead of PREFIX_patches.csv")

@@ -103,6 +103,21 @@ TEST(HeatOutputs, CsvOutputIsTheSurfaceTableAndPatchesCsvThePatchTable) {
   EXPECT_EQ(slurp(dir.file("p.csv")).rfind("patch,surface,area_m2,", 0), 0u);
 }
 
+TEST(HeatOutputs, VtuOutputIsTheVtuWithItsSummaryAndNoSurfaceCsv) {
+  const TempDir dir;
+  auto args = heat_args(dir);
+  args.insert(args.end(), {"-o", dir.file("r.vtu")});
+  ASSERT_EQ(run(args), kExitOk);
+  EXPECT_EQ(listing(dir.path()),
+            (std::vector<std::string>{"box.obj", "r.json", "r.vtu", "s.json"}));
+  EXPECT_NE(slurp(dir.file("r.vtu")).find("<VTKFile type=\"UnstructuredGrid\""),
+            std::string::npos);  // the structure: tests/io/vtu_test.cpp, the values: pytest
+  EXPECT_EQ(testing::read_json(dir.file("r.json"))["surfaces"].size(), 3u);
+  args.insert(args.end(), {"--patches-csv", dir.file("p.csv")});
+  ASSERT_EQ(run(args), kExitOk);
+  EXPECT_EQ(slurp(dir.file("p.csv")).rfind("patch,surface,area_m2,", 0), 0u);
+}
+
 TEST(HeatOutputs, APrefixKeepsItsThreeFilesAndPatchesCsvMovesOne) {
   const TempDir dir;
   auto args = heat_args(dir);
