@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <set>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -34,11 +35,30 @@ struct EdgeUse {
   }
 };
 
+// Each vertex's lowest-numbered twin at exactly its position (-0 and +0 one position): an OBJ
+// may repeat a corner under several indices; STL and PLY corners are shared already.
+// O(V log V).
+std::vector<std::int32_t> position_ids(const std::vector<Eigen::Vector3d>& vertices) {
+  const auto n = static_cast<std::int32_t>(vertices.size());
+  std::vector<std::int32_t> order(n), id(n);
+  for (std::int32_t i = 0; i < n; ++i) order[i] = i;
+  const auto key = [&](std::int32_t i) {
+    const Eigen::Vector3d p = vertices[i] + Eigen::Vector3d::Zero();
+    return std::make_tuple(p.x(), p.y(), p.z());
+  };
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::int32_t a, std::int32_t b) { return key(a) < key(b); });
+  for (std::int32_t k = 0; k < n; ++k)
+    id[order[k]] = k > 0 && key(order[k]) == key(order[k - 1]) ? id[order[k - 1]] : order[k];
+  return id;
+}
+
 }  // namespace
 
 void split_surfaces_at_feature_edges(Scene& scene, double max_angle_deg, const std::string& name) {
   const auto n = static_cast<std::int32_t>(scene.faces.size());
   std::vector<Eigen::Vector3d> normal(n);
+  const std::vector<std::int32_t> at = position_ids(scene.vertices);
   std::vector<EdgeUse> edges;
   for (std::int32_t f = 0; f < n; ++f) {
     const auto& v = scene.faces[f].vertices;
@@ -46,7 +66,7 @@ void split_surfaces_at_feature_edges(Scene& scene, double max_angle_deg, const s
     for (std::int32_t i : v) poly.push_back(scene.vertices[i]);
     normal[f] = newell_normal(poly);
     for (size_t k = 0; k < v.size(); ++k) {
-      const std::int32_t p = v[k], q = v[(k + 1) % v.size()];
+      const std::int32_t p = at[v[k]], q = at[v[(k + 1) % v.size()]];
       if (p != q) edges.push_back({std::min(p, q), std::max(p, q), f});
     }
   }

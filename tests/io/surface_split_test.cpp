@@ -12,12 +12,14 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "common/stl_text.hpp"
 #include "core/error.hpp"
 #include "geometry/polygon.hpp"
+#include "io/obj_loader.hpp"
 #include "io/stl_loader.hpp"
 
 namespace lambert {
@@ -219,6 +221,30 @@ TEST(SurfaceSplit, FortyThousandFacetsSplitIntoTheirFoldedHalves) {
   const double load_s = std::chrono::duration<double>(t1 - t0).count();
   const double split_s = std::chrono::duration<double>(t2 - t1).count() - load_s;
   std::printf("%zu facets: load %.3f s, split adds %.3f s\n", t.size(), load_s, split_s);
+}
+
+}  // namespace
+}  // namespace lambert
+
+namespace lambert {
+namespace {
+
+TEST(SurfaceSplit, ObjCornersRepeatedUnderOtherIndicesStillJoin) {
+  // Two coplanar quads and a third bent up by 90 degrees, each with its own four vertex
+  // indices: edges are matched by corner position, so at 30 degrees the flat pair is one piece.
+  std::istringstream obj(
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+      "v 1 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\n"
+      "v 2 0 0\nv 2 0 1\nv 2 1 1\nv 2 1 0\n"
+      "g plate\nf 1 2 3 4\nf 5 6 7 8\nf 9 12 11 10\n");
+  LoadOptions o;
+  o.split_angle = 30;
+  o.warn_without_emitter = false;
+  const Scene s = load_obj_stream(obj, "p.obj", {}, nullptr, o);
+  ASSERT_EQ(s.surfaces.size(), 2u);
+  EXPECT_EQ(s.surfaces[0].name, "plate/face_1");
+  EXPECT_EQ(s.faces[0].surface, s.faces[1].surface);
+  EXPECT_NE(s.faces[2].surface, s.faces[0].surface);
 }
 
 }  // namespace
