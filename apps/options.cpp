@@ -69,6 +69,7 @@ void add_scene_options(CLI::App* cmd, SceneArgs& args) {
   });
   add_declared(cmd, "--max-reflectance", args.load.max_reflectance);
   add_declared(cmd, "--vertex-colors-as-reflectance", args.load.vertex_colors_as_reflectance);
+  add_declared(cmd, "--split-angle", args.load.split_angle);
   add_declared(cmd, "--emit", args.emit);
   if (find_option_spec("--sky", cmd->get_name())) {  // the commands that solve for B
     add_declared(cmd, "--sky", args.sky);

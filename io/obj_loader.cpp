@@ -22,6 +22,7 @@
 #include "io/line_reader.hpp"
 #include "io/mtl_parser.hpp"
 #include "io/obj_parser.hpp"
+#include "io/surface_split.hpp"
 
 namespace lambert {
 namespace {
@@ -688,6 +689,7 @@ Scene load_obj_stream(std::istream& in, const std::string& name, const MtlOpener
       std::any_of(mats.undefined.begin(), mats.undefined.end(), [](bool u) { return u; }) ||
       std::any_of(obj.faces.begin(), obj.faces.end(),
                   [](const ObjFace& f) { return f.material < 0; });
+  if (options.split_angle >= 0.0) split_surfaces_at_feature_edges(scene, options.split_angle, name);
   for (const std::string& w : coincident_face_warnings(scene, name, report.coincident_faces))
     diag.warn(w);
   apply_emit(options.emit, name, scene);

@@ -29,6 +29,9 @@ struct LoadOptions {
   /// Each face whose corners all have colours (`v x y z r g b`) gets their mean as its
   /// reflectance (Face::rho) instead of its material's Kd.
   bool vertex_colors_as_reflectance = false;
+  /// --split-angle DEG: >= 0 splits each surface at edges where the faces' normals turn by
+  /// more than DEG degrees (io/surface_split.hpp); < 0: off (surfaces as the file has them).
+  double split_angle = -1.0;
   /// Warn when nothing emits (radiosity would be zero); off for `lambert heat`, whose
   /// sources are temperatures from its surfaces file.
   bool warn_without_emitter = true;

@@ -11,6 +11,7 @@
 #include "core/log.hpp"
 #include "geometry/polygon.hpp"
 #include "io/camera_file.hpp"
+#include "io/surface_split.hpp"
 
 namespace lambert {
 namespace {
@@ -152,6 +153,8 @@ Scene SceneBuilder::finish(const LoadOptions& options, int up) {
          " facet(s) store a normal opposite to their vertex order; the vertex order "
          "(counter-clockwise about the front) is used");
   if (scene_.faces.empty()) throw SceneError(name_ + ": empty scene: no facets with positive area");
+  if (options.split_angle >= 0.0)
+    split_surfaces_at_feature_edges(scene_, options.split_angle, name_);
   for (const std::string& w : coincident_face_warnings(scene_, name_, report_.coincident_faces))
     warn(w);
   scene_.materials.push_back({"default", options.default_reflectance, Eigen::Vector3d::Zero()});

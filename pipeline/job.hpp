@@ -38,8 +38,9 @@ std::string parse_sun(const std::string& text, Daylight& light);
 /// Scene file, how to load it and meshing target.
 struct SceneArgs {
   std::string scene;  ///< OBJ path; empty = built-in Cornell box
-  LoadOptions
-      load;  ///< --strict, --default-reflectance, --max-reflectance, --vertex-colors-as-reflectance
+  /// --strict, --default-reflectance, --max-reflectance, --vertex-colors-as-reflectance,
+  /// --split-angle
+  LoadOptions load;
   bool default_reflectance_given = false;  ///< --default-reflectance was on the command line
   std::vector<std::string> emit;           ///< --emit NAME_OR_GLOB=R,G,B, parsed by load_scene
   double max_edge = 0.0;                   ///< --max-edge

@@ -253,6 +253,10 @@ std::vector<OptionSpec> make_specs() {
   add_row(flag("--vertex-colors-as-reflectance",
                "Each face whose corners all have colours (v x y z r g b) reflects their mean "
                "instead of its material's Kd"));
+  add_row(real("--split-angle", 0.0, 180.0, "",
+               "Split each surface into NAME/face_1, NAME/face_2, ... at the edges where the "
+               "faces' normals turn by more than this many degrees (an STL body into its base "
+               "and fins; default: off)"));
   add_row(text("--emit", "NAME_OR_GLOB=R,G,B", emit_error, "",
                "Surfaces (or materials) matching the name or glob emit radiosity R,G,B "
                "(repeatable; later rules win)")

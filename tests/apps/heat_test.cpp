@@ -14,6 +14,7 @@
 
 #include "apps/cli.hpp"
 #include "common/run_cli.hpp"
+#include "common/stl_text.hpp"
 #include "common/temp_dir.hpp"
 #include "geometry/analytic.hpp"
 #include "io/exr.hpp"
@@ -23,6 +24,7 @@
 namespace lambert {
 namespace {
 
+using testing::ascii_stl;
 using testing::read_json;
 using testing::run;
 using testing::slurp;
@@ -65,24 +67,6 @@ std::vector<Tri> icosphere(double r, int levels, bool inward) {
 // A quad (counter-clockwise about its front) as two triangles.
 std::vector<Tri> quad(Eigen::Vector3d a, Eigen::Vector3d b, Eigen::Vector3d c, Eigen::Vector3d d) {
   return {{a, b, c}, {a, c, d}};
-}
-
-std::string ascii_stl(const std::vector<std::pair<std::string, std::vector<Tri>>>& solids) {
-  std::string s;
-  char buf[200];
-  for (const auto& [name, tris] : solids) {
-    s += "solid " + name + "\n";
-    for (const auto& t : tris) {
-      s += "facet normal 0 0 0\nouter loop\n";
-      for (const auto& p : t) {
-        std::snprintf(buf, sizeof buf, "vertex %.17g %.17g %.17g\n", p.x(), p.y(), p.z());
-        s += buf;
-      }
-      s += "endloop\nendfacet\n";
-    }
-    s += "endsolid " + name + "\n";
-  }
-  return s;
 }
 
 const Json& surface(const Json& j, const std::string& name) {
