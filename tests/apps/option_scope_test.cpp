@@ -80,6 +80,7 @@ std::map<std::string, Trial> trials(const std::string& ff_file, const std::strin
       {"--default-reflectance", {{{"0.2,0.3,0.4"}}}},  // every face has a material: refused
       {"--max-reflectance", {{{"0.5"}}}},
       {"--vertex-colors-as-reflectance", {{{}}}},
+      {"--split-angle", {{{"30"}}}},
       {"--emit", {{{"floor=1,2,3"}}}},
       {"--max-edge", {{{"0.3"}}, {}, {"--patches"}}},
       {"--patches", {{{"30"}}}},
@@ -134,9 +135,10 @@ std::map<std::string, Trial> trials(const std::string& ff_file, const std::strin
 
 // Options that change no result by design: output paths, logging, threads (results are
 // bitwise the same at any thread count), the memory check, the strictness of loading (the
-// scene is clean).
-const std::set<std::string> kNoEffect = {"--output",  "--threads",    "--quiet",
-                                         "--verbose", "--max-memory", "--strict"};
+// scene is clean), and --split-angle (every surface here is one flat face: nothing to split;
+// SurfaceSplit.* and SplitAngleCli.* show what it changes).
+const std::set<std::string> kNoEffect = {"--output",     "--threads", "--quiet",      "--verbose",
+                                         "--max-memory", "--strict",  "--split-angle"};
 // Not walked, with the reason: --distributed needs mpirun (tests/mpi walk its refusals);
 // --medium-grid needs a grid file (tests/apps/medium_test.cpp).
 const std::set<std::string> kNotWalked = {"--distributed", "--medium-grid", "--help",  "scene",
