@@ -99,6 +99,7 @@ int run_heat(const HeatOptions& opts) {
     throw UsageError(
         "--ambient (southwell's display term) does not apply to heat: it would "
         "change J; --ambient-temperature sets the environment");
+  check_heat_output_options(opts.images, opts.run.given);
   const Timer total;
   const HeatPaths paths = heat_paths(opts);
   JobPlan plan = job_plan(opts.run);

@@ -7,6 +7,7 @@
 
 #include "apps/commands.hpp"
 #include "core/atomic_file.hpp"
+#include "core/error.hpp"
 #include "io/colormap.hpp"
 #include "io/exr.hpp"
 #include "io/ply.hpp"
@@ -105,6 +106,19 @@ std::string heat_page_path(const HeatImageArgs& args) {
 }
 
 }  // namespace
+
+void check_heat_output_options(const HeatImageArgs& args, const OptionGiven& given) {
+  if (!given) return;
+  const bool camera_read = !args.image.empty() || !args.glb.empty();
+  for (const char* name : {"--eye", "--look-at", "--up", "--fov", "--size"})
+    if (given(name) && !camera_read)
+      throw UsageError(std::string(name) +
+                       " does not apply to heat without --image or --glb (it sets their camera)");
+  if (given("--image-quantity") && args.image.empty() && args.ply.empty())
+    throw UsageError(
+        "--image-quantity does not apply to heat without --image or --ply (it "
+        "chooses what they colour)");
+}
 
 void add_heat_outputs_to_plan(JobPlan& plan, const HeatImageArgs& args) {
   plan.outputs.push_back({"--vertex-exr", args.vertex_exr});

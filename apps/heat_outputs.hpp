@@ -33,6 +33,9 @@ struct HeatImageArgs {
 };
 /// Adds the image and per-vertex output options to `heat`.
 void add_heat_output_options(CLI::App* cmd, HeatImageArgs& args);
+/// Refuses (UsageError) the picture options no picture reads: the camera options without
+/// --image or --glb, --image-quantity without --image or --ply.
+void check_heat_output_options(const HeatImageArgs& args, const OptionGiven& given);
 /// Adds those outputs to the job plan (collision and folder checks).
 void add_heat_outputs_to_plan(JobPlan& plan, const HeatImageArgs& args);
 

@@ -141,6 +141,29 @@ TEST(HeatOutputs, AFolderThatOutputCreatesTakesEveryOtherOutput) {
                                       "t.png", "v.exr"}));
 }
 
+TEST(HeatOutputs, PictureOptionsWithoutAPictureAreRefused) {
+  // The camera options set --image's and --glb's camera, --image-quantity what --image and
+  // --ply colour: without those outputs nothing reads them (they were silently ignored).
+  TempDir dir;
+  const std::vector<std::vector<std::string>> unread = {
+      {"--eye", "1", "2", "3"}, {"--fov", "30"}, {"--size", "64x64"}, {"--image-quantity", "flux"}};
+  for (const auto& extra : unread) {
+    std::vector<std::string> args = heat_args(dir);
+    args.insert(args.end(), {"-o", dir.file("h.csv")});
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto [code, err] = run_capturing(args);
+    EXPECT_EQ(code, kExitUsage) << extra[0] << ": " << err;
+    EXPECT_NE(err.find(extra[0] + " does not apply to heat"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(dir.file("h.csv"))) << extra[0];
+  }
+  // With the picture that reads them they are accepted.
+  std::vector<std::string> args = heat_args(dir);
+  args.insert(args.end(), {"-o", dir.file("h.csv"), "--glb", dir.file("h.glb"), "--eye", "0.5",
+                           "0.5", "2", "--ply", dir.file("h.ply"), "--image-quantity", "flux"});
+  EXPECT_EQ(run(args), kExitOk);
+  EXPECT_TRUE(fs::exists(dir.file("h.glb")) && fs::exists(dir.file("h.ply")));
+}
+
 TEST(HeatOutputs, AnOutputIntoAFolderNobodyCreatesIsRefusedBeforeAnyFolderIsMade) {
   const TempDir dir;
   auto args = heat_args(dir);

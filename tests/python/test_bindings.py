@@ -321,18 +321,25 @@ def test_long_calls_release_the_gil(cornell):
     assert seconds < 0.05 or ticks[0] >= 50 * seconds, (ticks[0], seconds)
 
 
-def test_heat_equals_the_cli_on_the_stl_example(tmp_path):
-    """lambert.heat on the STL worked example gives the CLI's per-patch Q bit for bit (the
-    same F: form_factors equals the CLI's; the same system and solver), and the closure
-    (sum of Q + environment power) is at rounding level."""
-    root = os.path.join(os.path.dirname(__file__), "..", "..", "data", "thermal_box")
-    stl = os.path.join(root, "thermal_box.stl")
+def thermal_box(tmp_path):
+    """The STL worked example (data/thermal_box): its path, the conditions of its three
+    surfaces and the --surfaces file holding them."""
+    import json
+    stl = os.path.join(os.path.dirname(__file__), "..", "..", "data", "thermal_box",
+                       "thermal_box.stl")
     conditions = {"heater": {"emissivity": 0.9, "temperature": 800},
                   "cold_plate": {"emissivity": 0.8, "temperature": 300},
                   "walls": {"emissivity": 0.5, "heat_flux": 0}}
     surfaces_file = tmp_path / "surfaces.json"
-    import json
     surfaces_file.write_text(json.dumps(conditions))
+    return stl, conditions, surfaces_file
+
+
+def test_heat_equals_the_cli_on_the_stl_example(tmp_path):
+    """lambert.heat on the STL worked example gives the CLI's per-patch Q bit for bit (the
+    same F: form_factors equals the CLI's; the same system and solver), and the closure
+    (sum of Q + environment power) is at rounding level."""
+    stl, conditions, surfaces_file = thermal_box(tmp_path)
     run_cli("heat", stl, "--surfaces", surfaces_file, "--length-unit", "mm", "--patches", 200,
             "--estimator", "hybrid", "--samples", 8, "--seed", 5, "--tol", 1e-10, "-q",
             "-o", tmp_path / "h")
@@ -369,15 +376,8 @@ def test_heat_conductors_equal_the_cli_and_are_reciprocal(tmp_path):
     (the same F and solver; the CSV holds 17 significant digits), GR is symmetric to the
     conductor solves' tolerance (1e-10 relative: each J^(S) is solved to it), and each row
     plus its environment share is eps A (every emitted watt ends somewhere)."""
-    root = os.path.join(os.path.dirname(__file__), "..", "..", "data", "thermal_box")
-    stl = os.path.join(root, "thermal_box.stl")
-    conditions = {"heater": {"emissivity": 0.9, "temperature": 800},
-                  "cold_plate": {"emissivity": 0.8, "temperature": 300},
-                  "walls": {"emissivity": 0.5, "heat_flux": 0}}
     import csv
-    import json
-    surfaces_file = tmp_path / "surfaces.json"
-    surfaces_file.write_text(json.dumps(conditions))
+    stl, conditions, surfaces_file = thermal_box(tmp_path)
     run_cli("heat", stl, "--surfaces", surfaces_file, "--length-unit", "mm", "--patches", 120,
             "--estimator", "hybrid", "--samples", 8, "--seed", 5, "--tol", 1e-10, "-q",
             "-o", tmp_path / "h.csv", "--conductors", tmp_path / "gr.csv")
