@@ -5,8 +5,8 @@
 // [rows[r], rows[r + 1]) of exactly the F a single process computes. Rank 0 gathers F to save
 // it, or PETSc solves over the row blocks (dist_petsc.cpp). Every stage that can fail on
 // one rank runs in dist::collective, so all ranks stop together with rank 0 reporting.
-#include "apps/distributed.hpp"
-
+// Built as the module lambert_distributed.so (apps/distributed_entry.hpp): its one export is
+// lambert_distributed_entry, at the end.
 #include <utility>
 
 #include "apps/cli.hpp"
@@ -14,6 +14,7 @@
 #include "apps/commands.hpp"
 #include "apps/dist_mpi.hpp"
 #include "apps/dist_petsc.hpp"
+#include "apps/distributed_entry.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
@@ -139,11 +140,7 @@ Json distributed_json(const dist::Session& s, const DistributedF& f, std::int64_
           {"gather_bytes", gathered}};
 }
 
-}  // namespace
-
-bool distributed_available() { return true; }
-
-int run_formfactors_distributed(const FormFactorsOptions& opts) {
+int formfactors_over_ranks(const FormFactorsOptions& opts) {
   return dist::run_job("", [&](const dist::Session& s) {
     const RunArgs run = rank_run_args(opts.run, s);
     LoadedScene scene;
@@ -175,11 +172,11 @@ int run_formfactors_distributed(const FormFactorsOptions& opts) {
   });
 }
 
-int run_matrix_distributed(const DistributedArgs& dist, const RunArgs& run_args,
-                           const FormFactorArgs& ff_args, const SolveOptions& solver,
-                           const std::function<LoadedScene(const RunArgs& run, bool root)>& load,
-                           const std::function<int(const LoadedScene&, const RadiosityResult&,
-                                                   const Json& section)>& finish) {
+int matrix_over_ranks(const DistributedArgs& dist, const RunArgs& run_args,
+                      const FormFactorArgs& ff_args, const SolveOptions& solver,
+                      const std::function<LoadedScene(const RunArgs& run, bool root)>& load,
+                      const std::function<int(const LoadedScene&, const RadiosityResult&,
+                                              const Json& section)>& finish) {
   return dist::run_job(dist.petsc_options, [&](const dist::Session& s) {
     const RunArgs run = rank_run_args(run_args, s);
     LoadedScene scene;
@@ -239,7 +236,7 @@ int run_matrix_distributed(const DistributedArgs& dist, const RunArgs& run_args,
   });
 }
 
-int run_solve_distributed(const SolveCommandOptions& opts) {
+int solve_over_ranks(const SolveCommandOptions& opts) {
   const Timer total;
   double load_seconds = 0.0;
   auto load = [&](const RunArgs& run, bool root) {
@@ -266,7 +263,16 @@ int run_solve_distributed(const SolveCommandOptions& opts) {
     result.distributed = section;
     return write_solve_outputs(opts, scene, result);
   };
-  return run_matrix_distributed(opts.dist, opts.run, opts.ff, opts.solve, load, finish);
+  return matrix_over_ranks(opts.dist, opts.run, opts.ff, opts.solve, load, finish);
 }
 
+}  // namespace
 }  // namespace lambert
+
+extern "C" __attribute__((visibility("default"))) const lambert::DistributedEntry*
+lambert_distributed_entry() {
+  static const lambert::DistributedEntry entry{
+      lambert::kDistributedLayout, &lambert::formfactors_over_ranks, &lambert::solve_over_ranks,
+      &lambert::matrix_over_ranks};
+  return &entry;
+}

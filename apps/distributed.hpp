@@ -1,7 +1,9 @@
 #pragma once
 // `--distributed` (docs/cluster.md): formfactors and solve over MPI ranks, the
-// solve in PETSc. Declared in every build; defined by apps/distributed.cpp when built with
-// LAMBERT_MPI, else by apps/distributed_stub.cpp, which refuses. No MPI type appears here.
+// solve in PETSc. Declared in every build. With LAMBERT_MPI, apps/distributed_loader.cpp
+// defines them by loading the module lambert_distributed.so (apps/distributed.cpp and
+// dist_*.cpp, the only files linked to MPI and PETSc; apps/distributed_entry.hpp) on first
+// use; without it apps/distributed_stub.cpp refuses. No MPI type appears here.
 
 #include <CLI/CLI.hpp>
 #include <functional>
