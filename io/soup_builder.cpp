@@ -157,8 +157,10 @@ Scene SceneBuilder::finish(const LoadOptions& options, int up) {
     split_surfaces_at_feature_edges(scene_, options.split_angle, name_);
   for (const std::string& w : coincident_face_warnings(scene_, name_, report_.coincident_faces))
     warn(w);
-  scene_.materials.push_back({"default", options.default_reflectance, Eigen::Vector3d::Zero()});
-  report_.default_material_used = true;
+  if (scene_.materials.empty()) {  // STL, PLY: every surface takes the default material
+    scene_.materials.push_back({"default", options.default_reflectance, Eigen::Vector3d::Zero()});
+    report_.default_material_used = true;
+  }
   apply_emit(options.emit, name_, scene_);
   for (const auto& s : scene_.surfaces)
     report_.has_emitter = report_.has_emitter || scene_.materials[s.material].emits();

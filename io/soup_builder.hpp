@@ -47,7 +47,8 @@ class SceneBuilder {
   /// file's stem (stem_1, stem_2, ... when there are several), in first-face order.
   void assign_components(const std::string& fallback_stem);
   Scene& scene() { return scene_; }
-  /// Warnings, the default material, the emit rules, the default view (`up`: 1 = y, 2 = z);
+  /// Warnings, the default material (when the caller added no materials: every surface
+  /// takes it), the emit rules, the default view (`up`: 1 = y, 2 = z);
   /// refuses a scene without faces or of an extent below 1e-50.
   Scene finish(const LoadOptions& options, int up);
 

@@ -20,6 +20,7 @@
 #include "geometry/polygon.hpp"
 #include "io/camera_file.hpp"
 #include "io/line_reader.hpp"
+#include "io/model_loader.hpp"
 #include "io/obj_loader.hpp"
 #include "io/obj_parser.hpp"
 #include "io/ply_loader.hpp"
@@ -243,6 +244,7 @@ Scene load_scene_path(const std::string& path, LoadReport* report, const LoadOpt
     std::error_code ec;
     const auto size = fs::file_size(path, ec);
     if (looks_like_ply(head)) return load_ply(path, report, options);
+    if (looks_like_model(path, head)) return load_model(path, report, options);
     if (!ec && looks_like_stl(head, size)) return load_stl(path, report, options);
   }
   return load_obj(path, report, options);  // also reports a missing or unreadable file

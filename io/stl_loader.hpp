@@ -45,8 +45,9 @@ Scene load_stl(const std::string& path, LoadReport* report = nullptr,
 Scene load_stl_bytes(const std::string& bytes, const std::string& name,
                      LoadReport* report = nullptr, const LoadOptions& options = {});
 
-/// Loads a scene file of either format, told apart by content (looks_like_stl): the one
-/// place where a command's SCENE is opened.
+/// Loads a scene file, its format told apart by content (PLY, STL; GLB and binary FBX by
+/// their first bytes), then by an extension assimp reads (io/model_loader.hpp), else OBJ:
+/// the one place where a command's SCENE is opened.
 Scene load_scene_path(const std::string& path, LoadReport* report = nullptr,
                       const LoadOptions& options = {});
 

@@ -11,7 +11,7 @@ packages=(build-essential cmake pkg-config libembree-dev libeigen3-dev libopenex
           libgtest-dev libcli11-dev zlib1g-dev nlohmann-json3-dev libcgal-dev
           pybind11-dev python3-dev python3-numpy python3-scipy python3-matplotlib python3-pytest
           ccache libopenmpi-dev openmpi-bin petsc-dev libtinygltf-dev chromium libexpat1-dev
-          python3-meshio)
+          python3-meshio libassimp-dev)
 # The asan preset builds with clang and links libFuzzer (from libclang-rt).
 [[ "$preset" == asan ]] && packages+=(clang libclang-rt-14-dev)
 missing=()
