@@ -1,7 +1,9 @@
 #include "io/model_loader.hpp"
 
+#include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <dlfcn.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -9,7 +11,6 @@
 
 #include <algorithm>
 #include <array>
-#include <assimp/Importer.hpp>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -27,6 +28,48 @@ namespace lambert {
 namespace {
 
 namespace fs = std::filesystem;
+
+// assimp's C API, opened with dlopen on first use: linking it would load and relocate its
+// 10 MB at every start of lambert, doubling the start-up of `lambert --version` (issue 36).
+// Its scene structures are plain structs; their methods used here are inline.
+struct Assimp {
+  decltype(&aiImportFile) import_file;
+  decltype(&aiImportFileFromMemory) import_memory;
+  decltype(&aiReleaseImport) release;
+  decltype(&aiGetErrorString) error;
+  decltype(&aiIsExtensionSupported) extension_supported;
+  decltype(&aiGetMaterialColor) colour;
+  decltype(&aiGetMaterialFloatArray) floats;
+  decltype(&aiGetMaterialString) string;
+  decltype(&aiGetMaterialTextureCount) textures;
+};
+
+const Assimp& assimp() {
+  static const Assimp api = [] {
+    void* lib = dlopen(LAMBERT_ASSIMP_LIBRARY, RTLD_NOW | RTLD_LOCAL);
+    if (!lib)
+      throw IoError(std::string("reading glTF, FBX, COLLADA, ... needs assimp (Debian: ") +
+                    "libassimp5; scripts/setup.sh installs it): " + dlerror());
+    auto get = [lib](const char* name) {
+      void* f = dlsym(lib, name);
+      if (!f) throw IoError(std::string(LAMBERT_ASSIMP_LIBRARY) + " has no " + name);
+      return f;
+    };
+    Assimp a;
+    a.import_file = reinterpret_cast<decltype(a.import_file)>(get("aiImportFile"));
+    a.import_memory = reinterpret_cast<decltype(a.import_memory)>(get("aiImportFileFromMemory"));
+    a.release = reinterpret_cast<decltype(a.release)>(get("aiReleaseImport"));
+    a.error = reinterpret_cast<decltype(a.error)>(get("aiGetErrorString"));
+    a.extension_supported =
+        reinterpret_cast<decltype(a.extension_supported)>(get("aiIsExtensionSupported"));
+    a.colour = reinterpret_cast<decltype(a.colour)>(get("aiGetMaterialColor"));
+    a.floats = reinterpret_cast<decltype(a.floats)>(get("aiGetMaterialFloatArray"));
+    a.string = reinterpret_cast<decltype(a.string)>(get("aiGetMaterialString"));
+    a.textures = reinterpret_cast<decltype(a.textures)>(get("aiGetMaterialTextureCount"));
+    return a;
+  }();
+  return api;
+}
 
 // What the child process hands back: flat arrays, written and read field by field.
 struct Soup {
@@ -159,7 +202,7 @@ std::string lower_extension(const std::string& path) {
 Eigen::Vector3d material_colour(const aiMaterial& m, const char* key, unsigned type, unsigned index,
                                 bool& found) {
   aiColor4D c;
-  found = m.Get(key, type, index, c) == AI_SUCCESS;
+  found = assimp().colour(&m, key, type, index, &c) == AI_SUCCESS;
   return found ? Eigen::Vector3d(c.r, c.g, c.b) : Eigen::Vector3d::Zero();
 }
 
@@ -167,7 +210,7 @@ void add_materials(const aiScene& sc, Soup& s) {
   for (unsigned k = 0; k < sc.mNumMaterials; ++k) {
     const aiMaterial& m = *sc.mMaterials[k];
     aiString name;
-    const bool named = m.Get(AI_MATKEY_NAME, name) == AI_SUCCESS && name.length > 0;
+    const bool named = assimp().string(&m, AI_MATKEY_NAME, &name) == AI_SUCCESS && name.length > 0;
     s.material_names.push_back(named ? name.C_Str() : "material_" + std::to_string(k));
     std::int32_t flags = 0;
     bool found = false;
@@ -178,9 +221,14 @@ void add_materials(const aiScene& sc, Soup& s) {
     rho = rho.unaryExpr([](double x) { return std::isfinite(x) ? std::clamp(x, 0.0, 1.0) : 0.0; });
     Eigen::Vector3d e = material_colour(m, AI_MATKEY_COLOR_EMISSIVE, found);
     float strength = 1.0f;
-    if (m.Get(AI_MATKEY_EMISSIVE_INTENSITY, strength) == AI_SUCCESS) e *= strength;
+    unsigned one = 1;
+    if (assimp().floats(&m, AI_MATKEY_EMISSIVE_INTENSITY, &strength, &one) == AI_SUCCESS &&
+        one == 1)
+      e *= strength;
     if (!e.allFinite() || e.minCoeff() < 0.0) e = Eigen::Vector3d::Zero(), flags |= kClamped;
-    if (m.GetTextureCount(aiTextureType_BASE_COLOR) + m.GetTextureCount(aiTextureType_DIFFUSE) > 0)
+    if (assimp().textures(&m, aiTextureType_BASE_COLOR) +
+            assimp().textures(&m, aiTextureType_DIFFUSE) >
+        0)
       flags |= kTextured;
     s.material_flags.push_back(flags);
     s.material_values.insert(s.material_values.end(), rho.data(), rho.data() + 3);
@@ -238,7 +286,7 @@ void add_node(const aiScene& sc, const aiNode& node, const aiMatrix4x4& parent, 
 
 Soup import(const std::string& path, bool colours) {
   Soup s;
-  Assimp::Importer importer;
+  const Assimp& api = assimp();
   // A GLB or binary FBX under another name: assimp picks its reader by the extension, so
   // the bytes go with the format's (a GLB holds its buffers; an FBX references no files).
   std::string bytes, hint;
@@ -252,12 +300,16 @@ Soup import(const std::string& path, bool colours) {
     if (h.rfind("Kaydara FBX Binary", 0) == 0 && ext != ".fbx") hint = "fbx";
     if (!hint.empty()) bytes = read_file_bytes(path);
   }
-  const aiScene* sc =
-      hint.empty() ? importer.ReadFile(path, aiProcess_ValidateDataStructure)
-                   : importer.ReadFileFromMemory(bytes.data(), bytes.size(),
-                                                 aiProcess_ValidateDataStructure, hint.c_str());
+  if (bytes.size() > 0xffffffffu) {
+    s.error = "a binary model over 4 GB";
+    return s;
+  }
+  const aiScene* sc = hint.empty()
+                          ? api.import_file(path.c_str(), aiProcess_ValidateDataStructure)
+                          : api.import_memory(bytes.data(), static_cast<unsigned>(bytes.size()),
+                                              aiProcess_ValidateDataStructure, hint.c_str());
   if (!sc || !sc->mRootNode) {
-    const std::string why = importer.GetErrorString();
+    const std::string why = api.error();
     s.error = why.empty() ? "not a scene the model reader (assimp) can read" : why;
     return s;
   }
@@ -268,6 +320,7 @@ Soup import(const std::string& path, bool colours) {
   add_materials(*sc, s);
   std::set<std::string> used_names;
   add_node(*sc, *sc->mRootNode, aiMatrix4x4(), colours, s, used_names);
+  api.release(sc);  // the child exits next; released all the same
   return s;
 }
 
@@ -352,7 +405,14 @@ bool looks_like_model(const std::string& path, const std::string& head) {
   const std::string ext = lower_extension(path);
   if (ext == ".obj" || ext == ".stl" || ext == ".ply") return false;  // lambert's own readers
   if (head.rfind("glTF", 0) == 0 || head.rfind("Kaydara FBX Binary", 0) == 0) return true;
-  return !ext.empty() && Assimp::Importer().IsExtensionSupported(ext);
+  if (ext.empty()) return false;
+  try {
+    return assimp().extension_supported(ext.c_str()) == AI_TRUE;
+  } catch (const IoError&) {  // no assimp here: its common formats still say what they need
+    for (const char* known : {".gltf", ".glb", ".fbx", ".dae", ".3ds", ".blend"})
+      if (ext == known) return true;
+    return false;
+  }
 }
 
 Scene load_model(const std::string& path, LoadReport* report_out, const LoadOptions& options) {
