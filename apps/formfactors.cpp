@@ -64,14 +64,17 @@ Json diagnostics_json(const LoadedScene& s, const FormFactors& ff, const FormFac
           {"entries_above_one", d.above_one}};
 }
 
-void print_diagnostics(const LoadedScene& s, const FormFactors& ff, const FormFactorDiagnostics& d) {
+void print_diagnostics(const LoadedScene& s, const FormFactors& ff,
+                       const FormFactorDiagnostics& d) {
   std::printf("patches %d, nnz %lld (%.1f%% dense), pairs tested %lld, culled %lld\n", d.n,
               static_cast<long long>(d.nnz), 100.0 * d.nnz / std::max(1.0, double(d.n) * d.n),
-              static_cast<long long>(ff.stats.pairs_tested), static_cast<long long>(ff.stats.pairs_culled));
+              static_cast<long long>(ff.stats.pairs_tested),
+              static_cast<long long>(ff.stats.pairs_culled));
   std::printf("rays %s in %s (%s rays/s)\n", format_si(double(ff.stats.rays)).c_str(),
               format_duration(ff.stats.seconds).c_str(),
               format_si(ff.stats.seconds > 0 ? ff.stats.rays / ff.stats.seconds : 0).c_str());
-  std::printf("row sums: min %.6f  mean %.6f  max %.6f\n", d.row_sum_min, d.row_sum_mean, d.row_sum_max);
+  std::printf("row sums: min %.6f  mean %.6f  max %.6f\n", d.row_sum_min, d.row_sum_mean,
+              d.row_sum_max);
   if (ff.specular_continued.size() == d.n && d.n > 0) {
     // Extended rows count light again after each specular bounce; what ends somewhere (row
     // sum minus what was carried on) is the quantity bounded by 1.
@@ -80,10 +83,13 @@ void print_diagnostics(const LoadedScene& s, const FormFactors& ff, const FormFa
       const double t = row_sum(ff.F, i) - ff.specular_continued[i];
       lo = std::min(lo, t), hi = std::max(hi, t), mean += t / d.n;
     }
-    std::printf("extended: row sums minus the part carried on by mirrors and glass: min %.6f  "
-                "mean %.6f  max %.6f\n", lo, mean, hi);
+    std::printf(
+        "extended: row sums minus the part carried on by mirrors and glass: min %.6f  "
+        "mean %.6f  max %.6f\n",
+        lo, mean, hi);
   }
-  std::printf("row-sum histogram (bins of %.2f from 0):", FormFactorDiagnostics::kHistogramMax / FormFactorDiagnostics::kHistogramBins);
+  std::printf("row-sum histogram (bins of %.2f from 0):",
+              FormFactorDiagnostics::kHistogramMax / FormFactorDiagnostics::kHistogramBins);
   for (auto c : d.row_sum_histogram) std::printf(" %lld", static_cast<long long>(c));
   std::printf("\nlargest row sums:");
   for (auto i : d.worst_rows)
@@ -109,7 +115,7 @@ Json surface_json(const SurfaceFactors& sf) {
   return {{"surfaces", sf.surfaces},
           {"areas", sf.areas},
           {"F", rows_json(sf.F)},
-          {"stderr", rows_json(sf.stderr_F)}};
+          {"stderr", sf.has_stderr ? rows_json(sf.stderr_F) : Json()}};
 }
 
 Json point_json(const PointFactors& pf) {
@@ -121,9 +127,10 @@ Eigen::Vector3d parse_vec(const std::vector<double>& v) { return {v[0], v[1], v[
 // The medium's zones appended to F (media.hpp). Returns the report section and prints how
 // the patches' power divides between the surfaces and the medium.
 Json extend_with_zones(const LoadedScene& s, const Medium& medium, const MediumArgs& args,
-                       const RunArgs& run, FormFactors& ff) {
+                       const RunArgs& run, FormFactors& ff, Eigen::VectorXd& zone_area) {
   const Timer timer;
   const Zones zones = make_zones(medium);
+  zone_area = zones.area;
   FormFactors extended = medium_form_factors(s, ff, medium, zones, args, run);
   const double seconds = timer.seconds();
   ff = std::move(extended);
@@ -167,8 +174,9 @@ Json extend_with_zones(const LoadedScene& s, const Medium& medium, const MediumA
 }  // namespace
 
 CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts) {
-  auto* cmd = app.add_subcommand(
-      "formfactors", "Compute form factors F and save them (Matrix Market or binary), or surface/point view factors");
+  auto* cmd = app.add_subcommand("formfactors",
+                                 "Compute form factors F and save them (Matrix Market or binary), "
+                                 "or surface/point view factors");
   opts.scene.default_patches = 2000;
   add_scene_options(cmd, opts.scene);
   add_run_options(cmd, opts.run);
@@ -189,8 +197,8 @@ CLI::App* add_formfactors_command(CLI::App& app, FormFactorsOptions& opts) {
 }
 
 void write_formfactors_outputs(const FormFactorsOptions& opts, const LoadedScene& scene,
-                               FormFactors& ff, const std::string& report,
-                               const Json& distributed, const Medium* medium) {
+                               FormFactors& ff, const std::string& report, const Json& distributed,
+                               const Medium* medium) {
   namespace fs = std::filesystem;
   warn_about_lighting(scene.mesh, ff.F);
   check_closed_lossless(scene.mesh, ff, false);
@@ -199,14 +207,16 @@ void write_formfactors_outputs(const FormFactorsOptions& opts, const LoadedScene
   const FormFactorDiagnostics d = diagnose(scene.mesh, ff.F);
   print_diagnostics(scene, ff, d);
   Json j = diagnostics_json(scene, ff, d, "");
-  if (medium) j["medium"] = extend_with_zones(scene, *medium, opts.medium, opts.run, ff);
+  Eigen::VectorXd zone_area;
+  if (medium) j["medium"] = extend_with_zones(scene, *medium, opts.medium, opts.run, ff, zone_area);
   const std::string settings = settings_string(ff.options, scene);
   j["settings"] = settings;
   const std::string ext = fs::path(opts.output).extension().string();
   const ValuePrecision precision =
       opts.precision == "float" ? ValuePrecision::Float : ValuePrecision::Double;
   if (opts.by_surface) {
-    write_json_file(opts.output, surface_json(surface_factors(scene.mesh, ff)));
+    write_json_file(opts.output,
+                    surface_json(surface_factors(scene.mesh, ff, medium ? &zone_area : nullptr)));
   } else if (ext == ".mtx") {
     write_matrix_market(opts.output, ff.F, {mesh_hash(scene.mesh), settings}, precision);
   } else {
@@ -237,10 +247,10 @@ int run_formfactors(const FormFactorsOptions& opts) {
     throw UsageError("formfactors: -o/--output is required");
   const std::string report = formfactors_report_path(opts);
   const std::shared_ptr<const Medium> medium = make_medium(opts.medium);
-  if (medium && (opts.by_surface || !opts.point.empty() || opts.with_stderr))
+  if (medium && (!opts.point.empty() || opts.with_stderr))
     throw UsageError(
-        "--by-surface, --point and --stderr do not combine with a participating medium yet: "
-        "save F (-o F.bin or F.mtx) and read the zone columns");
+        "--point and --stderr do not combine with a participating medium yet: save F (-o F.bin "
+        "or F.mtx) and read the zone columns, or --by-surface for the exchange areas");
   JobPlan plan = job_plan(opts.run);
   plan.outputs = {{"-o", opts.output}};
   plan.medium = medium.get();
@@ -259,9 +269,11 @@ int run_formfactors(const FormFactorsOptions& opts) {
   if (!opts.point.empty()) {
     const FormFactorOptions o = make_ff_options(opts.ff, opts.run);
     if (scene.mesh.has_specular())
-      log_warn("--point: sensor-point factors are direct only (specular surfaces receive and "
-               "block; paths through mirrors and glass are not followed)");
-    const PointFactors pf = point_form_factors(scene.mesh, parse_vec(opts.point), parse_vec(opts.normal), o);
+      log_warn(
+          "--point: sensor-point factors are direct only (specular surfaces receive and "
+          "block; paths through mirrors and glass are not followed)");
+    const PointFactors pf =
+        point_form_factors(scene.mesh, parse_vec(opts.point), parse_vec(opts.normal), o);
     if (opts.output.empty()) {
       std::cout << json_text(point_json(pf));
     } else {

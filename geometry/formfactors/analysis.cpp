@@ -1,12 +1,11 @@
 #include "geometry/formfactors/analysis.hpp"
 
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <numeric>
 #include <sstream>
-
-#include <Eigen/SparseCore>
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
@@ -25,7 +24,8 @@ std::string surface_list(const PatchMesh& mesh, const std::vector<std::int32_t>&
   std::string names;
   for (size_t k = 0; k < std::min(kNamed, surfaces.size()); ++k)
     names += (k ? ", '" : "'") + mesh.surface_names.at(surfaces[k]) + "'";
-  if (surfaces.size() > kNamed) names += " and " + std::to_string(surfaces.size() - kNamed) + " more";
+  if (surfaces.size() > kNamed)
+    names += " and " + std::to_string(surfaces.size() - kNamed) + " more";
   return names;
 }
 
@@ -182,7 +182,8 @@ ClosedLossless closed_lossless_set(const PatchMesh& mesh, const FormFactors& ff,
 }  // namespace
 
 std::vector<ClosedLossless> find_closed_lossless(const PatchMesh& mesh, const FormFactors& ff) {
-  LAMBERT_CHECK(ff.F.rows() == mesh.size() && ff.F.cols() == mesh.size(), "F does not match the mesh");
+  LAMBERT_CHECK(ff.F.rows() == mesh.size() && ff.F.cols() == mesh.size(),
+                "F does not match the mesh");
   std::vector<ClosedLossless> out;
   for (int c = 0; c < 3; ++c) {
     ClosedLossless set = closed_lossless_set(mesh, ff, c);
@@ -202,7 +203,8 @@ std::vector<ClosedLossless> find_closed_lossless(const PatchMesh& mesh, const Fo
 std::string closed_lossless_message(const PatchMesh& mesh, const ClosedLossless& c) {
   static const char* const kChannel[] = {"R", "G", "B"};
   std::string channels;
-  for (size_t k = 0; k < c.channels.size(); ++k) channels += (k ? ", " : "") + std::string(kChannel[c.channels[k]]);
+  for (size_t k = 0; k < c.channels.size(); ++k)
+    channels += (k ? ", " : "") + std::string(kChannel[c.channels[k]]);
   const bool one = c.surfaces.size() == 1;
   std::ostringstream leak;
   leak << std::setprecision(2) << std::max(0.0, c.max_leak);
@@ -210,27 +212,37 @@ std::string closed_lossless_message(const PatchMesh& mesh, const ClosedLossless&
          std::to_string(c.patches.size()) + " patches) " + (one ? "is" : "are") +
          " lossless (reflectance 1) in channel " + channels +
          " and no light leaves them (none escapes or reaches a surface that absorbs; largest "
-         "row leak " + leak.str() + ", within F's error): I - rho F is singular "
+         "row leak " +
+         leak.str() +
+         ", within F's error): I - rho F is singular "
          "and no solver can converge; give one of them a reflectance below 1, or clamp with "
          "--max-reflectance 0.99";
 }
 
-SurfaceFactors surface_factors(const PatchMesh& mesh, const FormFactors& ff) {
+SurfaceFactors surface_factors(const PatchMesh& mesh, const FormFactors& ff,
+                               const Eigen::VectorXd* zone_area) {
   SurfaceFactors out;
-  const auto s = static_cast<Eigen::Index>(mesh.surface_names.size());
+  const std::int32_t n = mesh.size();
+  const Eigen::Index zones = zone_area ? zone_area->size() : 0;
+  LAMBERT_CHECK(ff.F.rows() == n + zones, "F does not hold the patches and the zones");
+  const auto surfaces = static_cast<Eigen::Index>(mesh.surface_names.size());
+  const Eigen::Index s = surfaces + (zones > 0 ? 1 : 0);
   out.surfaces = mesh.surface_names;
+  if (zones > 0) out.surfaces.push_back(kMediumGroup);
   out.areas.assign(s, 0.0);
   out.F = Eigen::MatrixXd::Zero(s, s);
   Eigen::MatrixXd var = Eigen::MatrixXd::Zero(s, s);
-  const bool have_err = ff.stderr_F.nonZeros() > 0;
-  for (std::int32_t i = 0; i < mesh.size(); ++i) {
-    const Patch& p = mesh.patches[i];
-    out.areas[p.surface] += p.area;
-    // stderr_F shares F's sparsity pattern: walk both CSR arrays by position.
+  // stderr_F shares F's sparsity pattern when it is there (a medium's zones carry none).
+  out.has_stderr = ff.stderr_F.nonZeros() > 0 && ff.stderr_F.nonZeros() == ff.F.nonZeros();
+  auto group = [&](Eigen::Index u) { return u < n ? mesh.patches[u].surface : surfaces; };
+  for (Eigen::Index i = 0; i < n + zones; ++i) {
+    const Eigen::Index g = group(i);
+    const double area = i < n ? mesh.patches[i].area : (*zone_area)[i - n];
+    out.areas[g] += area;
     for (auto k = ff.F.outerIndexPtr()[i]; k < ff.F.outerIndexPtr()[i + 1]; ++k) {
-      const auto h = mesh.patches[ff.F.innerIndexPtr()[k]].surface;
-      out.F(p.surface, h) += p.area * ff.F.valuePtr()[k];
-      if (have_err) var(p.surface, h) += std::pow(p.area * ff.stderr_F.valuePtr()[k], 2);
+      const Eigen::Index h = group(ff.F.innerIndexPtr()[k]);
+      out.F(g, h) += area * ff.F.valuePtr()[k];
+      if (out.has_stderr) var(g, h) += std::pow(area * ff.stderr_F.valuePtr()[k], 2);
     }
   }
   for (Eigen::Index g = 0; g < s; ++g) {

@@ -18,10 +18,10 @@ struct FormFactorDiagnostics {
   double row_sum_min = 0.0, row_sum_max = 0.0, row_sum_mean = 0.0;
   std::vector<std::int64_t> row_sum_histogram;  ///< kHistogramBins bins over [0, kHistogramMax)
   std::vector<std::int32_t> worst_rows;         ///< rows with the largest row sums, descending
-  double reciprocity_max = 0.0;  ///< max_ij |A_i F_ij - A_j F_ji| (scene units²)
-  double reciprocity_max_relative = 0.0;  ///< the same, divided by max(A_i F_ij, A_j F_ji)
-  std::int64_t negative = 0;     ///< entries < 0
-  std::int64_t above_one = 0;    ///< entries > 1
+  double reciprocity_max = 0.0;                 ///< max_ij |A_i F_ij - A_j F_ji| (scene units²)
+  double reciprocity_max_relative = 0.0;        ///< the same, divided by max(A_i F_ij, A_j F_ji)
+  std::int64_t negative = 0;                    ///< entries < 0
+  std::int64_t above_one = 0;                   ///< entries > 1
   static constexpr int kHistogramBins = 22;
   static constexpr double kHistogramMax = 1.1;  ///< row sums above 1 show over-estimation
 };
@@ -80,12 +80,20 @@ std::string closed_lossless_message(const PatchMesh& mesh, const ClosedLossless&
 struct SurfaceFactors {
   std::vector<std::string> surfaces;
   std::vector<double> areas;
-  Eigen::MatrixXd F;       ///< F(g, h) from surface g to surface h
+  Eigen::MatrixXd F;         ///< F(g, h) from surface g to surface h
   Eigen::MatrixXd stderr_F;  ///< zero when no per-entry errors were estimated
+  bool has_stderr = false;   ///< F came with per-entry standard errors
 };
 
-/// Aggregates F (and ff.stderr_F if present: independent entries, variances add).
-SurfaceFactors surface_factors(const PatchMesh& mesh, const FormFactors& ff);
+/// The name of the participating medium's group in surface_factors.
+inline constexpr const char* kMediumGroup = "(medium)";
+
+/// Aggregates F (and ff.stderr_F if present: independent entries, variances add). With
+/// `zone_area` (a medium's zones appended to F after the patches, their effective areas
+/// 4 σt V), the zones form one more group, kMediumGroup, of area Σ 4 σt V: A_G F_G,medium
+/// and A_medium F_medium,H are the zonal method's direct exchange areas (gs, sg, gg).
+SurfaceFactors surface_factors(const PatchMesh& mesh, const FormFactors& ff,
+                               const Eigen::VectorXd* zone_area = nullptr);
 
 /// View factors from a differential area at a point to every surface.
 struct PointFactors {

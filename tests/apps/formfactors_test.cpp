@@ -91,12 +91,72 @@ TEST(FormFactorsCommand, BySurfaceTableIsReciprocalAndRowsOfTheClosedCubeSumToOn
   }
 }
 
+// Issue 36 item 5: with a participating medium --by-surface adds the medium as one more
+// group, "(medium)", of area 4 σt V: the zonal method's direct exchange areas gs and gg.
+// The unit cube filled with a thin grey absorber (σt = κ = 1e-3 per unit, 2³ zones):
+// - each surface row still sums to the surfaces' row without the medium (the medium takes
+//   what the walls no longer see; media.md), to rounding;
+// - A_G F_G,med = A_med F_med,G (the zone rows are reciprocal by construction), to rounding;
+// - Σ_G A_G F_G,med = 4 κ V in the thin limit (Cauchy: the cosine-weighted mean chord from a
+//   convex body's boundary is 4V/S). Bias: 1 - e^-x >= x - x²/2, so the deficit is at most
+//   κ ℓmax / 2 = κ √3 / 2 = 8.7e-4 relative. Noise: chords lie in [0, √3], so their standard
+//   deviation is at most √3/2, and the mean chord 2/3 is estimated from N K = 24 x 4096
+//   rays: relative standard error <= (√3/2) / (2/3) / √98304 = 4.1e-3; 4 of them and the
+//   bias give the 1.75e-2 relative tolerance.
+TEST(FormFactorsCommand, BySurfaceWithAMediumGivesItsExchangeAreas) {
+  testing::TempDir dir;
+  dir.write("c.mtl", "newmtl grey\nKd 0.5 0.5 0.5\nKe 1 1 1\n");
+  const std::string obj = dir.write("c.obj", kCubeObj);
+  const std::vector<std::string> base = {"formfactors", obj,   "-q",        "--by-surface",
+                                         "--max-edge",  "0.5", "--samples", "4"};
+  auto table = [&](const std::vector<std::string>& extra, const std::string& name) {
+    std::vector<std::string> args = base;
+    args.insert(args.end(), extra.begin(), extra.end());
+    args.insert(args.end(), {"-o", dir.file(name)});
+    EXPECT_EQ(run(args), kExitOk);
+    return parse_json_file(dir.file(name));
+  };
+  const double kappa = 1e-3;
+  const nlohmann::json clear = table({}, "clear.json");
+  const nlohmann::json fog = table({"--medium-box", "0,0,0,1,1,1", "--sigma-a", "0.001,0.001,0.001",
+                                    "--voxels", "2", "--medium-rays", "4096"},
+                                   "fog.json");
+  ASSERT_EQ(fog.at("surfaces").size(), 7u);
+  EXPECT_EQ(fog.at("surfaces")[6], "(medium)");
+  EXPECT_TRUE(fog.at("stderr").is_null());  // the zones' factors carry no standard errors
+  const auto area = fog.at("areas").get<std::vector<double>>();
+  EXPECT_NEAR(area[6], 4 * kappa * 1.0, 1e-15);  // 4 σt V over the 8 zones
+  const auto F = fog.at("F").get<std::vector<std::vector<double>>>();
+  const auto F0 = clear.at("F").get<std::vector<std::vector<double>>>();
+  double gs = 0.0;
+  for (int g = 0; g < 6; ++g) {
+    double with = 0.0, without = 0.0;
+    for (int h = 0; h < 6; ++h) {
+      with += F[g][h], without += F0[g][h];
+      EXPECT_LE(F[g][h], F0[g][h] + 1e-15);  // attenuated, never brighter
+    }
+    EXPECT_NEAR(with + F[g][6], without, 1e-12);
+    EXPECT_NEAR(area[g] * F[g][6], area[6] * F[6][g], 1e-15);
+    gs += area[g] * F[g][6];
+  }
+  EXPECT_NEAR(gs, 4 * kappa, 1.75e-2 * 4 * kappa);
+  // The medium's row: its part to the walls is gs / A_med (reciprocity from the patches'
+  // rays), so it carries gs's relative noise; the rest (zone to zone) is small here.
+  double medium_row = 0.0;
+  for (int h = 0; h < 7; ++h) medium_row += F[6][h];
+  EXPECT_NEAR(medium_row, 1.0, 1.75e-2);
+}
+
 TEST(FormFactorsCommand, SavedMatrixIsRefusedForAnotherMeshing) {
   testing::TempDir dir;
   dir.write("c.mtl", "newmtl grey\nKd 0.5 0.5 0.5\nKe 1 1 1\n");
   const std::string obj = dir.write("c.obj", kCubeObj);
-  ASSERT_EQ(run({"formfactors", obj, "-q", "--max-edge", "0.5", "--samples", "2", "-o", dir.file("F.mtx")}), kExitOk);
-  ASSERT_EQ(run({"formfactors", obj, "-q", "--max-edge", "0.5", "--samples", "2", "-o", dir.file("F.bin")}), kExitOk);
+  ASSERT_EQ(run({"formfactors", obj, "-q", "--max-edge", "0.5", "--samples", "2", "-o",
+                 dir.file("F.mtx")}),
+            kExitOk);
+  ASSERT_EQ(run({"formfactors", obj, "-q", "--max-edge", "0.5", "--samples", "2", "-o",
+                 dir.file("F.bin")}),
+            kExitOk);
   const nlohmann::json report = parse_json_file(dir.file("F.report.json"));
   // hybrid computes A_i F_ij once per pair: reciprocal to rounding (|A_i F_ij| <= 1, so a few
   // ulp of 1).
@@ -170,8 +230,8 @@ TEST(FormFactorsCommand, CountOptionsOfAnotherEstimatorAreUsageErrors) {
   EXPECT_EQ(run({"formfactors", "-q", "--patches", "60", "--estimator", "hybrid", "--rays", "64",
                  "-o", out}),
             kExitUsage);
-  EXPECT_EQ(run({"formfactors", "-q", "--patches", "60", "--estimator", "gather", "--samples",
-                 "8", "-o", out}),
+  EXPECT_EQ(run({"formfactors", "-q", "--patches", "60", "--estimator", "gather", "--samples", "8",
+                 "-o", out}),
             kExitUsage);
   EXPECT_EQ(run({"formfactors", "-q", "--patches", "60", "--rays", "0", "-o", out}), kExitUsage);
   EXPECT_EQ(run({"formfactors", "-q", "--patches", "60", "--symmetrize", "--reciprocity", "none",
@@ -233,23 +293,28 @@ TEST(FormFactorsCommand, AnalyticRefusesCountsAndOtherEstimatorsRefuseTol) {
   testing::TempDir dir;
   const std::string obj = dir.write("s.obj", kPartialShadowObj);
   const std::string out = dir.file("F.bin");
-  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--samples", "8", "-o", out}), kExitUsage);
-  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--rays", "8", "-o", out}), kExitUsage);
-  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "hybrid", "--tol", "1e-8", "-o", out}), kExitUsage);
-  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--tol", "0", "-o", out}), kExitUsage);
-  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--tol", "nan", "-o", out}), kExitUsage);
+  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--samples", "8", "-o", out}),
+            kExitUsage);
+  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--rays", "8", "-o", out}),
+            kExitUsage);
+  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "hybrid", "--tol", "1e-8", "-o", out}),
+            kExitUsage);
+  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--tol", "0", "-o", out}),
+            kExitUsage);
+  EXPECT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--tol", "nan", "-o", out}),
+            kExitUsage);
 }
 
 TEST(FormFactorsCommand, AnalyticFileKeepsItsTolerance) {
   testing::TempDir dir;
   const std::string obj = dir.write("s.obj", kPartialShadowObj);
   const std::string bin = dir.file("F.bin");
-  ASSERT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--tol", "1e-7",
-                 "--max-edge", "2", "-o", bin}),
+  ASSERT_EQ(run({"formfactors", obj, "-q", "--estimator", "analytic", "--tol", "1e-7", "--max-edge",
+                 "2", "-o", bin}),
             kExitOk);
   const std::string report = dir.file("B.json");  // solve's report next to -o
-  ASSERT_EQ(run({"solve", obj, "-q", "--max-edge", "2", "--ff", bin, "--emit", "light=1,1,1",
-                 "-o", dir.file("B.csv")}),
+  ASSERT_EQ(run({"solve", obj, "-q", "--max-edge", "2", "--ff", bin, "--emit", "light=1,1,1", "-o",
+                 dir.file("B.csv")}),
             kExitOk);
   const nlohmann::json settings = parse_json_file(report).at("form_factors");
   EXPECT_EQ(settings.at("estimator").get<std::string>(), "analytic");

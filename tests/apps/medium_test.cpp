@@ -575,8 +575,8 @@ TEST(MediumCli, TheMemoryEstimateCountsTheZones) {
       kExitUsage);
   EXPECT_NE(::testing::internal::GetCapturedStderr().find("the medium's zones"), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir.file("F.bin")));
-  // --by-surface has no zone columns yet: refused rather than silently dropping the medium.
-  EXPECT_EQ(run({"formfactors", "-o", dir.file("s.json"), "--by-surface", "-q", "--medium-box",
+  // --stderr: the zones carry no standard errors yet: refused, not silently dropped.
+  EXPECT_EQ(run({"formfactors", "-o", dir.file("F.bin"), "--stderr", "-q", "--medium-box",
                  "0,0,0,556,548.8,559.2", "--sigma-a", "0.001,0.001,0.001"}),
             kExitUsage);
 }
