@@ -26,16 +26,44 @@
 namespace lambert {
 namespace {
 
-// "[k/n] what" on stderr, counting the stages of one run.
+// "[k/n] what" on stderr, counting the stages of one run, and each stage's wall and CPU
+// time under its report key (report.json "timings"; CPU / wall near the thread count where a
+// stage is parallel: issue 37).
 class Stages {
  public:
   explicit Stages(int total) : total_(total) {}
-  void next(const std::string& what) {
+  /// Ends the stage before (if any) and starts `key` ("": the stage before goes on).
+  void next(const std::string& key, const std::string& what) {
     log_info("[" + std::to_string(++k_) + "/" + std::to_string(total_) + "] " + what);
+    if (key.empty()) return;
+    close();
+    key_ = key, wall_ = Timer(), cpu_ = process_cpu_seconds();
+  }
+  /// {key: {"wall": s, "cpu": s}} of every stage so far, the current one up to now, and their
+  /// "total".
+  Json timings() {
+    close();
+    Json j = Json::object();
+    double wall = 0.0, cpu = 0.0;
+    for (const auto& [key, t] : done_) {
+      j[key] = {{"wall", t.first}, {"cpu", t.second}};
+      wall += t.first, cpu += t.second;
+    }
+    j["total"] = {{"wall", wall}, {"cpu", cpu}};
+    return j;
   }
 
  private:
+  void close() {
+    if (key_.empty()) return;
+    done_.emplace_back(key_, std::make_pair(wall_.seconds(), process_cpu_seconds() - cpu_));
+    key_.clear();
+  }
   int total_, k_ = 0;
+  std::string key_;
+  Timer wall_;
+  double cpu_ = 0.0;
+  std::vector<std::pair<std::string, std::pair<double, double>>> done_;
 };
 
 // Where a run writes.
@@ -56,9 +84,9 @@ struct MethodOutcome {
   const Eigen::MatrixX3d& B;
   const Eigen::MatrixX3d* indirect = nullptr;  ///< I = F (B - E) when B came with F
   const MediumView* medium = nullptr;          ///< the participating medium, when there is one
-  std::string settings;            ///< the method's part of the settings line
-  Json sections = Json::object();  ///< the method's report sections, in report order
-  Json energy = Json::array();     ///< energy_balance: one object per channel
+  std::string settings;                        ///< the method's part of the settings line
+  Json sections = Json::object();              ///< the method's report sections, in report order
+  Json energy = Json::array();                 ///< energy_balance: one object per channel
   std::vector<std::pair<std::string, double>> seconds;  ///< the method's stages, report keys
   std::vector<std::string> time_labels;                 ///< the same for the summary's time line
   std::int64_t rays = 0;
@@ -66,7 +94,7 @@ struct MethodOutcome {
   std::string patches_noun;          ///< after the patch count ("" or " leaves")
   std::vector<std::string> summary;  ///< stdout lines between rays and vertices
   SolveStatus status = SolveStatus::Converged;
-  std::string not_converged;  ///< the warning when status is not Converged
+  std::string not_converged;                         ///< the warning when status is not Converged
   const std::vector<EmitterBasis>* bases = nullptr;  ///< the solution per light source
   double bases_seconds = 0.0;
   std::string no_relighting;  ///< why there are no bases (when none)
@@ -163,8 +191,10 @@ void print_summary(const RunOptions& opts, const MethodOutcome& m, const Tail& t
   for (const std::string& line : m.summary) std::printf("%s\n", line.c_str());
   const auto [after, before] = worst_power_error(t.shaded.power);
   if (t.shaded.interpolation == "exact-direct")
-    std::printf("vertices   exact direct light at the vertices; field vs patch power per surface "
-                "(max) %.2e (not rescaled)\n", after);
+    std::printf(
+        "vertices   exact direct light at the vertices; field vs patch power per surface "
+        "(max) %.2e (not rescaled)\n",
+        after);
   else
     std::printf(
         "vertices   power error per surface (max) %.2e with %s interpolation "
@@ -231,16 +261,19 @@ Json write_run_viewer(const RunPaths& paths, const MethodOutcome& m, const Shade
 // The stages every method shares: per-vertex radiosity, render, write, report, summary.
 int finish_run(const RunOptions& opts, const RunPaths& paths, const MethodOutcome& m,
                const Camera& camera, Stages& stages) {
-  stages.next("per-vertex radiosity (" + resolve_vertex_interp(opts.shade, m.loaded, m.indirect) + ")");
-  const ShadedField shaded = shade_vertices(m.loaded, m.B, m.indirect, opts.shade, opts.run.threads);
+  stages.next("vertices", "per-vertex radiosity (" +
+                              resolve_vertex_interp(opts.shade, m.loaded, m.indirect) + ")");
+  const ShadedField shaded =
+      shade_vertices(m.loaded, m.B, m.indirect, opts.shade, opts.run.threads);
 
-  stages.next("rendering " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  stages.next("render",
+              "rendering " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
   RenderStats rs;
   const Image image = render_scene(m.loaded, m.B, shaded.field, camera, opts.shade,
                                    opts.ff.specular_depth, opts.run, &rs, m.medium);
   const double ev = choose_exposure(opts.shade, image, m.loaded.scene.daylight.has_sky());
 
-  stages.next("writing " + opts.output_dir + "/" + paths.name + ".*");
+  stages.next("write", "writing " + opts.output_dir + "/" + paths.name + ".*");
   const Timer timer;
   const std::string settings = m.settings + shade_settings(opts, shaded.interpolation, camera);
   std::vector<std::string> files =
@@ -248,7 +281,9 @@ int finish_run(const RunOptions& opts, const RunPaths& paths, const MethodOutcom
   const Json viewer = write_run_viewer(paths, m, shaded, camera, ev, settings, files);
   files.push_back(paths.report);
   const Tail tail{shaded, rs, camera, ev, timer.seconds(), files, settings, viewer};
-  write_json_file(paths.report, report_json(opts, m, tail));
+  Json report = report_json(opts, m, tail);
+  report["timings"] = stages.timings();  // the report's own writing is not in "write"
+  write_json_file(paths.report, report);
   print_summary(opts, m, tail);
   if (m.status != SolveStatus::Converged) {
     log_warn(m.not_converged);
@@ -428,14 +463,14 @@ int run_matrix_over_ranks(const RunOptions& opts) {
     if (opts.medium.active() || opts.adapt.active())
       throw UsageError("--distributed does not take a participating medium or --adapt yet");
     const Timer timer;
-    stages.next(loading_what(opts, "loading and meshing "));
+    stages.next("load_and_mesh", loading_what(opts, "loading and meshing "));
     JobPlan plan = job_plan(run);
     if (root) paths = prepare_outputs(opts, plan);  // rank 0 alone creates and writes
     LoadedScene loaded = load_scene(opts.scene, plan);
     camera = make_camera(loaded.scene, opts.camera);
     load_seconds = timer.seconds();
-    stages.next("form factors over the ranks");
-    stages.next("solving (I - rho F) B = E with PETSc over the ranks");
+    stages.next("form_factors_and_solve", "form factors over the ranks");
+    stages.next("", "solving (I - rho F) B = E with PETSc over the ranks");
     return loaded;
   };
   auto finish = [&](const LoadedScene& loaded, const RadiosityResult& r, const Json& section) {
@@ -453,7 +488,7 @@ int run_matrix(const RunOptions& opts) {
     throw UsageError("--adapt does not combine with a participating medium yet");
   Stages stages(6);
   Timer timer;
-  stages.next(loading_what(opts, "loading and meshing "));
+  stages.next("load_and_mesh", loading_what(opts, "loading and meshing "));
   JobPlan plan;
   const RunPaths paths = prepare_outputs(opts, plan);
   plan_form_factors(plan, opts.ff, opts.run);
@@ -471,18 +506,19 @@ int run_matrix(const RunOptions& opts) {
                                     ? auto_estimator(loaded.mesh.size(), opts.ff.tol_given)
                                     : opts.ff.estimator;
   const std::string count = estimator_count_option(estimator);
-  const std::string per =
-      count == "rays"      ? ", " + std::to_string(opts.ff.rays) + " rays per patch"
-      : count == "samples" ? ", " + std::to_string(opts.ff.samples) + " samples per pair"
-                           : "";
-  stages.next("form factors (" +
-              (opts.ff.ff_file.empty() ? estimator + per : "from " + opts.ff.ff_file) + ")");
+  const std::string per = count == "rays" ? ", " + std::to_string(opts.ff.rays) + " rays per patch"
+                          : count == "samples"
+                              ? ", " + std::to_string(opts.ff.samples) + " samples per pair"
+                              : "";
+  stages.next("form_factors",
+              "form factors (" +
+                  (opts.ff.ff_file.empty() ? estimator + per : "from " + opts.ff.ff_file) + ")");
   RadiosityResult r;
   std::optional<MediumResult> medium_result;
   timer.reset();
   std::vector<AdaptRound> rounds;
   if (opts.adapt.active()) {
-    stages.next("adaptive meshing and solving with " + opts.solver.solver);
+    stages.next("adapt_and_solve", "adaptive meshing and solving with " + opts.solver.solver);
     SolveOptions so = opts.solver;
     set_memory_limit(so, opts.run.max_memory);
     FormFactors F;
@@ -505,12 +541,13 @@ int run_matrix(const RunOptions& opts) {
     const FormFactors F = obtain_form_factors(loaded, opts.ff, opts.run, false, medium.get());
     r.ff_seconds = timer.seconds();
     if (medium) {
-      stages.next("medium zones and solving (I - rho F) B = E with " + opts.solver.solver);
+      stages.next("medium_and_solve",
+                  "medium zones and solving (I - rho F) B = E with " + opts.solver.solver);
       medium_result =
           solve_scene_with_medium(loaded, F, medium, opts.medium, opts.solver, opts.run, r);
       r.ff_seconds += medium_result->seconds;  // the zones' exchange factors are form factors
     } else {
-      stages.next("solving (I - rho F) B = E with " + opts.solver.solver);
+      stages.next("solve", "solving (I - rho F) B = E with " + opts.solver.solver);
       solve_scene(loaded, F, opts.solver, opts.run, r, true);
     }
   }
@@ -524,7 +561,7 @@ int run_hierarchical(const RunOptions& opts) {
   check_vertex_interp(opts.shade, false, "--method hierarchical");
   Stages stages(5);
   const Timer timer;
-  stages.next(loading_what(opts, "loading "));
+  stages.next("load", loading_what(opts, "loading "));
   JobPlan plan;
   const RunPaths paths = prepare_outputs(opts, plan);
   Scene scene = load_checked_scene(opts.scene, plan);
@@ -538,7 +575,7 @@ int run_hierarchical(const RunOptions& opts) {
   std::ostringstream what;
   what << "hierarchical radiosity (epsilon " << ho.epsilon << ", " << ho.link_rays
        << " rays per link, tol " << ho.tol << ")";
-  stages.next(what.str());
+  stages.next("hierarchical", what.str());
   const HierarchicalRun h = solve_scene_hierarchical(std::move(scene), ho);
   const HierarchicalStats& st = h.stats;
 

@@ -1,9 +1,18 @@
 #pragma once
-// Wall-clock timer.
+// Wall-clock timer and the process's CPU time.
+
+#include <time.h>
 
 #include <chrono>
 
 namespace lambert {
+
+/// CPU seconds this process has used so far, over all its threads (user + system).
+inline double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 /// Measures elapsed wall time from construction or the last reset().
 class Timer {

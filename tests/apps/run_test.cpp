@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -19,7 +20,6 @@ namespace lambert {
 using testing::run;
 using testing::slurp;
 namespace {
-
 
 // A tiny open box (unit cube without its z = 0 face, faces pointing inward) lit by an
 // emissive patch on the ceiling; without a .camera sidecar the default camera looks in
@@ -124,6 +124,38 @@ TEST(RunCommand, TinySceneProducesEveryFile) {
 // The counters are process-wide and other tests may have run in this process before (ctest
 // runs one test per process, a plain run of the executable does not), so the test reads
 // them before and after: one build more, and at most one device for this thread count.
+// report.json "timings" (issue 37): every stage of the matrix run under its key with wall
+// and CPU seconds, and their total. A run on one thread (-j 1) cannot use more CPU time than
+// wall time in any stage; 10 ms absorbs the two clocks' granularity (both are read at each
+// stage boundary, microseconds apart).
+TEST(RunCommand, TheReportTimesEveryStageInWallAndCpuSeconds) {
+  lambert::testing::TempDir dir;
+  write_tiny_scene(dir);
+  const std::string out = dir.file("results");
+  ::testing::internal::CaptureStdout();
+  const int code = run({"run", dir.file("tiny.obj"), "-o", out, "--patches", "80", "--samples", "4",
+                        "--size", "40x30", "-q", "-j", "1"});
+  ::testing::internal::GetCapturedStdout();
+  ASSERT_EQ(code, kExitOk);
+  const nlohmann::json t = nlohmann::json::parse(slurp(out + "/report.json")).at("timings");
+  std::vector<std::string> keys;
+  for (const auto& [key, value] : t.items()) keys.push_back(key);
+  std::sort(keys.begin(), keys.end());
+  EXPECT_EQ(keys, (std::vector<std::string>{"form_factors", "load_and_mesh", "render", "solve",
+                                            "total", "vertices", "write"}));
+  double wall = 0.0, cpu = 0.0;
+  for (const auto& [key, value] : t.items()) {
+    if (key == "total") continue;
+    const double w = value.at("wall").get<double>(), c = value.at("cpu").get<double>();
+    EXPECT_GE(w, 0.0) << key;
+    EXPECT_GE(c, 0.0) << key;
+    EXPECT_LE(c, w + 0.01) << key;
+    wall += w, cpu += c;
+  }
+  EXPECT_NEAR(t.at("total").at("wall").get<double>(), wall, 1e-12);
+  EXPECT_NEAR(t.at("total").at("cpu").get<double>(), cpu, 1e-12);
+}
+
 TEST(RunCommand, BuildsOneBvhOnOneDeviceForFormFactorsAndRendering) {
   lambert::testing::TempDir dir;
   write_tiny_scene(dir);
@@ -272,8 +304,9 @@ TEST(RunCommand, VertexInterpAutoIsExactDirectOnDiscontinuityMeshes) {
   write_tiny_scene(dir);
   const std::string scene = dir.file("tiny.obj");
   auto interpolation = [&](const std::vector<std::string>& extra) {
-    std::vector<std::string> args = {"run", scene, "-o", dir.file("o/"), "--max-edge", "0.3",
-                                     "--samples", "2", "--size", "16x16", "--antialias", "1", "-q"};
+    std::vector<std::string> args = {"run",         scene,       "-o", dir.file("o/"), "--max-edge",
+                                     "0.3",         "--samples", "2",  "--size",       "16x16",
+                                     "--antialias", "1",         "-q"};
     args.insert(args.end(), extra.begin(), extra.end());
     ::testing::internal::CaptureStdout();
     const int code = run(args);
@@ -288,15 +321,16 @@ TEST(RunCommand, VertexInterpAutoIsExactDirectOnDiscontinuityMeshes) {
   EXPECT_EQ(interpolation({"--discontinuity", "--vertex-interp", "area"}), "area");
 
   ::testing::internal::CaptureStdout();
-  ASSERT_EQ(run({"solve", scene, "--max-edge", "0.3", "--samples", "2", "-o", dir.file("B.csv"), "-q"}),
-            kExitOk);
+  ASSERT_EQ(
+      run({"solve", scene, "--max-edge", "0.3", "--samples", "2", "-o", dir.file("B.csv"), "-q"}),
+      kExitOk);
   ::testing::internal::GetCapturedStdout();
   ::testing::internal::CaptureStderr();
   EXPECT_EQ(run({"render", scene, "--max-edge", "0.3", "--radiosity", dir.file("B.csv"),
                  "--vertex-interp", "exact-direct", "-o", dir.file("r.exr"), "-q"}),
             kExitUsage);
-  EXPECT_EQ(run({"run", scene, "--method", "hierarchical", "--vertex-interp", "exact-direct",
-                 "-o", dir.file("h/"), "-q"}),
+  EXPECT_EQ(run({"run", scene, "--method", "hierarchical", "--vertex-interp", "exact-direct", "-o",
+                 dir.file("h/"), "-q"}),
             kExitUsage);
   const std::string err = ::testing::internal::GetCapturedStderr();
   EXPECT_NE(err.find("exact-direct"), std::string::npos) << err;
