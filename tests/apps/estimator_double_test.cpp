@@ -13,6 +13,8 @@
 #include "apps/cli.hpp"
 #include "common/run_cli.hpp"
 #include "common/temp_dir.hpp"
+#include "core/error.hpp"
+#include "geometry/analytic.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "io/ff_file.hpp"
 #include "io/ff_settings.hpp"
@@ -118,6 +120,20 @@ TEST(TestEstimator, ItsValueReachesTheEstimatorAndTheSavedSettings) {
   mc.estimator = "mc";
   EXPECT_EQ(format_ff_settings(mc).find("uniform_weight"), std::string::npos);
   EXPECT_TRUE(ff_settings_report(mc)["uniform_weight"].is_null());
+}
+
+TEST(TestEstimator, TheLibraryChecksItsParameterAgainstItsDeclaration) {
+  const PatchMesh mesh = mesh_scene(unit_cube(), {0.5, 0});
+  FormFactorOptions o;
+  o.estimator = "uniform";
+  o.run.progress = false;
+  // Unset: the declared default, which the kernel reads (each row sums to it).
+  const FormFactors ff = compute_form_factors(mesh, o);
+  for (Eigen::Index i = 0; i < ff.F.rows(); ++i) EXPECT_NEAR(ff.F.row(i).sum(), 0.5, 1e-14);
+  for (const double bad : {0.0, 1.5}) {
+    set_estimator_param(o, "--uniform-weight", bad);
+    EXPECT_THROW(compute_form_factors(mesh, o), UsageError) << bad;
+  }
 }
 
 }  // namespace
