@@ -152,7 +152,7 @@ int formfactors_over_ranks(const FormFactorsOptions& opts) {
       JobPlan plan = job_plan(run);
       if (s.root()) plan.outputs = {{"-o", opts.output}, {"--report", report}};
       SceneArgs scene_args = opts.scene;  // analytic: whole faces unless asked (formfactors.cpp)
-      if ((opts.ff.estimator == "auto" ? auto_estimator(0, opts.ff.tol_given)
+      if ((opts.ff.estimator == "auto" ? auto_estimator(0, opts.ff.given("--ff-tol"))
                                        : opts.ff.estimator) == "analytic")
         scene_args.default_patches = 0;
       scene = load_scene(scene_args, plan);

@@ -262,8 +262,8 @@ int run_formfactors(const FormFactorsOptions& opts) {
   // The analytic estimator (named, or auto's pick for --ff-tol) integrates over whole
   // polygons: one patch per face unless --max-edge or --patches asks for more.
   SceneArgs scene_args = opts.scene;
-  if ((opts.ff.estimator == "auto" ? auto_estimator(0, opts.ff.tol_given) : opts.ff.estimator) ==
-      "analytic")
+  if ((opts.ff.estimator == "auto" ? auto_estimator(0, opts.ff.given("--ff-tol"))
+                                   : opts.ff.estimator) == "analytic")
     scene_args.default_patches = 0;
   const LoadedScene scene = load_scene(scene_args, plan);
   if (!opts.point.empty()) {

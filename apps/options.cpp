@@ -114,17 +114,20 @@ void add_solve_options(CLI::App* cmd, SolveOptions& o, bool with_solver) {
 void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load, bool tol_alias) {
   std::vector<CLI::Option*> compute_only;
   compute_only.push_back(add_declared(cmd, "--estimator", args.estimator));
-  compute_only.push_back(
-      add_declared(cmd, "--samples", args.samples)->each([&args](const std::string&) {
-        args.samples_given = true;
-      }));
-  compute_only.push_back(add_declared(cmd, "--rays", args.rays)->each([&args](const std::string&) {
-    args.rays_given = true;
-  }));
-  compute_only.push_back(add_declared(cmd, tol_alias ? "--ff-tol,--tol" : "--ff-tol", args.tol)
-                             ->each([&args](const std::string&) { args.tol_given = true; }));
+  // The estimators' parameters, as the registry declares them (bound to args.params, whose
+  // elements stay put; a value set before, such as run's cheaper --samples, is the default).
+  for (const DeclaredEstimatorParam& d : estimator_params()) {
+    const std::string& option = d.param.option;
+    double& value = args.params.emplace(option, args.param(option)).first->second;
+    const std::string names =
+        tol_alias && !d.param.alias.empty() ? option + "," + d.param.alias : option;
+    CLI::Option* o = add_declared(cmd, names, value)->each([&args, option](const std::string&) {
+      args.params_given.insert(option);
+    });
+    if (d.param.integer) o->type_name("INT");  // bound to a double, checked whole by its row
+    compute_only.push_back(o);
+  }
   compute_only.push_back(add_declared(cmd, "--threshold", args.threshold));
-  compute_only.push_back(add_declared(cmd, "--hemicube-res", args.hemicube_resolution));
   CLI::Option* reciprocity =
       add_declared(cmd, "--reciprocity", args.reciprocity)->each([&args](const std::string&) {
         args.reciprocity_given = true;

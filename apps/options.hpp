@@ -66,10 +66,12 @@ void add_method_options(CLI::App* cmd, MethodArgs& args, bool epsilon_list = fal
 /// `with_solver`) bound to `options`.
 void add_solve_options(CLI::App* cmd, SolveOptions& options, bool with_solver);
 
-/// Adds the form-factor options to a subcommand. `with_load` adds --ff FILE, which excludes
-/// the options that only steer a computation (--estimator, --samples, --rays, --threshold,
-/// --hemicube-res, --reciprocity, --symmetrize): given together, they are a usage error.
-/// `tol_alias` also names --ff-tol --tol (the formfactors command, which has no solver).
+/// Adds the form-factor options to a subcommand: --estimator, every estimator parameter the
+/// registry declares (estimator_params(): --samples, --rays, --ff-tol, --hemicube-res, ...),
+/// --threshold, --reciprocity, --symmetrize, the specular options. `with_load` adds --ff
+/// FILE, which excludes the options that only steer a computation: given together, they are a
+/// usage error. `tol_alias` also registers the parameters' aliases (--ff-tol as --tol: the
+/// formfactors command, which has no solver).
 void add_ff_options(CLI::App* cmd, FormFactorArgs& args, bool with_load = true,
                     bool tol_alias = false);
 

@@ -3,6 +3,7 @@
 // per-vertex radiosity, render, and every output file, with one progress line per stage on
 // stderr and a closing summary on stdout.
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -503,13 +504,15 @@ int run_matrix(const RunOptions& opts) {
   if (medium) check_medium_scene(loaded.mesh, &opts.shade);
 
   const std::string estimator = opts.ff.estimator == "auto"
-                                    ? auto_estimator(loaded.mesh.size(), opts.ff.tol_given)
+                                    ? auto_estimator(loaded.mesh.size(), opts.ff.given("--ff-tol"))
                                     : opts.ff.estimator;
   const std::string count = estimator_count_option(estimator);
-  const std::string per = count == "rays" ? ", " + std::to_string(opts.ff.rays) + " rays per patch"
-                          : count == "samples"
-                              ? ", " + std::to_string(opts.ff.samples) + " samples per pair"
-                              : "";
+  const std::string per =
+      count == "rays"
+          ? ", " + std::to_string(std::lround(opts.ff.param("--rays"))) + " rays per patch"
+      : count == "samples"
+          ? ", " + std::to_string(std::lround(opts.ff.param("--samples"))) + " samples per pair"
+          : "";
   stages.next("form_factors",
               "form factors (" +
                   (opts.ff.ff_file.empty() ? estimator + per : "from " + opts.ff.ff_file) + ")");
@@ -627,7 +630,7 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& opts) {
       "run", "The main job: load, mesh, form factors, solve, render; writes every output");
   opts.scene.default_patches = 1600;
   opts.scene.require_emitter = true;  // B from E: a scene where nothing emits is refused
-  opts.ff.samples = kRunDefaultSamples;
+  opts.ff.params["--samples"] = kRunDefaultSamples;
   add_scene_options(cmd, opts.scene);
   add_run_options(cmd, opts.run);
   add_method_options(cmd, opts.method);

@@ -108,7 +108,7 @@ Run run_method(const Scene& scene, const std::string& method, long target, int s
   if (adapt) {
     FormFactorArgs ff;
     ff.estimator = "hybrid";
-    ff.samples = samples;
+    ff.set_param("--samples", samples);
     RunArgs run;
     AdaptArgs a;
     a.patches = target;

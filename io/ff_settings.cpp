@@ -5,9 +5,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <limits>
 #include <sstream>
 #include <type_traits>
+
+#include "core/error.hpp"
 
 namespace lambert {
 // The helpers in a namespace of their own: lambert_io compiles in batches of files (unity
@@ -200,20 +203,86 @@ Setting specular_depth() {
   return s;
 }
 
+// The row of an estimator parameter, from its declaration (EstimatorParam): an integer as
+// decimal, a real as %.17g; read back through set_estimator_param.
+Setting estimator_param_row(const DeclaredEstimatorParam& d) {
+  const EstimatorParam& p = d.param;
+  Setting s{"", "", p.stored_always ? When::Always : When::Estimator,
+            p.integer ? Kind::Integer : Kind::Real};
+  s.param = p.option;
+  s.estimators = d.estimators;
+  s.required = p.required;
+  if (p.integer) {
+    const bool stored = p.stored_min != 0.0 || p.stored_max != 0.0;
+    s.min = static_cast<std::int64_t>(stored ? p.stored_min : p.lo);
+    s.max = static_cast<std::int64_t>(stored ? p.stored_max : p.hi);
+  } else {
+    s.positive = p.lo > 0.0 || (p.lo == 0.0 && p.open_lo);
+  }
+  const std::string option = p.option;
+  if (p.integer) {
+    s.text = [option](const O& o) {
+      return std::to_string(static_cast<long long>(estimator_param(o, option)));
+    };
+    s.value = [option](const O& o) {
+      return Json(static_cast<std::int64_t>(estimator_param(o, option)));
+    };
+    s.read = [](const Setting& row, const std::string& v, O& o) {
+      long long k = 0;
+      if (!parse_int(v, k) || k < row.min || k > row.max) return false;
+      set_estimator_param(o, row.param, static_cast<double>(k));
+      return true;
+    };
+  } else {
+    s.text = [option](const O& o) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.17g", estimator_param(o, option));
+      return std::string(buf);
+    };
+    s.value = [option](const O& o) { return Json(estimator_param(o, option)); };
+    s.read = [](const Setting& row, const std::string& v, O& o) {
+      double x = 0.0;
+      if (!parse_double(v, x) || (row.positive && !(x > 0.0))) return false;
+      set_estimator_param(o, row.param, x);
+      return true;
+    };
+  }
+  return s;
+}
+
+// The fixed rows, then each estimator parameter's after the row it names (key or report
+// name; at the end when it names none). The keys and names are the rows' own strings, which
+// live as long as the table (the parameters' in `keys`).
+std::vector<Setting> with_estimator_params(std::vector<Setting> rows) {
+  static std::deque<std::string> keys;  // the parameters' keys and names (never moved)
+  for (const DeclaredEstimatorParam& d : estimator_params()) {
+    Setting s = estimator_param_row(d);
+    keys.push_back(d.param.key.empty() ? d.param.keyword : d.param.key);
+    s.key = keys.back().c_str();
+    keys.push_back(d.param.report.empty() ? d.param.keyword : d.param.report);
+    s.name = keys.back().c_str();
+    for (const Setting& r : rows)
+      LAMBERT_CHECK(std::string(r.key) != s.key && std::string(r.name) != s.name,
+                    d.param.option + ": its settings key or report name is taken");
+    auto at = rows.end();
+    if (!d.param.after.empty())
+      at = std::find_if(rows.begin(), rows.end(), [&](const Setting& r) {
+        return d.param.after == r.key || d.param.after == r.name;
+      });
+    LAMBERT_CHECK(d.param.after.empty() || at != rows.end(),
+                  d.param.option + ": no setting '" + d.param.after + "' to follow");
+    rows.insert(at == rows.end() ? at : at + 1, std::move(s));
+  }
+  return rows;
+}
+
 std::vector<Setting> make_settings() {
   using Contents = FormFactorContents;
-  return {
+  return with_estimator_params({
       required(word<&O::estimator>("estimator", "estimator", When::Always, {})),
       word<&O::estimator_requested>("", "estimator_requested", When::Resolved, {}),
-      required(integer<&O::pair, &PairEstimatorParams::samples>("samples", "samples", When::Always,
-                                                                1, kIntMax)),
-      // "rays" in reports is the count traced.
-      integer<&O::gather, &GatherParams::rays>("rays", "rays_per_patch", When::Always, 1, kIntMax),
       required(unsigned_integer<&O::run, &FormFactorRun::seed>("seed", "seed", When::Always)),
       required(real<&O::threshold>("threshold", "threshold", When::Always, false)),
-      integer<&O::hemicube, &HemicubeParams::resolution>("hemicube_res", "hemicube_resolution",
-                                                         When::Always, 1, kIntMax),
-      real<&O::analytic, &AnalyticParams::tol>("tol", "tol", When::Analytic, true),
       reciprocity(),
       symmetrize(),
       flag<&O::contents, &Contents::extended>("", "extended", When::Always),
@@ -226,11 +295,11 @@ std::vector<Setting> make_settings() {
       integer<&O::contents, &Contents::medium_rays>("medium_rays", "", When::Medium, 1, kIntMax),
       integer<&O::contents, &Contents::transmittance_samples>("transmittance_samples", "",
                                                               When::Medium, 1, kIntMax),
-  };
+  });
 }
 
 // The groups of the settings text, in order.
-constexpr When kTextOrder[] = {When::Always, When::Extended, When::Analytic, When::Medium,
+constexpr When kTextOrder[] = {When::Always, When::Extended, When::Estimator, When::Medium,
                                When::Resolved};
 
 }  // namespace
@@ -250,8 +319,8 @@ bool setting_applies(const FormFactorSetting& s, const FormFactorOptions& o) {
       return true;
     case When::Extended:
       return o.contents.extended;
-    case When::Analytic:
-      return o.estimator == "analytic";
+    case When::Estimator:
+      return std::find(s.estimators.begin(), s.estimators.end(), o.estimator) != s.estimators.end();
     case When::Medium:
       return o.contents.medium_zones > 0;
     case When::Resolved:

@@ -2,14 +2,16 @@
 // The settings of a form-factor computation as data: one row per setting of
 // FormFactorOptions that is stored with a saved F (the settings text, format_ff_settings and
 // parse_ff_settings) or reported (the form_factors section of the reports,
-// ff_settings_report). A new estimator parameter is its field in its block of
-// FormFactorOptions and one row of form_factor_settings().
+// ff_settings_report). An estimator parameter's row comes from its declaration on the
+// estimator's registry entry (EstimatorParam in geometry/formfactors/formfactors.hpp): key,
+// report name, kind, range and place; nothing is added here for it.
 //
 // The settings text is space-separated key=value pairs, e.g. "estimator=hybrid samples=32
 // rays=1024 seed=1 threshold=0 hemicube_res=128 reciprocity=none symmetrize=0". Saved files
 // and their readers depend on it byte for byte: rows may be added, never changed.
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -24,11 +26,11 @@ struct FormFactorSetting {
   /// lists the settings by group in this order, each group in table order (keys are only
   /// ever appended, for older readers); reports list them in table order.
   enum class When {
-    Always,    ///< stored always; reported when the estimator is known (not a foreign file)
-    Extended,  ///< F holds specular paths (contents.extended)
-    Analytic,  ///< the estimator is "analytic"
-    Medium,    ///< F holds a participating medium's zones (contents.medium_zones > 0)
-    Resolved,  ///< the estimator was resolved from "auto" (estimator_requested not empty)
+    Always,     ///< stored always; reported when the estimator is known (not a foreign file)
+    Extended,   ///< F holds specular paths (contents.extended)
+    Estimator,  ///< the estimator is one of `estimators` (an estimator parameter: analytic's tol)
+    Medium,     ///< F holds a participating medium's zones (contents.medium_zones > 0)
+    Resolved,   ///< the estimator was resolved from "auto" (estimator_requested not empty)
   };
   /// How the value is written and what reading it back accepts.
   enum class Kind {
@@ -55,11 +57,15 @@ struct FormFactorSetting {
   /// A legacy key of the setting keyed `yields_to`: checked, but ignored where that key is
   /// given (symmetrize= before reciprocity=).
   const char* yields_to = nullptr;
+  /// The estimator parameter the row stores (its option, "--samples"; "" = none) and the
+  /// estimators that declare it (When::Estimator: the row applies to them).
+  std::string param = {};
+  std::vector<std::string> estimators = {};
 
   /// The value as stored.
-  std::string (*text)(const FormFactorOptions&) = nullptr;
+  std::function<std::string(const FormFactorOptions&)> text = nullptr;
   /// The value as reported.
-  Json (*value)(const FormFactorOptions&) = nullptr;
+  std::function<Json(const FormFactorOptions&)> value = nullptr;
   /// Stores a well-formed value into the options; false (options unspecified) otherwise.
   bool (*read)(const FormFactorSetting&, const std::string&, FormFactorOptions&) = nullptr;
 };

@@ -27,34 +27,61 @@ std::string selected_estimator(const FormFactorArgs& args) {
   return args.ff_file.empty() ? args.estimator : "";
 }
 
+double FormFactorArgs::param(const std::string& option) const {
+  const auto it = params.find(option);
+  if (it != params.end()) return it->second;
+  const DeclaredEstimatorParam* d = find_estimator_param(option);
+  LAMBERT_CHECK(d != nullptr, "no estimator declares the parameter " + option);
+  return d->param.fallback;
+}
+
+void FormFactorArgs::set_param(const std::string& option, double value) {
+  LAMBERT_CHECK(find_estimator_param(option) != nullptr,
+                "no estimator declares the parameter " + option);
+  params[option] = value;
+  params_given.insert(option);
+}
+
+std::string estimator_readers_text(const std::vector<std::string>& estimators) {
+  std::string out = estimators.size() == 1 ? "the estimator " : "the estimators ";
+  for (size_t k = 0; k < estimators.size(); ++k)
+    out += (k == 0 ? "" : k + 1 == estimators.size() ? " and " : ", ") + estimators[k];
+  return out;
+}
+
+namespace {
+
+std::string readers_of(const std::string& option) {
+  const DeclaredEstimatorParam* d = find_estimator_param(option);
+  return d ? estimator_readers_text(d->estimators) : "";
+}
+
+}  // namespace
+
 FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run) {
   FormFactorOptions o;
   o.estimator = args.estimator;
-  o.pair.samples = args.samples;
-  o.gather.rays = args.rays;
+  for (const auto& [option, value] : args.params) set_estimator_param(o, option, value);
   o.run.seed = run.seed;
   o.run.threads = run.threads;
   o.threshold = args.threshold;
-  o.hemicube.resolution = args.hemicube_resolution;
   o.reciprocity = args.symmetrize ? "average" : args.reciprocity;
   o.run.progress = !run.quiet;
   o.specular.depth = args.specular_depth;
   o.specular.rays = args.specular_rays;
-  o.analytic.tol = args.tol;
-  o.analytic.tol_given = args.tol_given;
+  o.analytic.tol_given = args.given("--ff-tol");
   if (args.estimator != "auto") {
     const std::vector<std::string> unused = unused_count_options(args, args.estimator);
     if (!unused.empty())
       throw UsageError(unused.front() + " does not apply to --estimator " + args.estimator +
-                       " (--samples is per patch pair for mc and hybrid, --rays per patch for "
-                       "gather, --ff-tol the error target of analytic)");
+                       " (read by " + readers_of(unused.front()) + ")");
   }
   return o;
 }
 
 void check_auto_pick(const FormFactorArgs& args, std::int64_t patches) {
   if (args.estimator != "auto") return;
-  const std::string pick = auto_estimator(patches, args.tol_given);
+  const std::string pick = auto_estimator(patches, args.given("--ff-tol"));
   const std::vector<std::string> unused = unused_count_options(args, pick);
   if (args.reciprocity_given && pick != "gather")
     throw UsageError((args.symmetrize ? "--symmetrize" : "--reciprocity") +
@@ -64,9 +91,8 @@ void check_auto_pick(const FormFactorArgs& args, std::int64_t patches) {
                      "read it)");
   if (!unused.empty())
     throw UsageError(unused.front() + " does not apply: --estimator auto picks " + pick + " for " +
-                     std::to_string(patches) +
-                     " patches (name the estimator that reads it: --samples mc or hybrid, "
-                     "--rays gather, --ff-tol analytic)");
+                     std::to_string(patches) + " patches (name the estimator that reads it: " +
+                     readers_of(unused.front()) + ")");
 }
 
 void check_ff_args_for_mesh(const FormFactorArgs& args, const PatchMesh& mesh) {
@@ -79,11 +105,11 @@ void check_ff_args_for_mesh(const FormFactorArgs& args, const PatchMesh& mesh) {
 
 std::vector<std::string> unused_count_options(const FormFactorArgs& args,
                                               const std::string& estimator) {
-  const std::string used = estimator_count_option(estimator);
   std::vector<std::string> out;
-  if (args.rays_given && used != "rays") out.push_back("--rays");
-  if (args.samples_given && used != "samples") out.push_back("--samples");
-  if (args.tol_given && used != "tol") out.push_back("--ff-tol");
+  for (const DeclaredEstimatorParam& d : estimator_params())
+    if (args.given(d.param.option) &&
+        std::find(d.estimators.begin(), d.estimators.end(), estimator) == d.estimators.end())
+      out.push_back(d.param.option);
   return out;
 }
 

@@ -2,7 +2,9 @@
 // The form-factor settings of every command that needs F, and the stage that computes F or
 // loads a saved one (with its checks and report pieces).
 
+#include <set>
 #include <string>
+#include <vector>
 
 #include "geometry/formfactors/formfactors.hpp"
 #include "io/json.hpp"
@@ -12,33 +14,43 @@ namespace lambert {
 
 struct Medium;
 
-/// `run`'s --samples default: cheaper than the other commands' (FormFactorArgs::samples), for
-/// a quick first picture.
+/// `run`'s --samples default: cheaper than the other commands' (the parameter's declared
+/// default), for a quick first picture.
 constexpr int kRunDefaultSamples = 16;
 
-/// --estimator, --samples, --rays, --threshold, --hemicube-res, --reciprocity,
-/// --symmetrize, --ff.
+/// --estimator and the estimators' parameters (estimator_params(): --samples, --rays,
+/// --ff-tol, --hemicube-res, and whatever the registry declares), --threshold,
+/// --reciprocity, --symmetrize, the specular options, --ff.
 struct FormFactorArgs {
   std::string estimator = "auto";
-  int samples = 32;
-  int rays = 1024;
+  /// The estimators' parameters by option name ("--samples"); an absent one is at its
+  /// declared default. The front ends bind to these values (CLI) or set them (set_param).
+  EstimatorParamValues params;
+  /// The estimator parameters the user gave (a front end's set_param or `each` marks them).
+  std::set<std::string> params_given;
   double threshold = 0.0;
-  int hemicube_resolution = 128;
   std::string reciprocity = "auto";
-  bool symmetrize = false;     ///< alias of --reciprocity average
-  bool samples_given = false;  ///< --samples was on the command line
-  bool rays_given = false;     ///< --rays was on the command line
-  double tol = 1e-6;           ///< --ff-tol (--tol in formfactors): estimator analytic
-  bool tol_given = false;      ///< --ff-tol was on the command line
-  std::string ff_file;         ///< load F from this file instead of computing it
+  bool symmetrize = false;  ///< alias of --reciprocity average
+  std::string ff_file;      ///< load F from this file instead of computing it
   /// --specular-depth: specular bounces followed by the extended form factors and by the
   /// ray-traced view pass (with --ff it steers the view pass only; F keeps its own).
   int specular_depth = 8;
   int specular_rays = 1024;  ///< --specular-rays: rays per patch of the extended part
+  /// --specular-depth or --specular-rays was on the command line.
   bool specular_given = false;
-  bool reciprocity_given = false;  ///< --reciprocity or --symmetrize was on the command line  ///<
-                                   ///< --specular-depth or --specular-rays was on the command line
+  bool reciprocity_given = false;  ///< --reciprocity or --symmetrize was on the command line
+
+  /// The value of the estimator parameter `option`: as set, else its declared default.
+  double param(const std::string& option) const;
+  /// Sets the estimator parameter `option` as given by the user.
+  void set_param(const std::string& option, double value);
+  /// The user gave the estimator parameter `option`.
+  bool given(const std::string& option) const { return params_given.count(option) > 0; }
 };
+
+/// What reads an estimator parameter, for messages and the option reference: "the estimator
+/// gather", "the estimators hybrid and mc" (its DeclaredEstimatorParam::estimators).
+std::string estimator_readers_text(const std::vector<std::string>& estimators);
 
 /// Adds F to a job plan: --ff as an input, or the computation's options for the memory
 /// estimate.
@@ -49,12 +61,13 @@ void plan_form_factors(JobPlan& plan, const FormFactorArgs& args, const RunArgs&
 /// from --ff.
 std::string selected_estimator(const FormFactorArgs& args);
 
-/// Refuses (UsageError) a count option (--samples, --rays, --ff-tol) that the estimator
-/// --estimator auto picks for `patches` patches does not read; nothing for a named estimator.
+/// Refuses (UsageError) an estimator parameter (--samples, --rays, --ff-tol, ...) that the
+/// estimator --estimator auto picks for `patches` patches does not read; nothing for a named
+/// estimator.
 void check_auto_pick(const FormFactorArgs& args, std::int64_t patches);
 
 /// Builds FormFactorOptions from the arguments ("auto" stays unresolved: it needs the patch
-/// count). Throws UsageError when a named estimator does not read a count that was given
+/// count). Throws UsageError when a named estimator does not read a parameter that was given
 /// (--rays with a pair estimator or the hemicube, --samples with gather).
 FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run);
 
@@ -62,8 +75,8 @@ FormFactorOptions make_ff_options(const FormFactorArgs& args, const RunArgs& run
 /// and the specular options refused on a mesh without mirror or glass (UsageError).
 void check_ff_args_for_mesh(const FormFactorArgs& args, const PatchMesh& mesh);
 
-/// The count options given on the command line that `estimator` (resolved) ignores, as
-/// option names ("--rays", "--samples", "--ff-tol"); empty when none.
+/// The estimator parameters given that `estimator` (resolved) does not declare, as option
+/// names ("--rays", "--samples", "--ff-tol"), in registry order; empty when none.
 std::vector<std::string> unused_count_options(const FormFactorArgs& args,
                                               const std::string& estimator);
 

@@ -63,13 +63,13 @@ bool computes_f(const Selection& s) { return !s.estimator.empty(); }
 // "--estimator E" may read an option of the estimators `names`: E is one of them, or auto
 // and one of them is among auto's picks (hybrid, gather, analytic, by the patch count once
 // the scene is meshed: that pick is checked then, ff_stage.cpp).
-bool estimator_may_be(const Selection& s, std::initializer_list<const char*> names) {
+bool estimator_may_be(const Selection& s, const std::vector<std::string>& names) {
   if (!computes_f(s)) return false;
   if (s.estimator == "auto")
-    return std::any_of(names.begin(), names.end(), [](const char* n) {
+    return std::any_of(names.begin(), names.end(), [](const std::string& n) {
       return is_one_of(n, {"hybrid", "gather", "analytic"});
     });
-  return is_one_of(s.estimator, names);
+  return std::find(names.begin(), names.end(), s.estimator) != names.end();
 }
 
 // --reciprocity and --symmetrize: the estimators whose F is not reciprocal by construction
@@ -171,6 +171,10 @@ struct Row {
   }
   Row& fallback(std::string default_text) {
     s.default_text = std::move(default_text);
+    return *this;
+  }
+  Row& described(std::string doc) {
+    s.doc = std::move(doc);
     return *this;
   }
 };
@@ -304,42 +308,27 @@ std::vector<OptionSpec> make_specs() {
                      " patches, gather from there)")
               .py("estimator")
               .by_method("matrix"));
-  const std::string samples_doc = "Sample pairs (rays) per patch pair (pair estimators mc, hybrid)";
-  const auto samples_reads = [](const Selection& s) {
-    return estimator_may_be(s, {"mc", "hybrid"});
-  };
-  add_row(integer("--samples", 1, 1 << 20, std::to_string(ff.samples), samples_doc)
-              .py("samples")
-              .by_method("matrix")
-              .read_by("the pair estimators mc and hybrid", samples_reads));
-  add_row(integer("--samples", 1, 1 << 20, std::to_string(kRunDefaultSamples),
-                  samples_doc + "; run's default is cheaper than the other commands'")
-              .on({"run"})
-              .by_method("matrix")
-              .read_by("the pair estimators mc and hybrid", samples_reads));
-  add_row(
-      integer("--rays", 1, 1 << 24, std::to_string(ff.rays), "Rays per patch (estimator gather)")
-          .py("rays")
-          .by_method("matrix")
-          .read_by("the estimator gather",
-                   [](const Selection& s) { return estimator_may_be(s, {"gather"}); }));
-  add_row(real("--ff-tol", 1e-15, 1.0, number_text(ff.tol),
-               "Absolute error target of every form factor (estimator analytic)")
-              .py("tol")
-              .read_by("the estimator analytic (and auto's choice of it)",
-                       [](const Selection& s) { return estimator_may_be(s, {"analytic"}); }));
+  // The estimators' parameters, from the registry's declarations (EstimatorParam): read by
+  // the estimators that declare them. run's --samples has a cheaper default.
+  for (const DeclaredEstimatorParam& d : estimator_params()) {
+    const EstimatorParam& p = d.param;
+    Row r = p.integer
+                ? integer(p.option, p.lo, p.hi, std::to_string(std::lround(p.fallback)), p.doc)
+                : real(p.option, p.lo, p.hi, number_text(p.fallback), p.doc, p.open_lo);
+    r.by_method("matrix").read_by(
+        estimator_readers_text(d.estimators),
+        [readers = d.estimators](const Selection& s) { return estimator_may_be(s, readers); });
+    add_row(Row(r).py(p.keyword));
+    if (p.option == "--samples")
+      add_row(r.on({"run"})
+                  .fallback(std::to_string(kRunDefaultSamples))
+                  .described(p.doc + "; run's default is cheaper than the other commands'"));
+  }
   add_row(
       real("--threshold", 0.0, 1.0, number_text(ff.threshold), "Drop form factors below this value")
           .py("threshold")
           .by_method("matrix")
           .read_by("a computed F", computes_f));
-  add_row(integer("--hemicube-res", 4, 8192, std::to_string(ff.hemicube_resolution),
-                  "Hemicube top-face resolution (estimator hemicube)")
-              .py("hemicube_resolution")
-              .by_method("matrix")
-              .read_by("the estimator hemicube", [](const Selection& s) {
-                return computes_f(s) && s.estimator == "hemicube";
-              }));
   add_row(choice("--reciprocity", {"auto", "none", "average"}, ff.reciprocity,
                  "Replace A_i F_ij and A_j F_ji by their mean: none, average, or auto (average "
                  "for gather, none for the others)")

@@ -9,7 +9,9 @@
 //   - the Python keyword's check and docstring line (python/);
 //   - the option reference in docs/options.md (`lambert options --markdown`, kept current by
 //     scripts/check_docs_options.sh).
-// Adding an option: one row here, one binding in apps/options.cpp (the field it sets).
+// Adding an option: one row here, one binding in apps/options.cpp (the field it sets). An
+// estimator's parameter has neither: its rows and binding come from its declaration on the
+// estimator's registry entry (EstimatorParam, geometry/formfactors/formfactors.hpp).
 
 #include <functional>
 #include <string>

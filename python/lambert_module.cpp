@@ -158,6 +158,9 @@ py::dict options_dict(const FormFactorOptions& o) {
   d["tol"] = o.analytic.tol;
   d["reciprocity"] = o.reciprocity;
   d["extended"] = o.contents.extended;
+  for (const DeclaredEstimatorParam& p : estimator_params())  // those of later estimators
+    if (!d.contains(p.param.keyword.c_str()))
+      d[p.param.keyword.c_str()] = estimator_param(o, p.param.option);
   return d;
 }
 
@@ -396,24 +399,15 @@ FormFactorArgs ff_args_from_keywords(const py::dict& settings) {
   apply_keywords(settings, "form factors", "form_factors",
                  [&](const std::string& name, const std::string& text, double x) {
                    const int n = static_cast<int>(x);  // Integer rows: whole, in int's range
-                   if (name == "--estimator") {
+                   if (find_estimator_param(name) != nullptr) {
+                     args.set_param(name, x);  // an estimator's (the registry declares it)
+                   } else if (name == "--estimator") {
                      args.estimator = text;
                    } else if (name == "--reciprocity") {
                      args.reciprocity = text;
                      args.reciprocity_given = true;
-                   } else if (name == "--samples") {
-                     args.samples = n;
-                     args.samples_given = true;
-                   } else if (name == "--rays") {
-                     args.rays = n;
-                     args.rays_given = true;
-                   } else if (name == "--ff-tol") {
-                     args.tol = x;
-                     args.tol_given = true;
                    } else if (name == "--threshold") {
                      args.threshold = x;
-                   } else if (name == "--hemicube-res") {
-                     args.hemicube_resolution = n;
                    } else if (name == "--specular-depth") {
                      args.specular_depth = n;
                      args.specular_given = true;
@@ -492,6 +486,10 @@ py::list option_spec_list() {
     d["choices"] = spec.choices;
     if (spec.kind == OptionKind::Integer || spec.kind == OptionKind::Real)
       d["range"] = py::make_tuple(spec.lo, spec.hi);
+    // The estimators that declare it, for an estimator's parameter (form_factors' docstring).
+    const DeclaredEstimatorParam* param =
+        spec.commands.empty() ? find_estimator_param(spec.name) : nullptr;
+    d["estimators"] = param ? param->estimators : std::vector<std::string>{};
     out.append(d);
   }
   return out;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <memory>
 
 #include "core/error.hpp"
@@ -111,20 +113,6 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
 
 namespace {
 
-struct EstimatorEntry {
-  const char* name;
-  bool pairwise;     ///< computes each unordered pair once (compute_pairwise): accepts a row range
-  bool traces_rays;  ///< reports replicate standard errors (needs count >= 4); follows mirrors
-  bool uses_bvh;     ///< queries a BVH (rays, or the analytic estimator's blocker search)
-  const char* count_option;  ///< "samples", "rays", "tol" or "" (estimator_count_option)
-  /// "auto" reciprocity averages: gather (noisy one-sided rows; averaging halves the variance
-  /// of a pair and makes F reciprocal). Not the pair estimators (reciprocal by
-  /// construction) nor the hemicube (its non-reciprocity is a result `accuracy` studies).
-  bool auto_average;
-  FormFactors (*compute)(const PatchMesh&, const FormFactorOptions&, const Bvh*);
-  double (*peak_bytes)(std::int64_t patches, const FormFactorOptions&);
-};
-
 // Bytes of one CSR entry: a value and a column index of the storage index type.
 constexpr double kCsrEntry = sizeof(double) + sizeof(SparseF::StorageIndex);
 
@@ -167,35 +155,114 @@ double gather_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
          static_cast<double>(resolve_threads(o.run.threads)) * per_thread;
 }
 
-const std::vector<EstimatorEntry>& registry() {
-  static const std::vector<EstimatorEntry> table = {
-      {"hybrid", true, true, true, "samples", false,
-       [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
-         return ff::compute_pairwise(m, o, *b, ff::estimate_hybrid);
-       },
-       pairwise_peak_bytes},
-      {"mc", true, true, true, "samples", false,
-       [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
-         return ff::compute_pairwise(m, o, *b, ff::estimate_mc);
-       },
-       pairwise_peak_bytes},
-      {"hemicube", false, false, false, "", false,
-       [](const PatchMesh& m, const FormFactorOptions& o, const Bvh*) {
-         return ff::compute_hemicube(m, o);  // rasterises: no rays
-       },
-       hemicube_peak_bytes},
-      {"gather", false, true, true, "rays", true,
-       [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
-         return ff::compute_gather(m, o, *b);
-       },
-       gather_peak_bytes},
-      {"analytic", true, false, true, "tol", false,
-       [](const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
-         return ff::compute_pairwise(m, o, *b, ff::estimate_analytic);
-       },
-       pairwise_peak_bytes},
+// The largest value of the int members the parameters of the first estimators live in (what
+// a settings text may hold).
+constexpr double kIntMax = std::numeric_limits<std::int32_t>::max();
+
+// The parameters of the first estimators: each lives in its block of FormFactorOptions (the
+// kernels read it by name) and is stored in every settings text, in the place it has had
+// since the first files.
+template <auto Block, auto Member>
+double get_int(const FormFactorOptions& o) {
+  return (o.*Block).*Member;
+}
+template <auto Block, auto Member>
+void set_int(FormFactorOptions& o, double v) {
+  (o.*Block).*Member = static_cast<int>(v);
+}
+// `p` stored as the int member Block::Member, in every text after `after`.
+template <auto Block, auto Member>
+EstimatorParam first_count(EstimatorParam p, const char* after) {
+  p.stored_always = true;
+  p.after = after;
+  p.stored_min = 1;
+  p.stored_max = kIntMax;
+  p.get = &get_int<Block, Member>;
+  p.set = &set_int<Block, Member>;
+  return p;
+}
+
+using O = FormFactorOptions;
+
+EstimatorParam samples_param() {
+  EstimatorParam p = first_count<&O::pair, &PairEstimatorParams::samples>(
+      integer_param("--samples", "samples", 1, 1 << 20, PairEstimatorParams{}.samples,
+                    "Sample pairs (rays) per patch pair (pair estimators mc, hybrid)"),
+      "estimator_requested");
+  p.required = true;
+  return p;
+}
+
+EstimatorParam rays_param() {
+  EstimatorParam p = first_count<&O::gather, &GatherParams::rays>(
+      integer_param("--rays", "rays", 1, 1 << 24, GatherParams{}.rays,
+                    "Rays per patch (estimator gather)"),
+      "samples");
+  p.report = "rays_per_patch";  // "rays" in reports is the count traced
+  return p;
+}
+
+EstimatorParam hemicube_resolution_param() {
+  EstimatorParam p = first_count<&O::hemicube, &HemicubeParams::resolution>(
+      integer_param("--hemicube-res", "hemicube_resolution", 4, 8192, HemicubeParams{}.resolution,
+                    "Hemicube top-face resolution (estimator hemicube)"),
+      "threshold");
+  p.key = "hemicube_res";
+  return p;
+}
+
+EstimatorParam tol_param() {
+  EstimatorParam p = real_param("--ff-tol", "tol", 1e-15, 1.0, AnalyticParams{}.tol,
+                                "Absolute error target of every form factor (estimator analytic)");
+  p.alias = "--tol";  // formfactors has no solver tolerance
+  p.after = "hemicube_res";
+  p.get = [](const FormFactorOptions& o) { return o.analytic.tol; };
+  p.set = [](FormFactorOptions& o, double v) { o.analytic.tol = v; };
+  return p;
+}
+
+FormFactors run_hybrid(const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
+  return ff::compute_pairwise(m, o, *b, ff::estimate_hybrid);
+}
+FormFactors run_mc(const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
+  return ff::compute_pairwise(m, o, *b, ff::estimate_mc);
+}
+FormFactors run_hemicube(const PatchMesh& m, const FormFactorOptions& o, const Bvh*) {
+  return ff::compute_hemicube(m, o);  // rasterises: no rays
+}
+FormFactors run_gather(const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
+  return ff::compute_gather(m, o, *b);
+}
+FormFactors run_analytic(const PatchMesh& m, const FormFactorOptions& o, const Bvh* b) {
+  return ff::compute_pairwise(m, o, *b, ff::estimate_analytic);
+}
+
+// The registry: one row per estimator (FormFactorEstimator: name, pairwise, traces_rays,
+// uses_bvh, count_option, auto_average, compute, peak_bytes, params).
+std::vector<FormFactorEstimator> make_registry() {
+  // clang-format off
+  return {
+      {"hybrid", true, true, true, "samples", false, run_hybrid, pairwise_peak_bytes,
+       {samples_param()}},
+      {"mc", true, true, true, "samples", false, run_mc, pairwise_peak_bytes, {samples_param()}},
+      {"hemicube", false, false, false, "", false, run_hemicube, hemicube_peak_bytes,
+       {hemicube_resolution_param()}},
+      {"gather", false, true, true, "rays", true, run_gather, gather_peak_bytes, {rays_param()}},
+      {"analytic", true, false, true, "tol", false, run_analytic, pairwise_peak_bytes,
+       {tol_param()}},
   };
+  // clang-format on
+}
+
+std::vector<FormFactorEstimator>& registry() {
+  static std::vector<FormFactorEstimator> table = make_registry();
   return table;
+}
+
+// Set when the parameters were first listed (estimator_params): the registry is then final.
+bool& registry_read() {
+  static bool read = false;
+  return read;
 }
 
 // Drops the pairs whose factors are both below the threshold: F_ij and F_ji go together,
@@ -222,17 +289,119 @@ void apply_threshold(FormFactors& ff, double threshold) {
   if (with_err) ff.stderr_F.prune(not_nan);
 }
 
-const EstimatorEntry& find_estimator(const std::string& name) {
-  for (const auto& e : registry())
+const FormFactorEstimator& find_estimator(const std::string& name) {
+  for (const auto& e : form_factor_estimator_table())
     if (name == e.name) return e;
   throw UsageError("unknown form-factor estimator '" + name + "'");
 }
 
 }  // namespace
 
+EstimatorParam integer_param(std::string option, std::string keyword, double lo, double hi,
+                             double fallback, std::string doc) {
+  EstimatorParam p;
+  p.option = std::move(option);
+  p.keyword = std::move(keyword);
+  p.lo = lo;
+  p.hi = hi;
+  p.fallback = fallback;
+  p.doc = std::move(doc);
+  return p;
+}
+
+EstimatorParam real_param(std::string option, std::string keyword, double lo, double hi,
+                          double fallback, std::string doc, bool open_lo) {
+  EstimatorParam p =
+      integer_param(std::move(option), std::move(keyword), lo, hi, fallback, std::move(doc));
+  p.integer = false;
+  p.open_lo = open_lo;
+  return p;
+}
+
+namespace {
+
+// The same declaration (two estimators may share a parameter: one option, one meaning).
+bool same_param(const EstimatorParam& a, const EstimatorParam& b) {
+  return a.keyword == b.keyword && a.integer == b.integer && a.lo == b.lo && a.hi == b.hi &&
+         a.open_lo == b.open_lo && a.fallback == b.fallback && a.doc == b.doc && a.get == b.get &&
+         a.set == b.set;
+}
+
+}  // namespace
+
+void register_form_factor_estimator(FormFactorEstimator estimator) {
+  LAMBERT_CHECK(!registry_read(), "register_form_factor_estimator after the registry was read");
+  LAMBERT_CHECK(estimator.compute != nullptr && estimator.peak_bytes != nullptr,
+                "estimator '" + estimator.name + "' without compute or peak_bytes");
+  for (const FormFactorEstimator& e : registry())
+    LAMBERT_CHECK(e.name != estimator.name, "estimator '" + estimator.name + "' registered twice");
+  LAMBERT_CHECK(estimator.name != "auto" && !estimator.name.empty(), "bad estimator name");
+  registry().push_back(std::move(estimator));
+}
+
+const std::vector<FormFactorEstimator>& form_factor_estimator_table() {
+  registry_read() = true;
+  return registry();
+}
+
+const std::vector<DeclaredEstimatorParam>& estimator_params() {
+  static const std::vector<DeclaredEstimatorParam> params = [] {
+    std::vector<DeclaredEstimatorParam> out;
+    for (const FormFactorEstimator& e : form_factor_estimator_table())
+      for (const EstimatorParam& p : e.params) {
+        auto it = std::find_if(out.begin(), out.end(), [&](const DeclaredEstimatorParam& d) {
+          return d.param.option == p.option;
+        });
+        if (it == out.end()) {
+          LAMBERT_CHECK(p.option.rfind("--", 0) == 0 && !p.keyword.empty(),
+                        "estimator parameter '" + p.option + "' without option or keyword");
+          out.push_back({p, {}});
+          it = out.end() - 1;
+        }
+        LAMBERT_CHECK(same_param(it->param, p),
+                      "estimator parameter " + p.option + " declared two ways");
+        it->estimators.push_back(e.name);
+      }
+    return out;
+  }();
+  return params;
+}
+
+const DeclaredEstimatorParam* find_estimator_param(const std::string& option) {
+  for (const DeclaredEstimatorParam& d : estimator_params())
+    if (d.param.option == option) return &d;
+  return nullptr;
+}
+
+namespace {
+
+const EstimatorParam& declared_param(const std::string& option) {
+  const DeclaredEstimatorParam* d = find_estimator_param(option);
+  LAMBERT_CHECK(d != nullptr, "no estimator declares the parameter " + option);
+  return d->param;
+}
+
+}  // namespace
+
+double estimator_param(const FormFactorOptions& options, const std::string& option) {
+  const EstimatorParam& p = declared_param(option);
+  if (p.get) return p.get(options);
+  const auto it = options.params.find(option);
+  return it == options.params.end() ? p.fallback : it->second;
+}
+
+void set_estimator_param(FormFactorOptions& options, const std::string& option, double value) {
+  const EstimatorParam& p = declared_param(option);
+  if (p.integer) value = std::round(value);
+  if (p.set)
+    p.set(options, value);
+  else
+    options.params[option] = value;
+}
+
 std::vector<std::string> form_factor_estimators() {
   std::vector<std::string> names;
-  for (const auto& e : registry()) names.emplace_back(e.name);
+  for (const auto& e : form_factor_estimator_table()) names.emplace_back(e.name);
   return names;
 }
 
@@ -284,7 +453,7 @@ FormFactorOptions resolve_form_factor_options(const FormFactorOptions& options,
     o.estimator = auto_estimator(patches, o.analytic.tol_given);
     o.estimator_requested = "auto";
   }
-  const EstimatorEntry& e = find_estimator(o.estimator);
+  const FormFactorEstimator& e = find_estimator(o.estimator);
   if (o.reciprocity == "auto") o.reciprocity = e.auto_average ? "average" : "none";
   if (o.reciprocity != "none" && o.reciprocity != "average")
     throw UsageError("unknown reciprocity mode '" + o.reciprocity + "' (none, average, auto)");
@@ -309,16 +478,30 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
     throw UsageError("--hemicube-res must be in [4, 8192]");
   if (mesh.patches.empty()) throw UsageError("the scene has no patches");
   const FormFactorOptions o = resolve_form_factor_options(options, mesh.size());
-  const EstimatorEntry& e = find_estimator(o.estimator);
+  const FormFactorEstimator& e = find_estimator(o.estimator);
+  for (const EstimatorParam& p : e.params) {
+    if (p.get) continue;  // the first estimators' parameters: checked above
+    const double v = estimator_param(o, p.option);
+    const bool above = p.open_lo ? v > p.lo : v >= p.lo;
+    if (!(std::isfinite(v) && above && v <= p.hi && (!p.integer || v == std::floor(v)))) {
+      char range[96];
+      std::snprintf(range, sizeof range, "%s%g, %g]", p.open_lo ? "(" : "[", p.lo, p.hi);
+      throw UsageError(p.option + " must be " + (p.integer ? "an integer" : "a number") + " in " +
+                       range);
+    }
+  }
   // Standard errors come from the spread of independent replicates (replicates.hpp),
   // which needs at least two of them, and Student's t with so few is wide: ask for four.
   const std::string count = e.count_option;
   if (e.traces_rays && o.run.with_stderr && (count == "rays" ? o.gather.rays : o.pair.samples) < 4)
-    throw UsageError("--stderr needs --" + count + " of at least 4 (standard errors come from "
-                     "independent replicates of the " + count + ")");
+    throw UsageError("--stderr needs --" + count +
+                     " of at least 4 (standard errors come from "
+                     "independent replicates of the " +
+                     count + ")");
   const bool specular = mesh.has_specular() && o.specular.depth > 0;
   if (specular && !e.traces_rays)
-    throw UsageError("--estimator " + o.estimator + " does not follow rays through mirrors and "
+    throw UsageError("--estimator " + o.estimator +
+                     " does not follow rays through mirrors and "
                      "glass: use mc, hybrid or gather for this scene, or --specular-depth 0 "
                      "(specular surfaces then only receive and block)");
   if (specular) ff::check_grey_specular(mesh);

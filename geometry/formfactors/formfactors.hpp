@@ -6,6 +6,7 @@
 
 #include <Eigen/SparseCore>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -94,6 +95,11 @@ struct FormFactorContents {
   int transmittance_samples = 0;
 };
 
+/// The parameters of the estimators that have no block of their own in FormFactorOptions:
+/// option name ("--foo") -> value (an integer parameter holds a whole number). A name that is
+/// absent is at its declared default (EstimatorParam::fallback; estimator_param reads it).
+using EstimatorParamValues = std::map<std::string, double>;
+
 /// Settings of one form-factor computation: the choice of estimator and what applies to
 /// every estimator, and one block per estimator's own parameters.
 struct FormFactorOptions {
@@ -112,6 +118,9 @@ struct FormFactorOptions {
   GatherParams gather;          ///< read by gather
   HemicubeParams hemicube;      ///< read by hemicube
   AnalyticParams analytic;      ///< read by analytic (and auto)
+  /// Read by the estimators whose parameters have no block above (estimator_param): a new
+  /// estimator's parameters live here, declared on its registry entry.
+  EstimatorParamValues params;
   SpecularParams specular;      ///< read by mc, hybrid and gather on a mesh with mirrors or glass
   FormFactorRun run;            ///< read by every estimator
   FormFactorSubset subset;      ///< read by every estimator (a row range: the pair estimators)
@@ -179,6 +188,111 @@ struct FormFactors {
   }
 };
 
+class Bvh;
+
+/// One parameter of an estimator, declared once on its registry entry
+/// (FormFactorEstimator::params). From it come the CLI option and its check, --help line and
+/// default (apps/options.cpp), its row in option_specs() (pipeline/option_specs.cpp: the
+/// option reference, and "does not apply" for an estimator that does not declare it), the
+/// Python keyword and its docstring line (python/), and its key in the settings text stored
+/// with a saved F and in the reports (io/ff_settings.cpp). Build one with integer_param or
+/// real_param; the defaults suit a new parameter (its value in FormFactorOptions::params,
+/// stored in the settings text when the estimator reads it).
+struct EstimatorParam {
+  std::string option;         ///< the CLI option, "--samples"
+  std::string keyword;        ///< the Python keyword, the settings key and the report name
+  bool integer = true;        ///< a whole number (else a finite real number)
+  double lo = 0.0, hi = 0.0;  ///< the accepted range [lo, hi] (open at lo when open_lo)
+  bool open_lo = false;
+  double fallback = 0.0;  ///< the default
+  std::string doc;        ///< the one-line description (--help, docs/options.md, Python)
+  std::string alias;      ///< another name the formfactors command takes ("--tol"; "" = none)
+
+  // The settings text (io/ff_settings.hpp). Keys are only ever added: saved files and their
+  // readers depend on the text byte for byte.
+  std::string key;     ///< the settings text's key ("" = `keyword`)
+  std::string report;  ///< the name in reports ("" = `keyword`)
+  /// Stored whatever the estimator, after the setting `after` (the parameters stored since
+  /// the first files: samples, rays, hemicube_res). Otherwise (the default) stored when the
+  /// estimator reads it, after the specular settings.
+  bool stored_always = false;
+  /// The setting (key or report name) it follows in the table, hence in reports and, stored
+  /// always, in the text ("" = after the others).
+  std::string after;
+  bool required = false;  ///< a settings text without it is refused (samples)
+  /// An integer parameter: the range a settings text's value must be in (both 0: [lo, hi]);
+  /// a saved value may be outside the command line's range (files from the library). A real
+  /// one's must be finite, and positive when the range is.
+  double stored_min = 0.0, stored_max = 0.0;
+
+  /// Where the value lives: a member of one of FormFactorOptions' blocks (the parameters that
+  /// predate this table, which the estimators read by name), or, left null, `params`.
+  double (*get)(const FormFactorOptions&) = nullptr;
+  void (*set)(FormFactorOptions&, double) = nullptr;
+};
+
+/// A parameter taking whole numbers in [lo, hi], `fallback` by default.
+EstimatorParam integer_param(std::string option, std::string keyword, double lo, double hi,
+                             double fallback, std::string doc);
+
+/// A parameter taking finite real numbers in [lo, hi] (> lo when open_lo), `fallback` by
+/// default.
+EstimatorParam real_param(std::string option, std::string keyword, double lo, double hi,
+                          double fallback, std::string doc, bool open_lo = false);
+
+/// One estimator: a row of the registry (formfactors.cpp), or one added by
+/// register_form_factor_estimator.
+struct FormFactorEstimator {
+  std::string name;  ///< the --estimator value
+  /// Computes each unordered pair once (compute_pairwise): accepts a row range.
+  bool pairwise = false;
+  /// Traces rays: reports replicate standard errors (needs count >= 4); follows mirrors.
+  bool traces_rays = false;
+  bool uses_bvh = false;     ///< queries a BVH (rays, or the analytic estimator's blocker search)
+  std::string count_option;  ///< "samples", "rays", "tol" or "" (estimator_count_option)
+  /// "auto" reciprocity averages: gather (noisy one-sided rows; averaging halves the variance
+  /// of a pair and makes F reciprocal). Not the pair estimators (reciprocal by construction)
+  /// nor the hemicube (its non-reciprocity is a result `accuracy` studies).
+  bool auto_average = false;
+  /// Computes F (every row, or the pairs FormFactorSubset selects); `bvh` is built over the
+  /// mesh when uses_bvh, else null. compute_form_factors checks the parameters first.
+  FormFactors (*compute)(const PatchMesh&, const FormFactorOptions&, const Bvh* bvh) = nullptr;
+  /// Upper bound (bytes) of the computation's memory (form_factor_peak_bytes).
+  double (*peak_bytes)(std::int64_t patches, const FormFactorOptions&) = nullptr;
+  /// The parameters it reads (one may be shared: mc and hybrid both declare --samples).
+  std::vector<EstimatorParam> params;
+};
+
+/// Adds an estimator to the registry (a plug-in, or a test's double). Call it before the
+/// first use of the registry or of the option table (a static initialiser): the CLI, the
+/// option reference and Python read the registry once. A name already registered, or a
+/// parameter that differs from another estimator's of the same option, is a bug
+/// (LAMBERT_CHECK).
+void register_form_factor_estimator(FormFactorEstimator estimator);
+
+/// The registry: every estimator, in the order --estimator lists them.
+const std::vector<FormFactorEstimator>& form_factor_estimator_table();
+
+/// An estimator parameter once, with the estimators that declare it (registry order).
+struct DeclaredEstimatorParam {
+  EstimatorParam param;
+  std::vector<std::string> estimators;
+};
+
+/// Every estimator parameter once, in registry order (an estimator's in its order).
+const std::vector<DeclaredEstimatorParam>& estimator_params();
+
+/// The declaration of the estimator parameter `option` ("--samples"), or nullptr.
+const DeclaredEstimatorParam* find_estimator_param(const std::string& option);
+
+/// The value of the estimator parameter `option` in `options` (its block's member, or
+/// `params`, or its default). An undeclared option is a bug (LAMBERT_CHECK).
+double estimator_param(const FormFactorOptions& options, const std::string& option);
+
+/// Sets the estimator parameter `option` (an integer one is rounded to the nearest whole
+/// number). An undeclared option is a bug (LAMBERT_CHECK).
+void set_estimator_param(FormFactorOptions& options, const std::string& option, double value);
+
 /// Names of the available estimators ("mc", "hybrid", ...); "auto" is not one of them.
 std::vector<std::string> form_factor_estimators();
 
@@ -226,8 +340,6 @@ FormFactorOptions resolve_form_factor_options(const FormFactorOptions& options,
 /// ("auto" is resolved first). --threshold prunes only after the
 /// estimate, so it does not lower the peak. Throws UsageError for an unknown estimator.
 double form_factor_peak_bytes(std::int64_t patches, const FormFactorOptions& options);
-
-class Bvh;
 
 /// Computes F for every patch pair of `mesh` with the chosen estimator. Multi-threaded;
 /// for a given seed the result is bitwise identical for any thread count. `bvh` (built over

@@ -144,7 +144,7 @@ def _wrap_ff(result, mesh, computed):
 
 def form_factors(mesh, estimator="auto", samples=None, rays=None, seed=1, threads=0,
                  threshold=0.0, reciprocity="auto", tol=None, hemicube_resolution=128,
-                 specular_depth=8, specular_rays=1024, stderr=False):
+                 specular_depth=8, specular_rays=1024, stderr=False, **estimator_params):
     """The form factors of the mesh, as a `FormFactors` (matrix, stderr, settings, stats).
 
     The keywords are the CLI's options (docs/options.md) with the same values, ranges and
@@ -156,13 +156,16 @@ def form_factors(mesh, estimator="auto", samples=None, rays=None, seed=1, thread
     ----------
     mesh : Mesh
         The patches (``scene.mesh(...)``).
-@declared --estimator --samples --rays --ff-tol --threshold --reciprocity --hemicube-res --specular-depth --specular-rays
+@declared --estimator @estimator-parameters --threshold --reciprocity --specular-depth --specular-rays
     seed : int, default 1
         The random seed: the same seed gives the same F whatever ``threads`` is.
     threads : int, default 0
         Worker threads (0: all cores).
     stderr : bool, default False
         Keep the per-entry standard errors of the Monte Carlo estimators (``.stderr``).
+    **estimator_params
+        The parameters of estimators registered beyond those above (listed above with
+        theirs), by keyword.
 
     Returns
     -------
@@ -178,6 +181,13 @@ def form_factors(mesh, estimator="auto", samples=None, rays=None, seed=1, thread
                      hemicube_resolution=_int(hemicube_resolution, "hemicube_resolution"),
                      specular_depth=_int(specular_depth, "specular_depth"),
                      specular_rays=_int(specular_rays, "specular_rays"))
+    for keyword, value in estimator_params.items():  # checked by their declarations
+        spec = _KEYWORD_SPECS.get(("form factors", keyword))
+        if spec is None or not spec["estimators"] or keyword in optional:
+            raise TypeError(f"form_factors() got an unexpected keyword argument '{keyword}'")
+        if value is not None:
+            optional[keyword] = (_int(value, keyword) if spec["kind"] == "integer"
+                                 else float(value))
     settings = {k: v for k, v in optional.items() if v is not None}
     settings.update({k: v for k, v in defaulted.items()
                      if not _is_default("form factors", k, v)})
@@ -438,6 +448,13 @@ def _is_default(group, keyword, value):
     return float(value) == float(spec["default"])
 
 
+def _readers(estimators):
+    """'the estimator gather', 'the estimators hybrid and mc'."""
+    names = (estimators[0] if len(estimators) == 1
+             else ", ".join(estimators[:-1]) + " and " + estimators[-1])
+    return ("the estimator " if len(estimators) == 1 else "the estimators ") + names
+
+
 def _document_declared(function):
     """Replaces each ``@declared --name ...`` line of the docstring by numpydoc entries for
     those options, written from their declarations: keyword, kind, default, what it accepts
@@ -447,12 +464,20 @@ def _document_declared(function):
         if not line.startswith("@declared "):
             lines.append(line)
             continue
+        names = []
         for name in line.split()[1:]:
+            # Every estimator's parameters, as the registry declares them (one line each).
+            names += ([n for n, spec in _SPECS.items() if spec["estimators"]]
+                      if name == "@estimator-parameters" else [name])
+        for name in names:
             spec = _SPECS[name]
             kind = {"integer": "int", "real": "float", "choice": "str", "flag": "bool",
                     "text": "str"}[spec["kind"]]
             lines.append(f"    {spec['keyword']} : {kind}, default {spec['default']}")
-            lines.append(f"        {spec['doc']}. Accepts {spec['accepts']} (the CLI's {name}).")
+            readers = (f" Read by {_readers(spec['estimators'])}."
+                       if spec["estimators"] else "")
+            lines.append(f"        {spec['doc']}. Accepts {spec['accepts']} (the CLI's {name})."
+                         + readers)
     function.__doc__ = "\n".join(lines)
     return function
 

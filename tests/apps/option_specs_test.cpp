@@ -27,15 +27,7 @@ namespace lambert {
 namespace {
 
 using testing::run_capturing;
-
-// `lambert ARGS` with stdout captured: the exit code and what went to stdout.
-std::pair<int, std::string> run_stdout(const std::vector<std::string>& args) {
-  ::testing::internal::CaptureStdout();
-  ::testing::internal::CaptureStderr();
-  const int code = testing::run(args);
-  ::testing::internal::GetCapturedStderr();
-  return {code, ::testing::internal::GetCapturedStdout()};
-}
+using testing::run_stdout;
 
 // A value just outside the row's range, or not one of its choices.
 std::string outside(const OptionSpec& s) {

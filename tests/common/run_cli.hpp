@@ -31,6 +31,15 @@ inline std::pair<int, std::string> run_capturing(const std::vector<std::string>&
   return {code, ::testing::internal::GetCapturedStderr()};
 }
 
+/// run(args) with stdout and stderr captured: the exit code and what went to stdout.
+inline std::pair<int, std::string> run_stdout(const std::vector<std::string>& args) {
+  ::testing::internal::CaptureStdout();
+  ::testing::internal::CaptureStderr();
+  const int code = run(args);
+  ::testing::internal::GetCapturedStderr();
+  return {code, ::testing::internal::GetCapturedStdout()};
+}
+
 /// The whole content of a file ("" if it cannot be read).
 inline std::string slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "core/error.hpp"
@@ -425,6 +427,43 @@ TEST(KernelSampler, WarpedNeighbourQuadClipsToAHexagonAndSamplesOnIt) {
         sampler.sample(rng.uniform(), rng.uniform(), rng.uniform(), rng, exhausted);
     EXPECT_TRUE(box.contains(y)) << "sample " << k << ": " << y.transpose();
   }
+}
+
+TEST(FormFactorRegistry, EveryParameterIsDeclaredOnceWithTheOptionsDefault) {
+  const std::vector<std::string> names = form_factor_estimators();
+  const FormFactorOptions defaults;
+  ASSERT_FALSE(estimator_params().empty());
+  for (const DeclaredEstimatorParam& d : estimator_params()) {
+    SCOPED_TRACE(d.param.option);
+    ASSERT_FALSE(d.estimators.empty());
+    for (const std::string& e : d.estimators)
+      EXPECT_NE(std::find(names.begin(), names.end(), e), names.end()) << e;
+    // An absent value means the declared default (the CLI's, Python's and the text's).
+    EXPECT_EQ(estimator_param(defaults, d.param.option), d.param.fallback);
+    EXPECT_GE(d.param.fallback, d.param.lo);
+    EXPECT_LE(d.param.fallback, d.param.hi);
+    // A value set through the declaration is the value the estimator reads.
+    FormFactorOptions o;
+    set_estimator_param(o, d.param.option, d.param.hi);
+    EXPECT_EQ(estimator_param(o, d.param.option), d.param.hi);
+  }
+  // The first estimators' parameters live in their blocks, which the kernels read by name.
+  FormFactorOptions o;
+  set_estimator_param(o, "--samples", 7);
+  set_estimator_param(o, "--rays", 300);
+  set_estimator_param(o, "--hemicube-res", 64);
+  set_estimator_param(o, "--ff-tol", 2.5e-7);
+  EXPECT_EQ(o.pair.samples, 7);
+  EXPECT_EQ(o.gather.rays, 300);
+  EXPECT_EQ(o.hemicube.resolution, 64);
+  EXPECT_EQ(o.analytic.tol, 2.5e-7);
+  EXPECT_TRUE(o.params.empty());
+  // One declaration per option, with every estimator that reads it.
+  EXPECT_EQ(find_estimator_param("--samples")->estimators,
+            (std::vector<std::string>{"hybrid", "mc"}));
+  EXPECT_EQ(find_estimator_param("--rays")->estimators, std::vector<std::string>{"gather"});
+  EXPECT_EQ(find_estimator_param("--ff-tol")->estimators, std::vector<std::string>{"analytic"});
+  EXPECT_EQ(find_estimator_param("--threshold"), nullptr);  // every estimator's: not a parameter
 }
 
 }  // namespace lambert

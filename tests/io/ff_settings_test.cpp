@@ -155,6 +155,29 @@ TEST(FormFactorSettings, TextIsTheFormatSavedFilesHold) {
             "medium_extinction=81985529216486895 medium_rays=55 transmittance_samples=6");
 }
 
+TEST(FormFactorSettings, EveryEstimatorParameterHasTheRowItsDeclarationGives) {
+  for (const DeclaredEstimatorParam& d : estimator_params()) {
+    const EstimatorParam& p = d.param;
+    SCOPED_TRACE(p.option);
+    int rows = 0;
+    for (const Setting& s : form_factor_settings()) {
+      if (s.param != p.option) continue;
+      ++rows;
+      EXPECT_EQ(s.key, p.key.empty() ? p.keyword : p.key);
+      EXPECT_EQ(s.name, p.report.empty() ? p.keyword : p.report);
+      EXPECT_EQ(s.estimators, d.estimators);
+      EXPECT_EQ(s.kind, p.integer ? Setting::Kind::Integer : Setting::Kind::Real);
+      // Stored for every estimator (the first ones'), or for those that read it.
+      FormFactorOptions o;
+      o.estimator = d.estimators.front();
+      EXPECT_TRUE(setting_applies(s, o));
+      o.estimator = "no such estimator";
+      EXPECT_EQ(setting_applies(s, o), p.stored_always);
+    }
+    EXPECT_EQ(rows, 1);
+  }
+}
+
 TEST(FormFactorSettings, ReportNamesEverySettingAndNullsWhatDoesNotApply) {
   FormFactorOptions o = every_row_stored();
   o.estimator_requested = "auto";

@@ -313,7 +313,7 @@ TEST(DiscontinuityRadiositySlow, PenumbraLineErrorFiveTimesBelowUniform) {
   loaded.discontinuity = true;
   FormFactorArgs ff;
   ff.estimator = "hybrid";
-  ff.samples = 64;
+  ff.set_param("--samples", 64);
   RunArgs run;
   run.quiet = true;
   SolveOptions so;
@@ -400,7 +400,7 @@ TEST(AdaptiveRadiositySlow, ImprovesMonotonicallyAndBeatsUniformAtEqualPatches) 
   const Scene scene = partial_shadow_scene();
   FormFactorArgs ff;
   ff.estimator = "hybrid";
-  ff.samples = 256;
+  ff.set_param("--samples", 256);
   RunArgs run;
   run.quiet = true;
   SolveOptions so;

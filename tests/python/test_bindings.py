@@ -469,6 +469,26 @@ def test_keywords_are_checked_and_documented_from_the_declarations(cornell_mesh)
         lambert.solve(cornell_mesh, F, solver="sor", omega=2.5)
 
 
+def test_help_lists_every_estimator_parameter_with_its_range_from_the_registry(cornell_mesh):
+    """help(lambert.form_factors) lists every parameter an estimator of the registry declares
+    (geometry/formfactors/formfactors.cpp), each with its range, default and readers, without a
+    hand-kept list: the declarations are the estimators' rows."""
+    params = [s for s in lambert.option_specs() if not s["commands"] and s["estimators"]]
+    assert {s["name"] for s in params} >= {"--samples", "--rays", "--ff-tol", "--hemicube-res"}
+    readers = {s["name"]: s["estimators"] for s in params}
+    assert sorted(readers["--samples"]) == ["hybrid", "mc"]
+    assert readers["--ff-tol"] == ["analytic"]
+    doc = lambert.form_factors.__doc__
+    for s in params:
+        entry = "\n".join(doc[doc.index(f"    {s['keyword']} : "):].split("\n")[:2])
+        assert f"default {s['default']}" in entry, s["name"]
+        assert f"Accepts {s['accepts']}" in entry, s["name"]
+        assert "Read by the estimator" in entry, s["name"]
+    assert "Accepts an integer in [1, 1048576]" in doc  # --samples, its range
+    with pytest.raises(TypeError, match="unexpected keyword argument 'no_such_parameter'"):
+        lambert.form_factors(cornell_mesh, no_such_parameter=1)
+
+
 def test_form_factor_keywords_go_by_name_through_the_clis_checks(cornell_mesh):
     """The form-factor keywords reach the library by name and pass the CLI's checks: what the
     chosen estimator does not read is refused with the reader from the declarations, auto's
