@@ -22,6 +22,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "io/json.hpp"
 #include "io/soup_builder.hpp"
 
 namespace lambert {
@@ -326,6 +327,46 @@ Soup import(const std::string& path, bool colours) {
 
 // ---- In lambert: the child, its message, the scene ----
 
+// glTF's KHR_materials_emissive_strength (Blender's exports carry a lamp's strength there),
+// which assimp 5.2 does not read: per glTF material, its name and emissive strength (1 where
+// none). Empty when `path` is no glTF or its JSON does not parse (assimp has read it, so that
+// leaves only what the JSON parser refuses: then the strengths stay 1).
+std::vector<std::pair<std::string, double>> gltf_emissive_strengths(const std::string& path) {
+  std::string text;
+  try {
+    text = read_file_bytes(path);
+  } catch (const IoError&) {
+    return {};
+  }
+  if (text.rfind("glTF", 0) == 0) {  // GLB: the JSON chunk's length at byte 12, its text at 20
+    std::uint32_t length = 0;
+    if (text.size() < 20) return {};
+    std::memcpy(&length, text.data() + 12, 4);
+    if (text.compare(16, 4, "JSON") != 0 || length > text.size() - 20) return {};
+    text = text.substr(20, length);
+  }
+  std::vector<std::pair<std::string, double>> out;
+  const Json j = Json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("materials") || !j["materials"].is_array())
+    return {};
+  for (const Json& m : j["materials"]) {
+    std::string name;
+    double strength = 1.0;
+    if (m.is_object() && m.contains("name") && m["name"].is_string()) name = m["name"];
+    if (m.is_object() && m.contains("extensions") && m["extensions"].is_object()) {
+      const Json& e = m["extensions"];
+      if (e.contains("KHR_materials_emissive_strength") &&
+          e["KHR_materials_emissive_strength"].is_object()) {
+        const Json& s = e["KHR_materials_emissive_strength"];
+        if (s.contains("emissiveStrength") && s["emissiveStrength"].is_number())
+          strength = s["emissiveStrength"].get<double>();
+      }
+    }
+    out.emplace_back(name, strength);
+  }
+  return out;
+}
+
 // Runs import(path) in a child process and returns its soup. `limit` bounds the wait.
 Soup import_in_child(const std::string& path, bool colours, double limit_seconds) {
   int fds[2];
@@ -462,6 +503,9 @@ Scene load_model(const std::string& path, LoadReport* report_out, const LoadOpti
   std::vector<std::int32_t> index(materials + 1, -1);  // file material (+1) -> scene's
   for (const std::int32_t m : s.surface_material) index[m + 1] = 0;
   int textured = 0, clamped = 0, uncoloured = 0;
+  // assimp lists a glTF's materials in the file's order (and may add a default one after).
+  const auto strengths = gltf_emissive_strengths(path);
+  int strengthened = 0;
   for (size_t m = 0; m < materials; ++m) {
     if (index[m + 1] < 0) continue;
     index[m + 1] = static_cast<std::int32_t>(scene.materials.size());
@@ -476,7 +520,16 @@ Scene load_model(const std::string& path, LoadReport* report_out, const LoadOpti
       rho = rho.cwiseProduct(options.default_reflectance), ++textured;
     }
     if (flags & kClamped) ++clamped;
-    scene.materials.push_back({s.material_names[m], limit(rho), Eigen::Vector3d(v[3], v[4], v[5])});
+    Eigen::Vector3d e(v[3], v[4], v[5]);
+    if (m < strengths.size() &&
+        (strengths[m].first.empty() || strengths[m].first == s.material_names[m]) &&
+        strengths[m].second != 1.0) {
+      if (!(std::isfinite(strengths[m].second) && strengths[m].second >= 0.0))
+        throw SceneError(path + ": material '" + s.material_names[m] +
+                         "': emissiveStrength must be a finite number >= 0");
+      e *= strengths[m].second, ++strengthened;
+    }
+    scene.materials.push_back({s.material_names[m], limit(rho), e});
   }
   if (index[0] == 0) {
     index[0] = static_cast<std::int32_t>(scene.materials.size());
@@ -516,6 +569,9 @@ Scene load_model(const std::string& path, LoadReport* report_out, const LoadOpti
       ++coloured;
     }
   }
+  if (strengthened > 0)
+    log_info(path + ": " + std::to_string(strengthened) +
+             " material(s) emit their glTF emissive colour times emissiveStrength");
   if (options.vertex_colors_as_reflectance && coloured == 0)
     warn(path + ": --vertex-colors-as-reflectance: no mesh of the file has vertex colours");
   if (limited > 0)

@@ -66,8 +66,15 @@ inline std::string gltf_with_data_uri(const std::string& matrix, bool colours = 
 }
 
 // A GLB: 12-byte header, the JSON chunk (padded with blanks), the BIN chunk (with zeros).
-inline std::string glb(const std::string& matrix) {
+// `emissive_strength` > 0: the material carries KHR_materials_emissive_strength.
+inline std::string glb(const std::string& matrix, double emissive_strength = 0.0) {
   std::string json = cube_json(matrix, ""), bin = cube_buffer();
+  if (emissive_strength > 0.0) {
+    const std::string factor = R"("emissiveFactor":[1,0.5,0])";
+    json.insert(json.find(factor) + factor.size(),
+                R"(,"extensions":{"KHR_materials_emissive_strength":{"emissiveStrength":)" +
+                    std::to_string(emissive_strength) + "}}");
+  }
   while (json.size() % 4) json += ' ';
   while (bin.size() % 4) bin += '\0';
   auto u32 = [](std::uint32_t x) { return std::string(reinterpret_cast<const char*>(&x), 4); };

@@ -180,6 +180,16 @@ TEST_F(ModelLoader, TheLoadingOptionsApplyToModelsToo) {
   }
 }
 
+// KHR_materials_emissive_strength (how Blender exports a bright lamp), which assimp 5.2 does
+// not apply, scales E; a negative strength is refused.
+TEST_F(ModelLoader, GltfEmissiveStrengthScalesTheEmission) {
+  const Scene s = load_model(write("lamp.glb", glb(kScaleAndMove, 4.0)));
+  EXPECT_EQ(s.materials[0].emission, Eigen::Vector3d(4.0, 2.0, 0.0));
+  std::string negative = glb(kScaleAndMove, 4.0);
+  negative.replace(negative.find("4.000000"), 8, "-4.00000");
+  EXPECT_THROW(load_model(write("negative.glb", negative)), SceneError);
+}
+
 TEST_F(ModelLoader, NamesThatAssimpDoesNotTakeStayWithLambertsOwnReaders) {
   EXPECT_TRUE(looks_like_model("a/b.GLTF", "{"));
   EXPECT_TRUE(looks_like_model("a/b.dae", "<?xml"));
