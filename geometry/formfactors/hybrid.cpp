@@ -32,16 +32,20 @@
 namespace lambert::ff {
 namespace {
 
-// A point uniform in area on a cell (triangle, or planar quad as two triangles); u picks
-// the triangle, (s, t) place the point in it.
-Eigen::Vector3d uniform_in_cell(const PatchGeom& g, double u, double s, double t) {
+// The area of the first of the two triangles a planar quad is cut into by uniform_in_cell
+// (its own area for a triangle), computed once per cell rather than once per point.
+double first_triangle_area(const PatchGeom& g) {
+  return g.n == 4 ? 0.5 * (g.p[1] - g.p[0]).cross(g.p[2] - g.p[0]).norm() : g.area;
+}
+
+// A point uniform in area on a cell (triangle, or planar quad as two triangles, `first`
+// the area of (p0, p1, p2): first_triangle_area); u picks the triangle, (s, t) place the
+// point in it.
+Eigen::Vector3d uniform_in_cell(const PatchGeom& g, double first, double u, double s, double t) {
   Eigen::Vector3d a = g.p[0], b = g.p[1], c = g.p[2];
-  if (g.n == 4) {
-    const double first = 0.5 * (g.p[1] - g.p[0]).cross(g.p[2] - g.p[0]).norm();
-    if (u * g.area >= first) {
-      b = g.p[2];
-      c = g.p[3];
-    }
+  if (g.n == 4 && u * g.area >= first) {
+    b = g.p[2];
+    c = g.p[3];
   }
   const double r = std::sqrt(s);
   return (1.0 - r) * a + r * (1.0 - t) * b + r * t * c;
@@ -94,15 +98,23 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
   thread_local std::vector<QuadCell> cells;
   thread_local std::vector<CellMode> modes;
   thread_local std::vector<PatchGeom> bfront;
-  thread_local std::vector<double> cdf, bcdf;
+  thread_local std::vector<double> cdf, bcdf, cell_first, bfront_first;
   const double G0 = integrate_unoccluded(a, b, kEstimatorAccuracy, cells);
   if (!(G0 > 0.0)) return est;
   cdf.clear();
-  for (const QuadCell& c : cells) cdf.push_back((cdf.empty() ? 0.0 : cdf.back()) + c.G);
+  cell_first.clear();
+  for (const QuadCell& c : cells) {
+    cdf.push_back((cdf.empty() ? 0.0 : cdf.back()) + c.G);
+    cell_first.push_back(first_triangle_area(c.g));
+  }
   modes.assign(cells.size(), CellMode{});
   front_part(b, a, bfront);
   bcdf.clear();
-  for (const PatchGeom& t : bfront) bcdf.push_back((bcdf.empty() ? 0.0 : bcdf.back()) + t.area);
+  bfront_first.clear();
+  for (const PatchGeom& t : bfront) {
+    bcdf.push_back((bcdf.empty() ? 0.0 : bcdf.back()) + t.area);
+    bfront_first.push_back(first_triangle_area(t));
+  }
   if (bcdf.empty() || !(bcdf.back() > 0.0)) return est;
   double ha = 0.0;  // for cell_mode
   for (const PatchGeom& t : bfront)
@@ -113,7 +125,8 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
     size_t t = 0;
     while (t + 1 < bfront.size() && pick >= bcdf[t]) ++t;
     const double lo = t ? bcdf[t - 1] : 0.0;
-    return uniform_in_cell(bfront[t], std::clamp((pick - lo) / bfront[t].area, 0.0, 1.0), s2, t2);
+    return uniform_in_cell(bfront[t], bfront_first[t],
+                           std::clamp((pick - lo) / bfront[t].area, 0.0, 1.0), s2, t2);
   };
   const std::uint64_t key =
       hash_keys(ctx.seed, static_cast<std::uint64_t>(i), static_cast<std::uint64_t>(j));
@@ -139,7 +152,7 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
       if (modes[c].joint) {
         double u[5] = {within, seq.get(r, 1), seq.get(r, 2), seq.get(r, 3), rng.uniform()};
         for (int t = 0; t < KernelSampler::kMaxTries && exhausted; ++t) {
-          x = uniform_in_cell(cells[c].g, u[0], u[1], u[2]);
+          x = uniform_in_cell(cells[c].g, cell_first[c], u[0], u[1], u[2]);
           y = on_b(u[3], u[4], rng.uniform());
           const Eigen::Vector3d d = y - x;
           const double r2 = d.squaredNorm();
@@ -148,7 +161,7 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
           for (double& v : u) v = rng.uniform();
         }
       } else {
-        x = uniform_in_cell(cells[c].g, within, seq.get(r, 1), seq.get(r, 2));
+        x = uniform_in_cell(cells[c].g, cell_first[c], within, seq.get(r, 1), seq.get(r, 2));
         const KernelSampler sampler(x, a.normal, b);
         w = sampler.factor() * cells[c].g.area / cells[c].G;
         if (!(w > 0.0) || sampler.empty()) continue;

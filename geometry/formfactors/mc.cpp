@@ -26,8 +26,14 @@ namespace lambert::ff {
 namespace {
 
 // True when some corner of either patch lies closer to the other than the larger diameter.
+// Every point of a patch lies within its diameter of its centroid, so no corner of one can be
+// within d of the other while the centroids are more than d + both diameters apart: then
+// the eight point-to-patch distances (~10 % of a far pair's time at 16 samples) are skipped.
+// The 1 % margin covers rounding and the warp of a quad (at most 1e-4 of its extent) that
+// distance_to_patch measures from its first corner's plane: the answer is the same.
 bool near_pair(const PatchGeom& a, const PatchGeom& b) {
   const double d = std::max(a.diameter, b.diameter);
+  if ((a.centroid - b.centroid).norm() > 1.01 * (d + a.diameter + b.diameter)) return false;
   for (int k = 0; k < a.n; ++k)
     if (distance_to_patch(a.p[k], b) < d) return true;
   for (int k = 0; k < b.n; ++k)

@@ -69,9 +69,24 @@ int cell_order(double h, double d, int extra) {
   return std::min(m + extra, kMaxGaussOrder);
 }
 
-// The four children of a cell: quads split at the bilinear midpoints (each child is the
-// bilinear image of a quarter of the parameter square), triangles at the edge midpoints.
-void split(const PatchGeom& g, PatchGeom* out) {
+// Cells whose long side exceeds kSliverRatio times their short one are halved across their
+// length instead of quartered: quartering keeps a cell's shape, so a sliver (a CAD tip facet
+// 100 mm by 0.05 mm) split until its length is under kappa times a distance of a few mm
+// became 4^6 cells ~1 um wide, the same number as a square of its length (issue 36: 95 % of
+// a heat sink's time). Halving makes the cell count grow with the length only (32 cells
+// instead of 1024 at length / h = 20). Every split, in two or in four, halves the diameter
+// the criterion and cell_order use, so depth still counts halvings. Cells within the ratio
+// (every patch of a usual mesh) are quartered as before.
+constexpr double kSliverRatio = 4.0;
+
+// The children of a cell, written to out; returns their count (2 or 4). Quads are split at
+// the bilinear midpoints (each child the bilinear image of a quarter, or of a half across
+// the long direction, of the parameter square). Triangles are quartered at the edge
+// midpoints; a sliver one (longest edge L > kSliverRatio x its height) is, when a needle
+// (shortest edge <= L / kSliverRatio), cut across at the midpoints of its two long edges
+// into an apex triangle and a trapezoid (a quad), and otherwise (a flat "cap") bisected at
+// the midpoint of its longest edge. Children keep the parent's winding.
+int split(const PatchGeom& g, PatchGeom* out) {
   auto make = [&](PatchGeom& c, std::initializer_list<Eigen::Vector3d> corners) {
     c.n = static_cast<int>(corners.size());
     int k = 0;
@@ -79,26 +94,97 @@ void split(const PatchGeom& g, PatchGeom* out) {
     if (c.n == 3) c.p[3] = c.p[2];
     c.normal = g.normal;
   };
-  const Eigen::Vector3d m01 = 0.5 * (g.p[0] + g.p[1]), m12 = 0.5 * (g.p[1] + g.p[2]);
+  auto mid = [](const Eigen::Vector3d& p, const Eigen::Vector3d& q) { return 0.5 * (p + q); };
+  int count = 4;
   if (g.n == 3) {
-    const Eigen::Vector3d m20 = 0.5 * (g.p[2] + g.p[0]);
-    make(out[0], {g.p[0], m01, m20});
-    make(out[1], {m01, g.p[1], m12});
-    make(out[2], {m20, m12, g.p[2]});
-    make(out[3], {m01, m12, m20});
+    double e[3];
+    for (int k = 0; k < 3; ++k) e[k] = (g.p[(k + 1) % 3] - g.p[k]).norm();
+    const int longest = static_cast<int>(std::max_element(e, e + 3) - e);
+    const int shortest = static_cast<int>(std::min_element(e, e + 3) - e);
+    const double L = e[longest];
+    if (L * L <= kSliverRatio * 2.0 * g.area) {
+      const Eigen::Vector3d m01 = mid(g.p[0], g.p[1]), m12 = mid(g.p[1], g.p[2]),
+                            m20 = mid(g.p[2], g.p[0]);
+      make(out[0], {g.p[0], m01, m20});
+      make(out[1], {m01, g.p[1], m12});
+      make(out[2], {m20, m12, g.p[2]});
+      make(out[3], {m01, m12, m20});
+    } else if (e[shortest] * kSliverRatio <= L) {
+      // Needle: edge (p, q) short, o the apex far from it.
+      const Eigen::Vector3d &p = g.p[shortest], &q = g.p[(shortest + 1) % 3],
+                            &o = g.p[(shortest + 2) % 3];
+      const Eigen::Vector3d mop = mid(o, p), mqo = mid(q, o);
+      make(out[0], {o, mop, mqo});
+      make(out[1], {mop, p, q, mqo});
+      count = 2;
+    } else {
+      // Cap: bisect the longest edge (p, q), o opposite.
+      const Eigen::Vector3d &p = g.p[longest], &q = g.p[(longest + 1) % 3],
+                            &o = g.p[(longest + 2) % 3];
+      const Eigen::Vector3d m = mid(p, q);
+      make(out[0], {o, p, m});
+      make(out[1], {o, m, q});
+      count = 2;
+    }
   } else {
-    const Eigen::Vector3d m23 = 0.5 * (g.p[2] + g.p[3]), m30 = 0.5 * (g.p[3] + g.p[0]);
-    const Eigen::Vector3d c = 0.25 * (g.p[0] + g.p[1] + g.p[2] + g.p[3]);
-    make(out[0], {g.p[0], m01, c, m30});
-    make(out[1], {m01, g.p[1], m12, c});
-    make(out[2], {c, m12, g.p[2], m23});
-    make(out[3], {m30, c, m23, g.p[3]});
+    const Eigen::Vector3d m01 = mid(g.p[0], g.p[1]), m12 = mid(g.p[1], g.p[2]),
+                          m23 = mid(g.p[2], g.p[3]), m30 = mid(g.p[3], g.p[0]);
+    const double along_u = (m12 - m30).norm(), along_v = (m23 - m01).norm();
+    if (along_u > kSliverRatio * along_v) {
+      make(out[0], {g.p[0], m01, m23, g.p[3]});
+      make(out[1], {m01, g.p[1], g.p[2], m23});
+      count = 2;
+    } else if (along_v > kSliverRatio * along_u) {
+      make(out[0], {g.p[0], g.p[1], m12, m30});
+      make(out[1], {m30, m12, g.p[2], g.p[3]});
+      count = 2;
+    } else {
+      const Eigen::Vector3d c = 0.25 * (g.p[0] + g.p[1] + g.p[2] + g.p[3]);
+      make(out[0], {g.p[0], m01, c, m30});
+      make(out[1], {m01, g.p[1], m12, c});
+      make(out[2], {c, m12, g.p[2], m23});
+      make(out[3], {m30, c, m23, g.p[3]});
+    }
   }
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < count; ++k) {
     PatchGeom& c = out[k];
     c.area = c.n == 3 ? 0.5 * (c.p[1] - c.p[0]).cross(c.p[2] - c.p[0]).norm()
                       : 0.5 * (c.p[2] - c.p[0]).cross(c.p[3] - c.p[1]).norm();
   }
+  return count;
+}
+
+// The error of a Gauss rule of order m along one parameter direction of quadrature_point
+// falls like (extent / 2d)^(2m) with the cell's extent in that direction, so a sliver cell
+// needs its full order along its length only: across it (0.05 mm against distances of
+// mm in a CAD heat sink) cell_order's lowest order is already exact to rounding. For a
+// sliver (longest extent > kSliverRatio x the other) this writes to `frame` the cell with its
+// corners turned (same winding) so that the parameter u runs along the length — a
+// triangle's collapsed corner p0 opposite its shortest edge; a quad as it is — and the
+// extents bounding |dx/du| (along) and |dx/dv| (across); otherwise returns false and the
+// cell gets one order from its diameter, as before. Triangle x = p0 + u (p1 - p0) +
+// u v (p2 - p1): |dx/du| <= max(|p1 - p0|, |p2 - p0|), |dx/dv| <= |p2 - p1|; bilinear quad:
+// |dx/du| <= max(|p1 - p0|, |p2 - p3|), |dx/dv| <= max(|p3 - p0|, |p2 - p1|).
+bool sliver_frame(const PatchGeom& g, PatchGeom& frame, double& along, double& across) {
+  frame = g;
+  if (g.n == 3) {
+    double e[3];
+    for (int k = 0; k < 3; ++k) e[k] = (g.p[(k + 1) % 3] - g.p[k]).norm();
+    const int shortest = static_cast<int>(std::min_element(e, e + 3) - e);
+    for (int k = 0; k < 3; ++k) frame.p[k] = g.p[(shortest + 2 + k) % 3];  // p0: the apex
+    frame.p[3] = frame.p[2];
+    along = std::max((frame.p[1] - frame.p[0]).norm(), (frame.p[2] - frame.p[0]).norm());
+    across = e[shortest];
+  } else {
+    const double u = std::max((g.p[1] - g.p[0]).norm(), (g.p[2] - g.p[3]).norm());
+    const double v = std::max((g.p[3] - g.p[0]).norm(), (g.p[2] - g.p[1]).norm());
+    if (v > u) {  // turn so that u runs along the length
+      for (int k = 0; k < 4; ++k) frame.p[k] = g.p[(k + 1) % 4];
+    }
+    along = std::max(u, v);
+    across = std::min(u, v);
+  }
+  return along > kSliverRatio * across;
 }
 
 }  // namespace
@@ -152,17 +238,24 @@ double integrate_unoccluded(const PatchGeom& a, const PatchGeom& b,
       if ((hovering < accuracy.kappa * h && depth < accuracy.max_depth) ||
           (touching < accuracy.kappa * h && depth < accuracy.touch_depth)) {
         PatchGeom children[4];
-        split(g, children);
-        for (const PatchGeom& c : children) stack.push_back({c, depth + 1});
+        const int count = split(g, children);
+        for (int k = 0; k < count; ++k) stack.push_back({children[k], depth + 1});
         continue;
       }
-      const GaussRule rule = gauss_legendre(cell_order(h, std::min(touching, hovering), accuracy.extra));
+      // A sliver gets the order its width needs across it (sliver_frame), any other cell
+      // one order both ways.
+      const double d = std::min(touching, hovering);
+      PatchGeom frame;
+      double along = h, across = h;
+      const PatchGeom& q = sliver_frame(g, frame, along, across) ? frame : g;
+      const GaussRule ru = gauss_legendre(cell_order(along, d, accuracy.extra));
+      const GaussRule rv = gauss_legendre(cell_order(across, d, accuracy.extra));
       QuadCell cell{g, 0.0};
-      for (int u = 0; u < rule.n; ++u)
-        for (int v = 0; v < rule.n; ++v) {
+      for (int u = 0; u < ru.n; ++u)
+        for (int v = 0; v < rv.n; ++v) {
           double jac;
-          const Eigen::Vector3d x = quadrature_point(g, rule.x[u], rule.x[v], jac);
-          cell.G += rule.w[u] * rule.w[v] * jac * point_to_patch(x, a.normal, b);
+          const Eigen::Vector3d x = quadrature_point(q, ru.x[u], rv.x[v], jac);
+          cell.G += ru.w[u] * rv.w[v] * jac * point_to_patch(x, a.normal, b);
         }
       if (cell.G > 0.0 && g.area > 0.0) {
         total += cell.G;

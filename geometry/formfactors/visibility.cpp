@@ -48,10 +48,12 @@ Eigen::Vector3d arvo(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const E
   const double s = std::sin(u1 * area - alpha), t = std::cos(u1 * area - alpha);
   const double u = t - cos_alpha, v = s + sin_alpha * a.dot(b);
   const double den = (v * s + u * t) * sin_alpha;
-  const double q = den != 0.0 ? std::clamp(((v * t - u * s) * cos_alpha - v) / den, -1.0, 1.0) : 1.0;
+  const double q =
+      den != 0.0 ? std::clamp(((v * t - u * s) * cos_alpha - v) / den, -1.0, 1.0) : 1.0;
   const Eigen::Vector3d c_perp = c - c.dot(a) * a;
   const double cpn = c_perp.norm();
-  const Eigen::Vector3d c_hat = cpn > 0.0 ? (q * a + std::sqrt(1.0 - q * q) * c_perp / cpn).eval() : a;
+  const Eigen::Vector3d c_hat =
+      cpn > 0.0 ? (q * a + std::sqrt(1.0 - q * q) * c_perp / cpn).eval() : a;
   const double z = std::clamp(1.0 - u2 * (1.0 - c_hat.dot(b)), -1.0, 1.0);
   const Eigen::Vector3d h_perp = c_hat - c_hat.dot(b) * b;
   const double hpn = h_perp.norm();
@@ -64,7 +66,7 @@ KernelSampler::KernelSampler(const Eigen::Vector3d& x, const Eigen::Vector3d& nx
                              const PatchGeom& b)
     : x_(x), nx_(nx), nb_(b.normal), plane_(b.normal.dot(b.p[0])) {
   const double height = nb_.dot(x) - plane_;  // x's height above b's plane
-  if (!(height > 0.0)) return;               // b's back faces x: nothing to receive
+  if (!(height > 0.0)) return;                // b's back faces x: nothing to receive
   ClippedCorners r;
   const int m = clip_to_horizon(x, nx, b, r);
   if (m < 3) return;
@@ -84,6 +86,24 @@ KernelSampler::KernelSampler(const Eigen::Vector3d& x, const Eigen::Vector3d& nx
     estimate += measure[k] * height / (rc * rc * rc);
   }
   area_mode_ = estimate < kSmallSolidAngle;
+  double rmin = 0.0;
+  if (area_mode_) {
+    // K = cosθ_x cosθ_y / r² with cosθ_y = height / r and r >= distance to b. Area sampling
+    // accepts with probability mean K / bound, mean K = π F(x -> b) / area. A sliver (a CAD
+    // facet 100 mm long, 0.05 mm wide) subtends a small solid angle yet runs from near x to
+    // many times as far, and K falls like 1/r³ along it: acceptance ~1e-4, 4096 tries per
+    // ray and a give-up (issue 36). Below kMinAreaAcceptance its solid angle is sampled.
+    rmin = std::max(distance_to_patch(x, b), height);
+    double area = 0.0;
+    for (int k = 0; k + 2 < m; ++k) area += measure[k];
+    const double mean_k = M_PI * factor_ / area, bound = cos_max * height / (rmin * rmin * rmin);
+    // Solid-angle sampling finds b's plane along every direction only when b is flat as
+    // seen from x: each corner about `height` below x along n_b (not a warped quad's corners
+    // on both sides of a point inside its warp).
+    bool flat = true;
+    for (int k = 0; k < m; ++k) flat = flat && -nb_.dot(r[k]) > 0.5 * height;
+    area_mode_ = !(flat && mean_k < kMinAreaAcceptance * bound);
+  }
   if (!area_mode_) {
     double total = 0.0;
     for (int k = 0; k + 2 < m; ++k) total += measure[k] = solid_angle(w[0], w[k + 1], w[k + 2]);
@@ -97,8 +117,6 @@ KernelSampler::KernelSampler(const Eigen::Vector3d& x, const Eigen::Vector3d& nx
     return;
   }
   if (area_mode_) {
-    // K = cosθ_x cosθ_y / r² with cosθ_y = height / r and r >= distance to b.
-    const double rmin = std::max(distance_to_patch(x, b), height);
     bound_ = cos_max * height / (rmin * rmin * rmin);
   } else {
     bound_ = cos_max;
@@ -155,7 +173,8 @@ int count_visible(const Bvh& bvh, const Eigen::Vector3d& x, const Eigen::Vector3
   int seen = 0;
   for (int r = 0; r < rays; ++r) {
     bool gave_up;
-    const Eigen::Vector3d y = sampler.sample(seq.get(r, 0), seq.get(r, 1), seq.get(r, 2), rng, gave_up);
+    const Eigen::Vector3d y =
+        sampler.sample(seq.get(r, 0), seq.get(r, 1), seq.get(r, 2), rng, gave_up);
     exhausted += gave_up;
     seen += visible(bvh, x, nx, y, b.normal, offset);
   }

@@ -19,8 +19,9 @@ namespace lambert::ff {
 /// directions uniform in the solid angle of b's part in front of x (Arvo 1995, per triangle
 /// of its fan), kept with probability cosθ_x / (bound of cosθ_x over b); or, when b subtends
 /// under kSmallSolidAngle (to first order; where Arvo's formulas lose digits and K is
-/// nearly uniform over b), points uniform in area, kept
-/// with probability K / (bound of K over b). Both are rejection samplers of the same density.
+/// nearly uniform over b) unless K is far from uniform over it (a sliver reaching from near
+/// x to far away: expected acceptance under kMinAreaAcceptance), points uniform in area,
+/// kept with probability K / (bound of K over b). Both are rejection samplers of the same density.
 class KernelSampler {
  public:
   KernelSampler(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& b);
@@ -36,6 +37,10 @@ class KernelSampler {
   /// Solid angles below this (sr) use area sampling: ~1e-16 / 1e-4 relative precision of
   /// Arvo's spherical-excess arithmetic, and a patch that small is nearly uniform in K.
   static constexpr double kSmallSolidAngle = 1e-4;
+  /// Area sampling only where its expected acceptance is at least this (else solid-angle
+  /// sampling): the break-even of a cheap area try against an Arvo try (trigonometry, ~5x
+  /// the cost) accepted with probability >= cos of b's elevation; as kMinJointAcceptance.
+  static constexpr double kMinAreaAcceptance = 0.2;
   /// Tries before giving up on the rejection.
   static constexpr int kMaxTries = 4096;
 

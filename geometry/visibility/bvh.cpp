@@ -100,6 +100,7 @@ struct Bvh::Impl {
   std::shared_ptr<RTCDeviceTy> device;
   std::unique_ptr<RTCSceneTy, SceneDeleter> scene;  // released before the device
   int exponent = 0;                                 // the BVH holds the scene scaled by 2^exponent
+  double scale = 1.0;                               // 2^exponent
 };
 
 namespace {
@@ -113,14 +114,21 @@ struct FrameRay {
 
 // Throws SceneError for a ray Embree cannot take (a medium box or sensor point far outside
 // the scene, a non-finite origin).
+//
+// v * 2^exponent is computed as float(double(v) * scale), scale = 2^exponent: the product is
+// exact in double (|exponent| <= ~100 for coordinates within 1e-30 .. 1e30) and the one
+// rounding to float is std::ldexp's, so the rays are the same floats without a libm call
+// per component (nine per ray were ~15 % of an occlusion query).
 FrameRay to_bvh_frame(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
-                      int exponent) {
+                      double scale) {
+  auto scaled = [](float v, double by) { return static_cast<float>(static_cast<double>(v) * by); };
   FrameRay r;
-  for (int k = 0; k < 3; ++k) r.o[k] = std::ldexp(origin[k], exponent);
-  const float length = std::ldexp(direction.cwiseAbs().maxCoeff(), exponent);
+  for (int k = 0; k < 3; ++k) r.o[k] = scaled(origin[k], scale);
+  const float length = scaled(direction.cwiseAbs().maxCoeff(), scale);
   if (length > 0.0f && std::isfinite(length) && (length > 0x1p30f || length < 0x1p-30f))
     r.shift = std::ilogb(length) + 1;
-  for (int k = 0; k < 3; ++k) r.d[k] = std::ldexp(direction[k], exponent - r.shift);
+  const double dscale = r.shift == 0 ? scale : std::ldexp(scale, -r.shift);
+  for (int k = 0; k < 3; ++k) r.d[k] = scaled(direction[k], dscale);
   if (!(r.o.cwiseAbs().maxCoeff() <= kMaxRayComponent &&
         r.d.cwiseAbs().maxCoeff() <= kMaxRayComponent))
     throw SceneError("a ray from (" + std::to_string(origin.x()) + ", " +
@@ -148,6 +156,7 @@ Bvh::Bvh(const PatchMesh& mesh, int threads) : impl_(std::make_unique<Impl>()) {
                        " in magnitude: the ray tracer (single precision) needs them between "
                        "1e-30 and 1e30; rescale the scene (e.g. other length units)");
     if (largest > 0.0) impl_->exponent = -(std::ilogb(largest) + 1);
+    impl_->scale = std::ldexp(1.0, impl_->exponent);
   }
   ++g_builds;
   impl_->device = process_device(threads);
@@ -192,7 +201,7 @@ bool Bvh::occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& directi
                    float tfar) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  const FrameRay f = to_bvh_frame(origin, direction, impl_->exponent);
+  const FrameRay f = to_bvh_frame(origin, direction, impl_->scale);
   RTCRay ray;
   ray.org_x = f.o.x();
   ray.org_y = f.o.y();
@@ -200,8 +209,8 @@ bool Bvh::occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& directi
   ray.dir_x = f.d.x();
   ray.dir_y = f.d.y();
   ray.dir_z = f.d.z();
-  ray.tnear = std::ldexp(tnear, f.shift);
-  ray.tfar = std::ldexp(tfar, f.shift);
+  ray.tnear = f.shift == 0 ? tnear : std::ldexp(tnear, f.shift);
+  ray.tfar = f.shift == 0 ? tfar : std::ldexp(tfar, f.shift);
   ray.time = 0.0f;
   ray.mask = 0xFFFFFFFFu;
   ray.id = 0;
@@ -238,7 +247,7 @@ RayHit Bvh::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& dire
                       float tfar) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  const FrameRay f = to_bvh_frame(origin, direction, impl_->exponent);
+  const FrameRay f = to_bvh_frame(origin, direction, impl_->scale);
   RTCRayHit rh;
   rh.ray.org_x = f.o.x();
   rh.ray.org_y = f.o.y();
@@ -246,8 +255,8 @@ RayHit Bvh::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& dire
   rh.ray.dir_x = f.d.x();
   rh.ray.dir_y = f.d.y();
   rh.ray.dir_z = f.d.z();
-  rh.ray.tnear = std::ldexp(tnear, f.shift);
-  rh.ray.tfar = std::ldexp(tfar, f.shift);
+  rh.ray.tnear = f.shift == 0 ? tnear : std::ldexp(tnear, f.shift);
+  rh.ray.tfar = f.shift == 0 ? tfar : std::ldexp(tfar, f.shift);
   rh.ray.time = 0.0f;
   rh.ray.mask = 0xFFFFFFFFu;
   rh.ray.id = 0;

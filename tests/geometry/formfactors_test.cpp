@@ -96,8 +96,8 @@ TEST(FormFactorHybrid, IsExactForUnoccludedPairs) {
 }
 
 TEST(FormFactorHybrid, MeshedSquaresSumToTheSurfaceFactor) {
-  for (const auto& [scene, exact] :
-       {std::pair{parallel_squares(1.0), kCubeOpposite}, std::pair{perpendicular_squares(), kCubeAdjacent}}) {
+  for (const auto& [scene, exact] : {std::pair{parallel_squares(1.0), kCubeOpposite},
+                                     std::pair{perpendicular_squares(), kCubeAdjacent}}) {
     const PatchMesh mesh = mesh_scene(scene, {0.25, 0});
     FormFactorOptions o;
     o.pair.samples = 8;
@@ -308,7 +308,7 @@ TEST(FormFactors, FloorRunningUnderAWallMatchesTheClosedForm) {
   Material m{"m", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
   add_polygon(s, "floor", m, {{-0.7, 0, 0}, {-0.7, 0, 1}, {1.3, 0, 1}, {1.3, 0, 0}});  // +y
   add_polygon(s, "wall", m, {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}});             // +x
-  const double exact = 1.3 * perpendicular_rectangles_factor(1, 1.3, 1) / 2.0;  // / A_floor
+  const double exact = 1.3 * perpendicular_rectangles_factor(1, 1.3, 1) / 2.0;         // / A_floor
   // Meshings whose floor patches straddle the wall's plane (0.3, 5) and one that does not
   // (0.1). mc runs on the two coarse ones only: the straddling is what it checks, and at
   // 0.1 its 4096 rays per pair took 85 % of the suite's time.
@@ -338,17 +338,18 @@ namespace lambert {
 // which is the left half of the opposite square: the near (high-kernel) half of b is
 // hidden. The exact G is that of the unshaded configuration a -> (right half of b), which
 // hybrid computes exactly (no blocker); an area-weighted visible fraction would give 1/2 of
-// G(a -> b) instead, 20 % too high here (0.04996 vs 0.04159). The plate sits 1e-3 in front of b, so its
-// penumbra on b is a band < 1e-3 wide: G changes by < 1e-3 relative (the bound used).
+// G(a -> b) instead, 20 % too high here (0.04996 vs 0.04159). The plate sits 1e-3 in front of b, so
+// its penumbra on b is a band < 1e-3 wide: G changes by < 1e-3 relative (the bound used).
 TEST(FormFactors, PartlyShadedReceiverUsesTheKernelWeightedVisibleFraction) {
   Material m{"m", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
   Scene open;
-  add_polygon(open, "a", m, {{0, 0, 0}, {0.5, 0, 0}, {0.5, 1, 0}, {0, 1, 0}});        // +z
-  add_polygon(open, "c", m, {{0.5, 0, 1}, {0.5, 1, 1}, {1, 1, 1}, {1, 0, 1}});        // -z
+  add_polygon(open, "a", m, {{0, 0, 0}, {0.5, 0, 0}, {0.5, 1, 0}, {0, 1, 0}});  // +z
+  add_polygon(open, "c", m, {{0.5, 0, 1}, {0.5, 1, 1}, {1, 1, 1}, {1, 0, 1}});  // -z
   Scene shaded;
   add_polygon(shaded, "a", m, {{0, 0, 0}, {0.5, 0, 0}, {0.5, 1, 0}, {0, 1, 0}});
   add_polygon(shaded, "b", m, {{0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1}});
-  add_polygon(shaded, "plate", m, {{-2, -2, 0.999}, {0.5, -2, 0.999}, {0.5, 3, 0.999}, {-2, 3, 0.999}});
+  add_polygon(shaded, "plate", m,
+              {{-2, -2, 0.999}, {0.5, -2, 0.999}, {0.5, 3, 0.999}, {-2, 3, 0.999}});
   FormFactorOptions o;
   o.pair.samples = 4;
   o.run.progress = false;
@@ -464,6 +465,41 @@ TEST(FormFactorRegistry, EveryParameterIsDeclaredOnceWithTheOptionsDefault) {
   EXPECT_EQ(find_estimator_param("--rays")->estimators, std::vector<std::string>{"gather"});
   EXPECT_EQ(find_estimator_param("--ff-tol")->estimators, std::vector<std::string>{"analytic"});
   EXPECT_EQ(find_estimator_param("--threshold"), nullptr);  // every estimator's: not a parameter
+}
+
+// A CAD sliver (issue 36: a round fin tip's facet, 100 mm by 0.05 mm) 2 mm above x, its
+// apex over x and its far end 50 patch-heights away. Its solid angle (~2e-5 sr to first
+// order) is under kSmallSolidAngle, but K falls like 1/r³ along it: area sampling
+// accepted with probability ~4e-4 (mean K 100 against a bound of 2.5e5), so a sample gave up
+// after kMaxTries with probability e^(-4096 * 4e-4) = 0.2 (the heat sink's unverified pairs).
+// Sampled by solid angle now: no sample gives up, every sample lies on the sliver.
+TEST(KernelSampler, LongSliverNearThePointNeverGivesUp) {
+  const double L = 0.1, w = 5e-5, h = 0.002;
+  ff::PatchGeom b;
+  b.n = 3;
+  b.p = {Eigen::Vector3d(0, 0, h), Eigen::Vector3d(L, w, h), Eigen::Vector3d(L, 0, h),
+         Eigen::Vector3d(L, 0, h)};
+  b.normal = -Eigen::Vector3d::UnitZ();
+  b.centroid = (b.p[0] + b.p[1] + b.p[2]) / 3.0;
+  b.area = 0.5 * L * w;
+  const Eigen::Vector3d x = Eigen::Vector3d::Zero(), nx = Eigen::Vector3d::UnitZ();
+  const ff::KernelSampler sampler(x, nx, b);
+  ASSERT_FALSE(sampler.empty());
+  EXPECT_EQ(sampler.factor(), ff::point_to_patch(x, nx, b));
+  Eigen::AlignedBox3d box;
+  for (const auto& p : b.p) box.extend(p);
+  box.extend(box.min() - Eigen::Vector3d::Constant(1e-9));
+  box.extend(box.max() + Eigen::Vector3d::Constant(1e-9));
+  Rng rng(11);
+  int gave_up = 0;
+  for (int k = 0; k < 256; ++k) {
+    bool exhausted = false;
+    const Eigen::Vector3d y =
+        sampler.sample(rng.uniform(), rng.uniform(), rng.uniform(), rng, exhausted);
+    gave_up += exhausted;
+    EXPECT_TRUE(box.contains(y)) << "sample " << k << ": " << y.transpose();
+  }
+  EXPECT_EQ(gave_up, 0);
 }
 
 }  // namespace lambert

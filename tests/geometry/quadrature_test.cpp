@@ -1,9 +1,13 @@
 // The unoccluded quadrature of hybrid (and of the accuracy reference) against closed forms,
 // for any size ratio, height and lateral position: docs/form-factors.md's "< 1e-6 relative"
 // for unoccluded pairs, checked here to 1e-5.
+#include "geometry/formfactors/quadrature.hpp"
+
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <vector>
 
 #include "geometry/analytic.hpp"
 #include "geometry/formfactors/formfactors.hpp"
@@ -26,6 +30,25 @@ Scene make_scene(const Pair& p) {
   add_polygon(scene, "big", m, {{-H, -H, 0}, {H, -H, 0}, {H, H, 0}, {-H, H, 0}});
   add_polygon(scene, "small", m, {{x0, y0, p.h}, {x0, y1, p.h}, {x1, y1, p.h}, {x1, y0, p.h}});
   return scene;
+}
+
+// A strip [0, L] x [y0, y0 + w] at height z as two needle triangles (corners in the order
+// a CAD exporter writes them), facing up (+z) or down.
+std::vector<ff::PatchGeom> strip(double L, double y0, double w, double z, bool up) {
+  const Eigen::Vector3d p00(0, y0, z), p10(L, y0, z), p11(L, y0 + w, z), p01(0, y0 + w, z);
+  std::vector<ff::PatchGeom> out;
+  for (const auto& t : {std::array<Eigen::Vector3d, 3>{p00, p10, p11},
+                        std::array<Eigen::Vector3d, 3>{p00, p11, p01}}) {
+    ff::PatchGeom g;
+    g.n = 3;
+    g.p = {t[0], up ? t[1] : t[2], up ? t[2] : t[1], up ? t[2] : t[1]};
+    g.normal = Eigen::Vector3d(0, 0, up ? 1 : -1);
+    g.area = 0.5 * L * w;
+    g.centroid = (t[0] + t[1] + t[2]) / 3.0;
+    g.diameter = std::hypot(L, w);
+    out.push_back(g);
+  }
+  return out;
 }
 
 double exact_G(const Pair& p) {
@@ -94,6 +117,46 @@ TEST(HybridQuadrature, SharedEdgeIsExact) {
   o.run.progress = false;
   const FormFactors ff = compute_form_factors(mesh_scene(perpendicular_squares(), {}), o);
   EXPECT_NEAR(ff.F.coeff(0, 1), kCubeAdjacent, 1e-6 * kCubeAdjacent);
+}
+
+// CAD slivers (issue 36): a round fin tip exported as facets 100 mm long and 0.1 mm wide
+// (aspect 1000), facing another such strip 2 or 20 mm away, straight above or offset. The
+// quadrature halves slivers across their length and gives them a low order across it; the
+// sum over the 2 x 2 triangle pairs must still be the rectangles' closed form to
+// kQuadratureTolerance (1e-6 relative per pair, so of the sum). The closed form loses ~16
+// ulps of its largest corner term (|g| <= L² = 0.01): 16 * 2.2e-16 * 0.01 / 2π < 1e-17
+// absolute, against G >= 1e-10 here.
+TEST(HybridQuadrature, SliverStripsMatchTheClosedForm) {
+  const double L = 0.1, w = 1e-4;
+  for (double h : {0.002, 0.02})
+    for (double offset : {0.0, 0.003}) {
+      const auto lower = strip(L, 0.0, w, 0.0, true), upper = strip(L, offset, w, h, false);
+      std::vector<ff::QuadCell> cells;
+      double G = 0.0;
+      for (const ff::PatchGeom& a : lower)
+        for (const ff::PatchGeom& b : upper)
+          G += ff::integrate_unoccluded(a, b, ff::kEstimatorAccuracy, cells);
+      const double exact = parallel_rectangles_G(0, L, 0, w, 0, L, offset, offset + w, h);
+      EXPECT_NEAR(G, exact, ff::kQuadratureTolerance * exact + 1e-17) << h << " " << offset;
+      std::printf("h %g offset %g: relative error %.1e\n", h, offset, std::abs(G / exact - 1));
+    }
+}
+
+// The cost of that accuracy grows with a sliver's length only. Quartering every cell (the
+// old split) kept the aspect ratio, so a strip under another 2 mm away was cut until its
+// cells were 1 mm long and 1 um wide: 4^7 = 16384 cells per triangle pair where the
+// length needs L / (kappa d) = 0.1 / (0.5 * 0.002) = 100. Allowed: 4x that (the criterion
+// takes a cell's centre-to-edge distance minus its radius, and cells near the strip's ends
+// are cut further) per pair.
+TEST(HybridQuadrature, SliverCellCountGrowsWithLengthOnly) {
+  const double L = 0.1, w = 1e-4, h = 0.002;
+  const auto lower = strip(L, 0.0, w, 0.0, true), upper = strip(L, 0.0, w, h, false);
+  std::vector<ff::QuadCell> cells;
+  for (const ff::PatchGeom& a : lower)
+    for (const ff::PatchGeom& b : upper) {
+      ff::integrate_unoccluded(a, b, ff::kEstimatorAccuracy, cells);
+      EXPECT_LE(cells.size(), 4 * L / (ff::kEstimatorAccuracy.kappa * h));
+    }
 }
 
 }  // namespace lambert
