@@ -17,6 +17,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <stdexcept>
 
@@ -332,18 +333,28 @@ Soup import(const std::string& path, bool colours) {
 // none). Empty when `path` is no glTF or its JSON does not parse (assimp has read it, so that
 // leaves only what the JSON parser refuses: then the strengths stay 1).
 std::vector<std::pair<std::string, double>> gltf_emissive_strengths(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[20] = {};
+  in.read(head, sizeof head);
+  const auto got = static_cast<size_t>(in.gcount());
   std::string text;
-  try {
-    text = read_file_bytes(path);
-  } catch (const IoError&) {
-    return {};
-  }
-  if (text.rfind("glTF", 0) == 0) {  // GLB: the JSON chunk's length at byte 12, its text at 20
+  if (got >= 4 && std::memcmp(head, "glTF", 4) == 0) {
+    // GLB: the JSON chunk's length at byte 12, its type at 16, its text from 20 (only that
+    // chunk is read, not the binary one).
     std::uint32_t length = 0;
-    if (text.size() < 20) return {};
-    std::memcpy(&length, text.data() + 12, 4);
-    if (text.compare(16, 4, "JSON") != 0 || length > text.size() - 20) return {};
-    text = text.substr(20, length);
+    std::memcpy(&length, head + 12, 4);
+    if (got < 20 || std::memcmp(head + 16, "JSON", 4) != 0) return {};
+    std::error_code ec;
+    const auto size = fs::file_size(path, ec);
+    if (ec || length > size - 20) return {};
+    text.resize(length);
+    in.read(text.data(), static_cast<std::streamsize>(length));
+    if (static_cast<size_t>(in.gcount()) != length) return {};
+  } else if (lower_extension(path) == ".gltf") {
+    text.assign(head, got);
+    text.append(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  } else {
+    return {};  // not a glTF
   }
   std::vector<std::pair<std::string, double>> out;
   const Json j = Json::parse(text, nullptr, false);
