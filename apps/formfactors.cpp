@@ -251,13 +251,15 @@ int run_formfactors(const FormFactorsOptions& opts) {
     throw UsageError(
         "--point and --stderr do not combine with a participating medium yet: save F (-o F.bin "
         "or F.mtx) and read the zone columns, or --by-surface for the exchange areas");
+  // The surface table carries standard errors, except with a medium (its zones have none).
+  const bool with_stderr = opts.with_stderr || (opts.by_surface && !medium);
   JobPlan plan = job_plan(opts.run);
   plan.outputs = {{"-o", opts.output}};
   plan.medium = medium.get();
   plan.medium_rays = opts.medium.rays;
   if (opts.point.empty()) {
     plan.outputs.push_back({"--report", report});
-    plan_form_factors(plan, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
+    plan_form_factors(plan, opts.ff, opts.run, with_stderr);
   }
   // The analytic estimator (named, or auto's pick for --ff-tol) integrates over whole
   // polygons: one patch per face unless --max-edge or --patches asks for more.
@@ -283,8 +285,7 @@ int run_formfactors(const FormFactorsOptions& opts) {
     return 0;
   }
   if (medium) check_medium_scene(scene.mesh, nullptr);
-  FormFactors ff =
-      obtain_form_factors(scene, opts.ff, opts.run, opts.with_stderr || opts.by_surface);
+  FormFactors ff = obtain_form_factors(scene, opts.ff, opts.run, with_stderr);
   write_formfactors_outputs(opts, scene, ff, report, Json(), medium.get());
   return 0;
 }

@@ -120,10 +120,6 @@ TEST(RunCommand, TinySceneProducesEveryFile) {
     EXPECT_NE(stdout_text.find(word), std::string::npos) << word;
 }
 
-// One Embree device per process, one BVH per run, shared by form factors and rendering.
-// The counters are process-wide and other tests may have run in this process before (ctest
-// runs one test per process, a plain run of the executable does not), so the test reads
-// them before and after: one build more, and at most one device for this thread count.
 // report.json "timings" (issue 37): every stage of the matrix run under its key with wall
 // and CPU seconds, and their total. A run on one thread (-j 1) cannot use more CPU time than
 // wall time in any stage; 10 ms absorbs the two clocks' granularity (both are read at each
@@ -132,11 +128,10 @@ TEST(RunCommand, TheReportTimesEveryStageInWallAndCpuSeconds) {
   lambert::testing::TempDir dir;
   write_tiny_scene(dir);
   const std::string out = dir.file("results");
-  ::testing::internal::CaptureStdout();
-  const int code = run({"run", dir.file("tiny.obj"), "-o", out, "--patches", "80", "--samples", "4",
-                        "--size", "40x30", "-q", "-j", "1"});
-  ::testing::internal::GetCapturedStdout();
-  ASSERT_EQ(code, kExitOk);
+  const auto [code, printed] =
+      lambert::testing::run_stdout({"run", dir.file("tiny.obj"), "-o", out, "--patches", "80",
+                                    "--samples", "4", "--size", "40x30", "-q", "-j", "1"});
+  ASSERT_EQ(code, kExitOk) << printed;
   const nlohmann::json t = nlohmann::json::parse(slurp(out + "/report.json")).at("timings");
   std::vector<std::string> keys;
   for (const auto& [key, value] : t.items()) keys.push_back(key);
@@ -156,6 +151,10 @@ TEST(RunCommand, TheReportTimesEveryStageInWallAndCpuSeconds) {
   EXPECT_NEAR(t.at("total").at("cpu").get<double>(), cpu, 1e-12);
 }
 
+// One Embree device per process, one BVH per run, shared by form factors and rendering.
+// The counters are process-wide and other tests may have run in this process before (ctest
+// runs one test per process, a plain run of the executable does not), so the test reads
+// them before and after: one build more, and at most one device for this thread count.
 TEST(RunCommand, BuildsOneBvhOnOneDeviceForFormFactorsAndRendering) {
   lambert::testing::TempDir dir;
   write_tiny_scene(dir);

@@ -22,22 +22,31 @@ inline int run(std::vector<std::string> args) {
   return run_cli(static_cast<int>(argv.size()), argv.data());
 }
 
-/// run(args) with stdout and stderr captured: the exit code and what went to stderr.
-inline std::pair<int, std::string> run_capturing(const std::vector<std::string>& args) {
+/// What a captured run printed.
+struct Captured {
+  int code;
+  std::string out, err;
+};
+
+/// run(args) with stdout and stderr captured.
+inline Captured run_captured(const std::vector<std::string>& args) {
   ::testing::internal::CaptureStderr();
   ::testing::internal::CaptureStdout();
   const int code = run(args);
-  ::testing::internal::GetCapturedStdout();
-  return {code, ::testing::internal::GetCapturedStderr()};
+  std::string out = ::testing::internal::GetCapturedStdout();
+  return {code, std::move(out), ::testing::internal::GetCapturedStderr()};
+}
+
+/// run(args) with stdout and stderr captured: the exit code and what went to stderr.
+inline std::pair<int, std::string> run_capturing(const std::vector<std::string>& args) {
+  Captured c = run_captured(args);
+  return {c.code, std::move(c.err)};
 }
 
 /// run(args) with stdout and stderr captured: the exit code and what went to stdout.
 inline std::pair<int, std::string> run_stdout(const std::vector<std::string>& args) {
-  ::testing::internal::CaptureStdout();
-  ::testing::internal::CaptureStderr();
-  const int code = run(args);
-  ::testing::internal::GetCapturedStderr();
-  return {code, ::testing::internal::GetCapturedStdout()};
+  Captured c = run_captured(args);
+  return {c.code, std::move(c.out)};
 }
 
 /// The whole content of a file ("" if it cannot be read).
