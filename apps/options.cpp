@@ -184,6 +184,7 @@ void add_shade_options(CLI::App* cmd, ShadeArgs& args) {
   add_declared(cmd, "--antialias", args.antialias);
   add_declared(cmd, "--exposure", args.exposure);
   add_declared(cmd, "--vertex-interp", args.vertex_interp);
+  add_declared(cmd, "--direct-rays", args.direct_rays);
 }
 
 }  // namespace lambert

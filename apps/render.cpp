@@ -32,13 +32,13 @@ std::string matrix_settings(const RenderOptions& o, const LoadedScene& s,
 
 // The settings line: the method's part, then shading and camera.
 std::string render_settings(const RenderOptions& o, const std::string& method_part,
-                            const std::string& interp, const Camera& cam) {
+                            const std::string& interp, const Camera& cam, int direct_rays) {
   std::ostringstream ss;
   ss << method_part;
   ss << " interp=" << interp << ' ' << shading_settings(o.shade, o.ff.specular_depth)
-     << (o.shade.wireframe ? " wireframe=1" : "") << " antialias=" << o.shade.antialias
-     << " render_seed=" << o.run.seed << " size=" << cam.width << "x" << cam.height
-     << " eye=" << cam.eye.x() << "," << cam.eye.y() << "," << cam.eye.z()
+     << " direct_rays=" << direct_rays << (o.shade.wireframe ? " wireframe=1" : "")
+     << " antialias=" << o.shade.antialias << " render_seed=" << o.run.seed << " size=" << cam.width
+     << "x" << cam.height << " eye=" << cam.eye.x() << "," << cam.eye.y() << "," << cam.eye.z()
      << " look_at=" << cam.look_at.x() << "," << cam.look_at.y() << "," << cam.look_at.z()
      << " vfov=" << cam.vfov_degrees;
   return ss.str();
@@ -68,15 +68,17 @@ void render_and_write(const RenderOptions& opts, const LoadedScene& loaded,
                       const Relighting& relight, const MediumView* medium = nullptr) {
   const ShadedField shaded = shade_vertices(loaded, B, indirect, opts.shade, opts.run.threads);
   RenderStats stats;
-  const Image image = render_scene(loaded, B, shaded.field, camera, opts.shade,
-                                   opts.ff.specular_depth, opts.run, &stats, medium);
+  const Image image =
+      render_scene(loaded, B, shaded.field, camera, opts.shade, opts.ff.specular_depth, opts.run,
+                   &stats, medium, indirect, shaded.interpolation);
   const double ev = choose_exposure(opts.shade, image, loaded.scene.daylight.has_sky());
   OutputPaths paths;
   paths.image_exr = opts.output;
   paths.png = png_path(opts);
   paths.vertex_exr = opts.vertex_exr;
   paths.ply = opts.ply;
-  const std::string settings = render_settings(opts, method_settings, shaded.interpolation, camera);
+  const std::string settings =
+      render_settings(opts, method_settings, shaded.interpolation, camera, stats.direct_rays);
   auto written = write_outputs(paths, loaded.mesh, shaded, image, ev, settings);
   if (!opts.glb.empty()) {
     static const std::vector<EmitterBasis> kNone;
@@ -129,6 +131,7 @@ int render_matrix(const RenderOptions& opts) {
   SceneArgs scene_args = opts.scene;
   scene_args.require_emitter = opts.radiosity.empty();  // --radiosity: B is given
   const LoadedScene loaded = load_scene(scene_args, plan);
+  check_pixel_direct(opts.shade, loaded);
   const Camera camera = make_camera(loaded.scene, opts.camera);
   RadiosityResult r;
   if (medium) {

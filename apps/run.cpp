@@ -103,11 +103,13 @@ struct MethodOutcome {
 
 std::vector<double> as_vector(const Eigen::Vector3d& v) { return {v[0], v[1], v[2]}; }
 
-std::string shade_settings(const RunOptions& o, const std::string& interp, const Camera& cam) {
+std::string shade_settings(const RunOptions& o, const std::string& interp, const Camera& cam,
+                           int direct_rays) {
   std::ostringstream ss;
   ss << " interp=" << interp << ' ' << shading_settings(o.shade, o.ff.specular_depth)
-     << (o.shade.wireframe ? " wireframe=1" : "") << " antialias=" << o.shade.antialias
-     << " render_seed=" << o.run.seed << " size=" << cam.width << "x" << cam.height;
+     << " direct_rays=" << direct_rays << (o.shade.wireframe ? " wireframe=1" : "")
+     << " antialias=" << o.shade.antialias << " render_seed=" << o.run.seed << " size=" << cam.width
+     << "x" << cam.height;
   return ss.str();
 }
 
@@ -166,6 +168,8 @@ Json report_json(const RunOptions& opts, const MethodOutcome& m, const Tail& t) 
                  {"height", t.camera.height},
                  {"samples_per_pixel", opts.shade.antialias * opts.shade.antialias},
                  {"rays", t.render.rays},
+                 {"direct_light", t.render.direct_rays > 0 ? "per pixel" : "from the vertices"},
+                 {"direct_rays", t.render.direct_rays},
                  {"exposure_ev", t.ev}};
   const Json shading = shading_json(opts.shade, opts.ff.specular_depth);
   for (const auto& [key, value] : shading.items()) j["render"][key] = value;
@@ -201,9 +205,13 @@ void print_summary(const RunOptions& opts, const MethodOutcome& m, const Tail& t
         "vertices   power error per surface (max) %.2e with %s interpolation "
         "(area-weighted alone: %.2e)\n",
         after, t.shaded.interpolation.c_str(), before);
-  std::printf("image      %dx%d, %d samples/pixel, %s, exposure %+.2f EV\n", t.camera.width,
+  const std::string direct =
+      t.render.direct_rays > 0
+          ? ", direct light per pixel (" + std::to_string(t.render.direct_rays) + " shadow rays)"
+          : "";
+  std::printf("image      %dx%d, %d samples/pixel, %s%s, exposure %+.2f EV\n", t.camera.width,
               t.camera.height, opts.shade.antialias * opts.shade.antialias,
-              shading_settings(opts.shade, opts.ff.specular_depth).c_str(), t.ev);
+              shading_settings(opts.shade, opts.ff.specular_depth).c_str(), direct.c_str(), t.ev);
   std::string times;
   for (size_t k = 0; k < m.seconds.size(); ++k)
     times += m.time_labels[k] + " " + format_duration(m.seconds[k].second) + ", ";
@@ -270,13 +278,15 @@ int finish_run(const RunOptions& opts, const RunPaths& paths, const MethodOutcom
   stages.next("render",
               "rendering " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
   RenderStats rs;
-  const Image image = render_scene(m.loaded, m.B, shaded.field, camera, opts.shade,
-                                   opts.ff.specular_depth, opts.run, &rs, m.medium);
+  const Image image =
+      render_scene(m.loaded, m.B, shaded.field, camera, opts.shade, opts.ff.specular_depth,
+                   opts.run, &rs, m.medium, m.indirect, shaded.interpolation);
   const double ev = choose_exposure(opts.shade, image, m.loaded.scene.daylight.has_sky());
 
   stages.next("write", "writing " + opts.output_dir + "/" + paths.name + ".*");
   const Timer timer;
-  const std::string settings = m.settings + shade_settings(opts, shaded.interpolation, camera);
+  const std::string settings =
+      m.settings + shade_settings(opts, shaded.interpolation, camera, rs.direct_rays);
   std::vector<std::string> files =
       write_outputs(paths.files, m.loaded.mesh, shaded, image, ev, settings);
   const Json viewer = write_run_viewer(paths, m, shaded, camera, ev, settings, files);
@@ -497,6 +507,7 @@ int run_matrix(const RunOptions& opts) {
   plan.medium_rays = opts.medium.rays;
   plan.direct = opts.solver.solver == "direct";
   LoadedScene loaded = load_scene(opts.scene, plan);
+  check_pixel_direct(opts.shade, loaded);
   const Camera camera = make_camera(loaded.scene, opts.camera);
   const double load_seconds = timer.seconds();
   log_info("      " + std::to_string(loaded.mesh.size()) + " patches on " +

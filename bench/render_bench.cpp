@@ -14,7 +14,10 @@
 // camera ray.
 //
 // Usage: render_bench [--size 512] [--patches 800] [--ref-patches 8000]
-//   [--gather 16,64,256] [--threads 0] [--png-dir DIR]
+//   [--gather 16,64,256] [--direct 8,32] [--threads 0] [--png-dir DIR]
+//
+// `--direct N` rows: Gouraud over the vertex field of E + rho I with the emitters' direct
+// light drawn per pixel by N shadow rays (what `run` draws by default, N = 8).
 
 #include <cmath>
 #include <cstdio>
@@ -97,7 +100,7 @@ Errors errors(const Image& img, const Image& ref) {
 int main(int argc, char** argv) {
   int size = 512, threads = 0;
   std::int64_t patches = 800, ref_patches = 8000;
-  std::string gathers = "16,64,256", png_dir;
+  std::string gathers = "16,64,256", direct_rays = "8,32", png_dir;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i], v = argv[i + 1];
     if (a == "--size")
@@ -108,6 +111,8 @@ int main(int argc, char** argv) {
       ref_patches = std::atol(v.c_str());
     else if (a == "--gather")
       gathers = v;
+    else if (a == "--direct")
+      direct_rays = v;
     else if (a == "--threads")
       threads = std::atoi(v.c_str());
     else if (a == "--png-dir")
@@ -151,9 +156,11 @@ int main(int argc, char** argv) {
   std::printf("%-22s %10s %12s %10s %10s %12s\n", "shading", "seconds", "rays", "vs gouraud",
               "L1 error", "RMS error");
   double gouraud_seconds = 0;
-  const auto report = [&](const std::string& name, const RenderSettings& o) {
+  const auto report = [&](const std::string& name, const RenderSettings& o,
+                          const VertexField* shading_field = nullptr) {
     RenderStats stats;
-    const Image img = render(coarse.mesh, bvh, cam, coarse.B, field, o, &stats, &light);
+    const Image img = render(coarse.mesh, bvh, cam, coarse.B,
+                             shading_field ? *shading_field : field, o, &stats, &light);
     if (gouraud_seconds == 0) gouraud_seconds = stats.seconds;
     const Errors e = errors(img, ref);
     std::printf("%-22s %10.2f %12lld %9.1fx %10.4f %12.4f\n", name.c_str(), stats.seconds,
@@ -163,6 +170,20 @@ int main(int argc, char** argv) {
     return stats.seconds;
   };
   report("gouraud", base);
+  // The emitters' direct light per pixel (pixel_direct.hpp) over the vertex field of E + rho I,
+  // as `run` draws it by default.
+  Eigen::MatrixX3d rest(coarse.mesh.size(), 3);
+  for (std::int32_t i = 0; i < coarse.mesh.size(); ++i)
+    rest.row(i) = (coarse.mesh.patches[i].emission +
+                   coarse.mesh.patches[i].rho.cwiseProduct(coarse.indirect.row(i).transpose()))
+                      .transpose();
+  const VertexField rest_field = interpolate_to_vertices(coarse.mesh, rest);
+  for (int n : parse_list(direct_rays)) {
+    const PixelDirectLight pixel(scene, n, 1e-6 * coarse.mesh.scale);
+    RenderSettings o = base;
+    o.pixel_direct = &pixel;
+    report("gouraud+direct-" + std::to_string(n), o, &rest_field);
+  }
   RenderSettings traced = base;
   traced.shading = Shading::Raytrace;
   report("raytrace", traced);

@@ -503,6 +503,17 @@ std::vector<OptionSpec> make_specs() {
                  "to conserve power), area (area-weighted only), exact-direct (exact direct "
                  "light at each vertex plus the area-weighted indirect light), or auto "
                  "(exact-direct on a --discontinuity mesh, else conservative)"));
+  add_row(integer("--direct-rays", 0, 1024, "",
+                  "N: the emitters' direct light drawn per pixel with N shadow rays per pixel "
+                  "sample (crisp shadows; exact where a light is all seen or all hidden) over "
+                  "the vertex field of the rest; 0 = all from the vertices; default 8 where it "
+                  "applies (not over an exact-direct field, nor with mirrors or glass, --sky or "
+                  "--sun, or more than 64 emitting faces)")
+              .read_by("Gouraud shading of a B solved over F (not --radiosity, a medium or "
+                       "--method hierarchical)",
+                       [](const Selection& s) {
+                         return s.shading == "gouraud" && !s.medium && !s.solvers.empty();
+                       }));
 
   group = "distributed";
   const std::string distributed_doc =

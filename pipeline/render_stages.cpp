@@ -9,6 +9,7 @@
 #include "core/log.hpp"
 #include "core/progress.hpp"
 #include "core/timer.hpp"
+#include "geometry/formfactors/constants.hpp"
 #include "geometry/visibility/bvh.hpp"
 #include "io/exr.hpp"
 #include "io/ply.hpp"
@@ -203,9 +204,26 @@ ShadedField shade_vertices(const LoadedScene& scene, const Eigen::MatrixX3d& B,
   return s;
 }
 
+std::string pixel_direct_obstacle(const LoadedScene& scene) {
+  if (scene.mesh.has_specular())
+    return "this scene has mirrors or glass (F carries light through them, shadow rays to the "
+           "emitters do not)";
+  if (scene.scene.daylight.any())
+    return "--sky or --sun light this scene (its sun is drawn per pixel already)";
+  const PixelDirectLight light(scene.scene, 1, 0.0);
+  return light.why();
+}
+
+void check_pixel_direct(const ShadeArgs& args, const LoadedScene& scene) {
+  if (args.direct_rays <= 0) return;
+  if (const std::string why = pixel_direct_obstacle(scene); !why.empty())
+    throw UsageError("--direct-rays does not apply: " + why + "; leave it out");
+}
+
 Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const VertexField& field,
                    const Camera& camera, const ShadeArgs& args, int specular_depth,
-                   const RunArgs& run, RenderStats* stats, const MediumView* medium) {
+                   const RunArgs& run, RenderStats* stats, const MediumView* medium,
+                   const Eigen::MatrixX3d* indirect, const std::string& interpolation) {
   const Timer timer;
   const PatchMesh& mesh = scene.mesh;
   const Bvh& bvh = scene_bvh(scene, run.threads);
@@ -239,11 +257,40 @@ Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const Ve
              format_duration(timer.seconds()));
     return img;
   }
-  Image img = render(mesh, bvh, camera, B, field, settings, stats, direct.get());
-  if (stats) stats->seconds = timer.seconds();  // including the BVH build when not yet built
+  // The emitters' direct light per pixel (pixel_direct.hpp): the field becomes E + rho I,
+  // and each front hit adds rho H_d(x) from its shadow rays. By default not over an
+  // exact-direct field (a discontinuity mesh's shadows follow its edges already).
+  const int rays = args.direct_rays >= 0             ? args.direct_rays
+                   : interpolation == "exact-direct" ? 0
+                                                     : kDefaultDirectRays;
+  std::unique_ptr<PixelDirectLight> pixel;
+  VertexField without_direct;
+  if (rays > 0 && indirect && !medium && settings.shading == Shading::Gouraud &&
+      pixel_direct_obstacle(scene).empty()) {
+    pixel = std::make_unique<PixelDirectLight>(scene.scene, rays, ff::kRayOffset * mesh.scale);
+    Eigen::MatrixX3d emitted_and_indirect(mesh.size(), 3);
+    for (std::int32_t i = 0; i < mesh.size(); ++i)
+      emitted_and_indirect.row(i) = (mesh.patches[i].emission +
+                                     mesh.patches[i].rho.cwiseProduct(indirect->row(i).transpose()))
+                                        .transpose();
+    without_direct = interpolate_to_vertices(
+        mesh, emitted_and_indirect,
+        parse_vertex_interpolation(interpolation == "exact-direct" ? "conservative"
+                                                                   : interpolation));
+    settings.pixel_direct = pixel.get();
+  }
+  Image img =
+      render(mesh, bvh, camera, B, pixel ? without_direct : field, settings, stats, direct.get());
+  if (stats) {
+    stats->seconds = timer.seconds();  // including the BVH build when not yet built
+    stats->direct_rays = pixel ? rays : 0;
+  }
   log_info("render: " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + ", " +
            std::to_string(args.antialias * args.antialias) + " samples/pixel, " +
-           shading_settings(args, specular_depth) + " in " + format_duration(timer.seconds()));
+           shading_settings(args, specular_depth) +
+           (pixel ? ", direct light per pixel (" + std::to_string(rays) + " shadow rays a sample)"
+                  : std::string()) +
+           " in " + format_duration(timer.seconds()));
   return img;
 }
 

@@ -40,7 +40,15 @@ struct ShadeArgs {
   /// auto (exact-direct on a --discontinuity mesh with F, else conservative), conservative,
   /// area or exact-direct (geometry/render/vertex_field.hpp)
   std::string vertex_interp = "auto";
+  /// --direct-rays N: shadow rays per pixel sample for the emitters' direct light, drawn per
+  /// pixel on Gouraud images (geometry/render/pixel_direct.hpp); 0 = from the vertices like
+  /// the rest; -1 = not given: kDefaultDirectRays where it applies (pixel_direct_obstacle).
+  int direct_rays = -1;
 };
+/// Shadow rays per pixel sample for the direct light when --direct-rays is not given: 32 a
+/// pixel with the default 2x2 samples (a penumbra pixel's standard error at most 1/11 of its
+/// direct light, ~1.6 s of CPU on the default Cornell image; lit and umbra pixels exact).
+constexpr int kDefaultDirectRays = 8;
 /// The shading the options ask for: --shading, else flat with --flat, raytrace with
 /// --final-gather, else Gouraud. Throws UsageError when they contradict each other.
 Shading resolve_shading(const ShadeArgs& args);
@@ -117,12 +125,26 @@ std::string resolve_vertex_interp(const ShadeArgs& args, const LoadedScene& scen
 ShadedField shade_vertices(const LoadedScene& scene, const Eigen::MatrixX3d& B,
                            const Eigen::MatrixX3d* indirect, const ShadeArgs& args, int threads);
 
+/// Why this scene's direct light cannot be drawn per pixel, empty when it can: F carries
+/// light through mirrors and glass that the shadow rays do not, --sky/--sun light is not in
+/// the indirect part, or too many emitting faces (PixelDirectLight::kMaxPieces).
+std::string pixel_direct_obstacle(const LoadedScene& scene);
+/// Refuses a --direct-rays N (N > 0) given on a scene where it cannot apply, before any work
+/// (UsageError naming the obstacle).
+void check_pixel_direct(const ShadeArgs& args, const LoadedScene& scene);
+
 /// Renders the scene through `camera` (with the run's shared BVH, scene_bvh); raytraced
 /// paths follow at most `specular_depth` specular bounces (--specular-depth). Camera rays
-/// pass through `medium` when given (render.hpp's MediumView).
+/// pass through `medium` when given (render.hpp's MediumView). With `indirect` (I = F (B -
+/// E), B solved over F), Gouraud shading draws the emitters' direct light per pixel (shadow
+/// rays, --direct-rays) over the vertex field of E + rho I, where pixel_direct_obstacle is
+/// empty and `field` is not an exact-direct field (unless --direct-rays is given);
+/// stats->direct_rays says whether it did.
 Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const VertexField& field,
                    const Camera& camera, const ShadeArgs& args, int specular_depth,
-                   const RunArgs& run, RenderStats* stats, const MediumView* medium = nullptr);
+                   const RunArgs& run, RenderStats* stats, const MediumView* medium = nullptr,
+                   const Eigen::MatrixX3d* indirect = nullptr,
+                   const std::string& interpolation = "conservative");
 
 /// The exposure (EV) to use: --exposure, or automatic from the image (from the pixels that
 /// hit the scene alone when `sky`: a sky behind it shows but does not set the exposure).

@@ -37,10 +37,18 @@ bool on_wire(const PatchMesh& mesh, const Patch& p, const Eigen::Vector3d& eye,
   return false;
 }
 
+// The direct light's sequence of one pixel (keyed by seed and pixel) and the sample's place
+// in it: the pixel's samples take consecutive runs of it (pixel_direct.hpp).
+struct PixelStream {
+  std::uint64_t stream = 0;
+  std::int64_t sample = 0;
+};
+
 Sample trace(const PatchMesh& mesh, const Bvh& bvh, const Eigen::Vector3d& eye,
              const Eigen::Vector3d& dir, const Eigen::MatrixX3d& patch_B,
              const VertexField& vertices, Shading shading, double wire_angle,
-             const ViewTracer* tracer, const Daylight* daylight, std::uint64_t stream,
+             const ViewTracer* tracer, const Daylight* daylight,
+             const PixelDirectLight* pixel_direct, PixelStream direct, std::uint64_t stream,
              std::int64_t& rays) {
   Sample s;
   ++rays;
@@ -63,6 +71,9 @@ Sample trace(const PatchMesh& mesh, const Bvh& bvh, const Eigen::Vector3d& eye,
   const Eigen::Vector3d x = eye + h.t * dir;
   s.value = shading == Shading::Flat ? Eigen::Vector3d(patch_B.row(h.patch).transpose())
                                      : field_value(mesh, vertices, h.patch, x);
+  if (pixel_direct)
+    s.value += p.rho.cwiseProduct(pixel_direct->irradiance(
+        bvh, x, p.normal, direct.stream, direct.sample * pixel_direct->rays(), rays));
   if (daylight && daylight->has_sun()) {
     if (p.normal.dot(daylight->sun_direction) < 0.0) ++rays;  // the shadow ray
     s.value += p.rho.cwiseProduct(
@@ -102,6 +113,9 @@ Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
       "render: a medium needs Gouraud or flat shading and one value per voxel");
   LAMBERT_CHECK(!options.daylight || (options.shading != Shading::Raytrace && !options.medium),
                 "render: daylight needs Gouraud or flat shading and no medium");
+  LAMBERT_CHECK(!options.pixel_direct ||
+                    (options.shading == Shading::Gouraud && !options.medium && !options.daylight),
+                "render: direct light per pixel needs Gouraud shading, no medium and no daylight");
   const bool flat = options.shading == Shading::Flat;
   const bool gathers = options.shading == Shading::Raytrace && options.view.final_gather > 0;
   LAMBERT_CHECK(flat || gathers ||
@@ -135,6 +149,8 @@ Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         int hits = 0;
         Rng rng(hash_keys(options.seed, pixel, 0x72656e646572ull));  // "render"
+        const std::uint64_t direct_stream =
+            hash_keys(options.seed, pixel, 0x646972656374ull);  // "direct"
         for (int sy = 0; sy < K; ++sy) {
           for (int sx = 0; sx < K; ++sx) {
             // Stratum centre for K = 1; jittered inside the stratum otherwise.
@@ -144,9 +160,10 @@ Image render(const PatchMesh& mesh, const Bvh& bvh, const Camera& camera,
             const double py = static_cast<double>(y) + (sy + jy) / K;
             const std::uint64_t stream =
                 hash_keys(options.seed ^ 0x76696577ull, pixel, sy * K + sx);  // "view"
-            const Sample s = trace(mesh, bvh, camera.eye, camera.ray_direction(px, py), patch_B,
-                                   vertices, options.shading, wire_angle, tracer.get(),
-                                   options.daylight, stream, row_rays[y]);
+            const Sample s =
+                trace(mesh, bvh, camera.eye, camera.ray_direction(px, py), patch_B, vertices,
+                      options.shading, wire_angle, tracer.get(), options.daylight,
+                      options.pixel_direct, {direct_stream, sy * K + sx}, stream, row_rays[y]);
             sum += options.medium ? through_medium(*options.medium, camera.eye,
                                                    camera.ray_direction(px, py), s)
                                   : s.value;

@@ -21,6 +21,7 @@
 #include "geometry/media/medium.hpp"
 #include "geometry/mesh/mesh.hpp"
 #include "geometry/render/camera.hpp"
+#include "geometry/render/pixel_direct.hpp"
 #include "geometry/render/raytrace.hpp"
 #include "geometry/render/vertex_field.hpp"
 #include "geometry/visibility/bvh.hpp"
@@ -79,12 +80,17 @@ struct RenderSettings {
   /// exact shadow ray (daylight.hpp), so `patch_B` and `vertices` must hold B without the
   /// patches' own sun part (render_scene takes it out).
   const Daylight* daylight = nullptr;
+  /// Direct light per pixel (Gouraud shading; must outlive the render): every front hit adds
+  /// ρ H_d(x) from its shadow rays (pixel_direct.hpp), so `vertices` must hold B without the
+  /// direct part, E + ρ I (render_scene builds it).
+  const PixelDirectLight* pixel_direct = nullptr;
 };
 
 /// What the render did.
 struct RenderStats {
-  std::int64_t rays = 0;  ///< every ray cast (camera, specular, gather)
+  std::int64_t rays = 0;  ///< every ray cast (camera, specular, gather, shadow)
   double seconds = 0.0;
+  int direct_rays = 0;  ///< shadow rays per sample for the direct light per pixel (0: none)
 };
 
 /// Renders the mesh as seen by `camera` (its width x height). `patch_B` is N x 3; `vertices`
