@@ -35,6 +35,7 @@
 #include "io/obj_loader.hpp"
 #include "io/tonemap.hpp"
 #include "pipeline/problem.hpp"
+#include "pipeline/render_stages.hpp"
 #include "solvers/radiosity.hpp"
 
 using namespace lambert;
@@ -172,12 +173,8 @@ int main(int argc, char** argv) {
   report("gouraud", base);
   // The emitters' direct light per pixel (pixel_direct.hpp) over the vertex field of E + rho I,
   // as `run` draws it by default.
-  Eigen::MatrixX3d rest(coarse.mesh.size(), 3);
-  for (std::int32_t i = 0; i < coarse.mesh.size(); ++i)
-    rest.row(i) = (coarse.mesh.patches[i].emission +
-                   coarse.mesh.patches[i].rho.cwiseProduct(coarse.indirect.row(i).transpose()))
-                      .transpose();
-  const VertexField rest_field = interpolate_to_vertices(coarse.mesh, rest);
+  const VertexField rest_field = emitted_and_indirect_field(coarse.mesh, coarse.indirect,
+                                                            VertexInterpolation::Conservative);
   for (int n : parse_list(direct_rays)) {
     const PixelDirectLight pixel(scene, n, 1e-6 * coarse.mesh.scale);
     RenderSettings o = base;

@@ -220,6 +220,17 @@ void check_pixel_direct(const ShadeArgs& args, const LoadedScene& scene) {
     throw UsageError("--direct-rays does not apply: " + why + "; leave it out");
 }
 
+VertexField emitted_and_indirect_field(const PatchMesh& mesh, const Eigen::MatrixX3d& indirect,
+                                       VertexInterpolation interpolation) {
+  LAMBERT_CHECK(indirect.rows() == mesh.size(), "indirect irradiance does not match the mesh");
+  Eigen::MatrixX3d values(mesh.size(), 3);
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    const Patch& p = mesh.patches[i];
+    values.row(i) = (p.emission + p.rho.cwiseProduct(indirect.row(i).transpose())).transpose();
+  }
+  return interpolate_to_vertices(mesh, values, interpolation);
+}
+
 Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const VertexField& field,
                    const Camera& camera, const ShadeArgs& args, int specular_depth,
                    const RunArgs& run, RenderStats* stats, const MediumView* medium,
@@ -268,13 +279,8 @@ Image render_scene(const LoadedScene& scene, const Eigen::MatrixX3d& B, const Ve
   if (rays > 0 && indirect && !medium && settings.shading == Shading::Gouraud &&
       pixel_direct_obstacle(scene).empty()) {
     pixel = std::make_unique<PixelDirectLight>(scene.scene, rays, ff::kRayOffset * mesh.scale);
-    Eigen::MatrixX3d emitted_and_indirect(mesh.size(), 3);
-    for (std::int32_t i = 0; i < mesh.size(); ++i)
-      emitted_and_indirect.row(i) = (mesh.patches[i].emission +
-                                     mesh.patches[i].rho.cwiseProduct(indirect->row(i).transpose()))
-                                        .transpose();
-    without_direct = interpolate_to_vertices(
-        mesh, emitted_and_indirect,
+    without_direct = emitted_and_indirect_field(
+        mesh, *indirect,
         parse_vertex_interpolation(interpolation == "exact-direct" ? "conservative"
                                                                    : interpolation));
     settings.pixel_direct = pixel.get();

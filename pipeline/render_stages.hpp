@@ -132,6 +132,10 @@ std::string pixel_direct_obstacle(const LoadedScene& scene);
 /// Refuses a --direct-rays N (N > 0) given on a scene where it cannot apply, before any work
 /// (UsageError naming the obstacle).
 void check_pixel_direct(const ShadeArgs& args, const LoadedScene& scene);
+/// The vertex field that the direct light per pixel is drawn over: E + rho I per patch (I =
+/// F (B - E), the indirect irradiance), interpolated with `interpolation`.
+VertexField emitted_and_indirect_field(const PatchMesh& mesh, const Eigen::MatrixX3d& indirect,
+                                       VertexInterpolation interpolation);
 
 /// Renders the scene through `camera` (with the run's shared BVH, scene_bvh); raytraced
 /// paths follow at most `specular_depth` specular bounces (--specular-depth). Camera rays

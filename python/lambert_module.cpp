@@ -30,6 +30,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/parallel.hpp"
+#include "geometry/formfactors/constants.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/mesh/mesh.hpp"
 #include "geometry/render/render.hpp"
@@ -51,6 +52,7 @@
 #include "pipeline/option_specs.hpp"
 #include "pipeline/problem.hpp"
 #include "pipeline/relight.hpp"
+#include "pipeline/render_stages.hpp"
 #include "pipeline/viewer_stage.hpp"
 #include "solvers/gebhart.hpp"
 #include "solvers/radiosity.hpp"
@@ -1055,7 +1057,9 @@ PYBIND11_MODULE(_lambert, m) {
          std::optional<double> fov, std::optional<int> width, std::optional<int> height,
          const std::string& shading, int antialias, std::uint64_t seed, int threads,
          const std::string& exr, const std::string& png, std::optional<double> ev,
-         std::optional<std::vector<double>> sky, std::optional<std::vector<double>> sun) {
+         std::optional<std::vector<double>> sky, std::optional<std::vector<double>> sun,
+         std::optional<IndexArray> indptr, std::optional<IndexArray> indices,
+         std::optional<ValueArray> data, std::optional<int> direct_rays) {
         Eigen::MatrixX3d b = matrix_n3(B, h.mesh.size(), "B");
         const Daylight light = daylight_from(sky, sun);
         Camera cam = default_camera(h.scene);
@@ -1085,6 +1089,30 @@ PYBIND11_MODULE(_lambert, m) {
             throw UsageError("sky and sun are drawn with gouraud or flat shading only");
           rs.daylight = &light;
         }
+        // The emitters' direct light per pixel (docs/rendering.md) needs the F that B was
+        // solved with: F is read for nothing else, so what cannot draw it refuses F.
+        const int rays = direct_rays ? *direct_rays : (indptr ? kDefaultDirectRays : 0);
+        if (rays < 0 || rays > 1024) throw UsageError("direct_rays must be in [0, 1024]");
+        if (direct_rays && *direct_rays > 0 && !indptr)
+          throw UsageError("direct_rays needs F, the form factors B was solved with");
+        if (indptr && rs.shading != Shading::Gouraud)
+          throw UsageError("F is read for the direct light per pixel, which gouraud shading draws "
+                           "only (got shading='" + shading + "')");
+        if (indptr && rays == 0)
+          throw UsageError("F is read for the direct light per pixel, and direct_rays=0 turns it "
+                           "off: leave F out");
+        std::unique_ptr<PixelDirectLight> pixel;
+        if (indptr) {
+          if (light.any() || h.mesh.has_specular())
+            throw UsageError(std::string("F is read for the direct light per pixel, which is not "
+                                         "drawn ") +
+                             (light.any() ? "under sky or sun (the sun is drawn per pixel already)"
+                                          : "in a scene with mirrors or glass"));
+          pixel = std::make_unique<PixelDirectLight>(h.scene, rays, ff::kRayOffset * h.mesh.scale);
+          if (!pixel->usable())
+            throw UsageError("the direct light per pixel cannot be drawn: " + pixel->why());
+          rs.pixel_direct = pixel.get();
+        }
         Image img;
         {
           Released release;
@@ -1093,7 +1121,14 @@ PYBIND11_MODULE(_lambert, m) {
             sources.sun = sun_patch_irradiance(h.mesh, h.get_bvh(), light, 1, threads);
             b -= sources.reflected_sun(h.mesh);
           }
-          const VertexField field = interpolate_to_vertices(h.mesh, b);
+          VertexField field;
+          if (pixel) {
+            const SparseRowMatrix F = csr_from_arrays(h.mesh.size(), *indptr, *indices, *data, "F");
+            field = emitted_and_indirect_field(h.mesh, indirect_irradiance(h.mesh, F, b),
+                                               VertexInterpolation::Conservative);
+          } else {
+            field = interpolate_to_vertices(h.mesh, b);
+          }
           img = render(h.mesh, h.get_bvh(), cam, b, field, rs);
           if (!exr.empty()) {
             ExrInfo info;
@@ -1109,5 +1144,6 @@ PYBIND11_MODULE(_lambert, m) {
       py::arg("mesh"), py::arg("B"), py::arg("eye"), py::arg("look_at"), py::arg("up"),
       py::arg("fov"), py::arg("width"), py::arg("height"), py::arg("shading"), py::arg("antialias"),
       py::arg("seed"), py::arg("threads"), py::arg("exr"), py::arg("png"), py::arg("ev"),
-      py::arg("sky"), py::arg("sun"));
+      py::arg("sky"), py::arg("sun"), py::arg("indptr"), py::arg("indices"), py::arg("data"),
+      py::arg("direct_rays"));
 }

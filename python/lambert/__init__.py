@@ -340,20 +340,26 @@ def write_vertex_exr(path, mesh, B, mode="conservative", settings=""):
 
 def render(mesh, B, eye=None, look_at=None, up=None, fov=None, width=None, height=None,
            shading="gouraud", antialias=2, seed=1, threads=0, exr=None, png=None, ev=None,
-           sky=None, sun=None):
+           sky=None, sun=None, F=None, direct_rays=None):
     """Renders B (N, 3) with the scene's camera (or the given eye/look_at/up/fov/size):
     returns the linear radiance image, float32 (height, width, 3); also writes it as an EXR
     and/or a tone-mapped PNG (exposure `ev` stops, automatic when None) when paths are given.
     With the `sky` and `sun` that B was solved with (`solve`), rays that miss the scene see
-    the sky and the sun is drawn per pixel with exact shadows (docs/scenes.md, Daylight)."""
+    the sky and the sun is drawn per pixel with exact shadows (docs/scenes.md, Daylight).
+    With `F`, the form factors B was solved with, the emitters' direct light is drawn per
+    pixel with `direct_rays` shadow rays per sample (default 8; gouraud shading only, as
+    `lambert run --direct-rays`, docs/rendering.md): crisp shadows over the vertex field of
+    the rest."""
     _check_mesh(mesh)
+    arrays = (None, None, None) if F is None else _csr_arrays(F, mesh, "F")
     vec = lambda v, name: None if v is None else [float(x) for x in _vec3(v, name)]  # noqa: E731
     return _lambert.render(mesh, B, vec(eye, "eye"), vec(look_at, "look_at"), vec(up, "up"),
                            None if fov is None else float(fov), _opt_int(width, "width"),
                            _opt_int(height, "height"), str(shading), _int(antialias, "antialias"),
                            _int(seed, "seed"), _int(threads, "threads"), str(exr or ""),
                            str(png or ""), None if ev is None else float(ev),
-                           _daylight(sky, 3, "sky"), _daylight(sun, 6, "sun"))
+                           _daylight(sky, 3, "sky"), _daylight(sun, 6, "sun"), *arrays,
+                           _opt_int(direct_rays, "direct_rays"))
 
 
 def write_glb(path, mesh, B, F=None, sky=None, sun=None, ev=None, page=None, solver="gauss-seidel",

@@ -175,6 +175,38 @@ def test_vertex_field_render_and_files(tmp_path, cornell_mesh):
     assert (tmp_path / "r.png").read_bytes()[:4] == b"\x89PNG"
 
 
+def test_render_with_F_draws_the_direct_light_per_pixel(tmp_path):
+    # The partial-shadow scene (geometry/analytic.hpp): only the floor reflects, so its
+    # indirect light is exactly 0 and, with F, every umbra pixel is exactly 0 (the shadow
+    # per pixel); from the vertices (no F) the umbra is smeared over the 0.5 patches.
+    floor = [(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)]
+    light = [(1.5, 1.5, 3), (1.5, 2.5, 3), (2.5, 2.5, 3), (2.5, 1.5, 3)]
+    blocker = [(1.6, 1.3, 1.5), (2.6, 1.3, 1.5), (2.6, 2.1, 1.5), (1.6, 2.1, 1.5)]
+    path = write_obj(tmp_path / "ps.obj", {"floor": [floor], "light": [light], "blocker": [blocker]},
+                     {"floor": ((0.5,) * 3, (0,) * 3), "light": ((0,) * 3, (1,) * 3),
+                      "blocker": ((0,) * 3, (0,) * 3)})
+    mesh = lambert.load_scene(path).mesh(max_edge=0.5)
+    F = lambert.form_factors(mesh, estimator="hybrid", samples=4)
+    B, _ = lambert.solve(mesh, F)
+    view = dict(eye=(2, -2, 2.4), look_at=(2, 2, 0), up=(0, 0, 1), fov=60, width=48, height=48,
+                antialias=1)
+    per_pixel = lambert.render(mesh, B, F=F, threads=1, **view)
+    assert np.array_equal(per_pixel, lambert.render(mesh, B, F=F, threads=2, **view))
+    from_vertices = lambert.render(mesh, B, **view)
+    zeros = lambda img: int((img[..., 1] == 0).sum())  # noqa: E731 (misses, black faces, umbra)
+    assert zeros(per_pixel) > zeros(from_vertices) + 20
+    assert per_pixel.max() > 0
+    # What cannot draw it refuses F or direct_rays, never ignores them.
+    with pytest.raises(lambert.UsageError, match="gouraud"):
+        lambert.render(mesh, B, F=F, shading="flat", **view)
+    with pytest.raises(lambert.UsageError, match="needs F"):
+        lambert.render(mesh, B, direct_rays=4, **view)
+    with pytest.raises(lambert.UsageError, match="leave F out"):
+        lambert.render(mesh, B, F=F, direct_rays=0, **view)
+    with pytest.raises(lambert.UsageError, match="direct_rays"):
+        lambert.render(mesh, B, F=F, direct_rays=-1, **view)
+
+
 def test_bad_files_raise_input_error_naming_the_file(tmp_path, cornell_mesh):
     missing = tmp_path / "missing.obj"
     with pytest.raises(lambert.InputError, match="missing.obj"):
