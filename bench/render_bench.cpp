@@ -173,8 +173,8 @@ int main(int argc, char** argv) {
   report("gouraud", base);
   // The emitters' direct light per pixel (pixel_direct.hpp) over the vertex field of E + rho I,
   // as `run` draws it by default.
-  const VertexField rest_field = emitted_and_indirect_field(coarse.mesh, coarse.indirect,
-                                                            VertexInterpolation::Conservative);
+  const VertexField rest_field =
+      emitted_and_indirect_field(coarse.mesh, coarse.indirect, VertexInterpolation::Conservative);
   for (int n : parse_list(direct_rays)) {
     const PixelDirectLight pixel(scene, n, 1e-6 * coarse.mesh.scale);
     RenderSettings o = base;

@@ -1096,11 +1096,14 @@ PYBIND11_MODULE(_lambert, m) {
         if (direct_rays && *direct_rays > 0 && !indptr)
           throw UsageError("direct_rays needs F, the form factors B was solved with");
         if (indptr && rs.shading != Shading::Gouraud)
-          throw UsageError("F is read for the direct light per pixel, which gouraud shading draws "
-                           "only (got shading='" + shading + "')");
+          throw UsageError(
+              "F is read for the direct light per pixel, which gouraud shading draws "
+              "only (got shading='" +
+              shading + "')");
         if (indptr && rays == 0)
-          throw UsageError("F is read for the direct light per pixel, and direct_rays=0 turns it "
-                           "off: leave F out");
+          throw UsageError(
+              "F is read for the direct light per pixel, and direct_rays=0 turns it "
+              "off: leave F out");
         std::unique_ptr<PixelDirectLight> pixel;
         if (indptr) {
           if (light.any() || h.mesh.has_specular())
