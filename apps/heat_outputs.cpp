@@ -110,7 +110,7 @@ std::string heat_page_path(const HeatImageArgs& args) {
 void check_heat_output_options(const HeatImageArgs& args, const OptionGiven& given) {
   if (!given) return;
   const bool camera_read = !args.image.empty() || !args.glb.empty();
-  for (const char* name : {"--eye", "--look-at", "--up", "--fov", "--size"})
+  for (const char* name : {"--eye", "--look-at", "--up", "--fov", "--size", "--view"})
     if (given(name) && !camera_read)
       throw UsageError(std::string(name) +
                        " does not apply to heat without --image or --glb (it sets their camera)");

@@ -174,6 +174,7 @@ void add_camera_options(CLI::App* cmd, CameraArgs& args) {
   add_declared(cmd, "--up", args.up);
   add_declared(cmd, "--fov", args.fov);
   add_declared(cmd, "--size", args.size);
+  add_declared(cmd, "--view", args.view);
 }
 
 void add_shade_options(CLI::App* cmd, ShadeArgs& args) {

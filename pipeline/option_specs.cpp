@@ -481,6 +481,10 @@ std::vector<OptionSpec> make_specs() {
   add_row(real("--up", -kInf, kInf, "", "Camera up vector X Y Z").values(3));
   add_row(real("--fov", 0.1, 179.0, "", "Vertical field of view, degrees"));
   add_row(text("--size", "WxH", nullptr, "", "Image size WxH in pixels (default 512x512)"));
+  add_row(choice("--view", {"front", "three-quarter", "top"}, "",
+                 "Frame the whole scene from the front (level), a three-quarter view (35 deg "
+                 "round, 30 deg above) or straight above, about its up axis (y; z for STL), "
+                 "instead of its camera; --eye, --look-at, --up and --fov still apply"));
 
   group = "shading";
   add_row(choice("--shading", {"gouraud", "flat", "raytrace"}, "",

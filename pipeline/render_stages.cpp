@@ -30,6 +30,14 @@ Camera make_camera(const Scene& scene, const CameraArgs& args) {
     const auto [lo, hi] = scene.bounds();
     cam = framing_camera(lo, hi);
   }
+  if (!args.view.empty()) {  // about the scene's up axis: z when its camera has z up, else y
+    const auto [lo, hi] = scene.bounds();
+    const int up = std::abs(cam.up.z()) > std::abs(cam.up.y()) ? 2 : 1;
+    const int width = cam.width, height = cam.height;
+    cam = view_camera(lo, hi, up, args.view);
+    cam.width = width;
+    cam.height = height;
+  }
   if (!args.eye.empty()) cam.eye = vec3(args.eye);
   if (!args.look_at.empty()) cam.look_at = vec3(args.look_at);
   if (!args.up.empty()) cam.up = vec3(args.up);

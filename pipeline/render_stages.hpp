@@ -24,6 +24,9 @@ struct CameraArgs {
   std::vector<double> eye, look_at, up;  ///< 3 values each, or empty
   double fov = 0.0;                      ///< vertical field of view in degrees; 0 = the scene's
   std::string size;                      ///< "WxH"; empty = the scene camera's
+  /// --view front|three-quarter|top: the scene's bounding box framed so instead of the
+  /// scene's camera (view_camera); empty = the scene's camera.
+  std::string view;
 };
 /// The scene's camera (or one framing the scene) with the overrides applied.
 /// Throws UsageError for a malformed --size or a degenerate view.

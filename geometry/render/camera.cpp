@@ -3,6 +3,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "core/error.hpp"
+
 namespace lambert {
 
 Eigen::Vector3d Camera::ray_direction(double px, double py) const {
@@ -47,20 +49,41 @@ Camera framing_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   return c;
 }
 
-Camera three_quarter_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up) {
+namespace {
+
+// The box framed from azimuth and elevation (degrees) about the `up` axis, from its front.
+Camera orbit_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up,
+                    double azimuth_degrees, double elevation_degrees) {
   Camera c = framing_camera(lo, hi);
   const Eigen::Vector3d center = 0.5 * (lo + hi);
   const double dist = (c.eye - center).norm();
   const Eigen::Vector3d u = up == 2 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();
   const Eigen::Vector3d front = up == 2 ? -Eigen::Vector3d::UnitY() : -Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d side = u.cross(front);  // front rotated 90° about u
-  const double azimuth = 35.0 * M_PI / 180.0, elevation = 30.0 * M_PI / 180.0;
+  const double azimuth = azimuth_degrees * M_PI / 180.0;
+  const double elevation = elevation_degrees * M_PI / 180.0;
   const Eigen::Vector3d dir =
       std::cos(elevation) * (std::cos(azimuth) * front + std::sin(azimuth) * side) +
       std::sin(elevation) * u;
   c.eye = center + dist * dir;
-  c.up = u;
+  // From straight above the up axis is the view direction: the picture's up is then the
+  // back of the scene (its front at the bottom).
+  c.up = elevation_degrees >= 90.0 ? Eigen::Vector3d(-front) : u;
   return c;
+}
+
+}  // namespace
+
+Camera three_quarter_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up) {
+  return orbit_camera(lo, hi, up, 35.0, 30.0);
+}
+
+Camera view_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up,
+                   const std::string& view) {
+  if (view == "front") return orbit_camera(lo, hi, up, 0.0, 0.0);
+  if (view == "top") return orbit_camera(lo, hi, up, 0.0, 90.0);
+  LAMBERT_CHECK(view == "three-quarter", "view_camera: unknown view " + view);
+  return three_quarter_camera(lo, hi, up);
 }
 
 }  // namespace lambert

@@ -40,4 +40,10 @@ Camera framing_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 /// a y-up scene (OBJ's convention) and -y for a z-up one (STL's, CAD's).
 Camera three_quarter_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up);
 
+/// The named views of a bounding box (--view): front (from the front, level), three-quarter
+/// (three_quarter_camera) or top (from straight above, the front at the bottom of the
+/// picture). `up` as for three_quarter_camera. Throws nothing; an unknown name is a check.
+Camera view_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up,
+                   const std::string& view);
+
 }  // namespace lambert

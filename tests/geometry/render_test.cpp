@@ -248,4 +248,40 @@ TEST(Camera, TheDefaultViewIsAThreeQuarterViewThatFramesTheWholeBox) {
   }
 }
 
+TEST(Camera, TheNamedViewsFrameTheWholeBoxFromTheirSides) {
+  // --view: front (level, from the front: -z for y up, -y for z up), top (straight down, the
+  // front at the picture's bottom) and three-quarter (sin 30° down); each a valid camera with
+  // every corner of the box inside the frame.
+  const Eigen::Vector3d lo(-5, -1, -3), hi(5, 2, 4);
+  for (int up : {1, 2}) {
+    const Eigen::Vector3d u = up == 2 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();
+    const Eigen::Vector3d front = up == 2 ? -Eigen::Vector3d::UnitY() : -Eigen::Vector3d::UnitZ();
+    for (const std::string view : {"front", "top", "three-quarter"}) {
+      const Camera c = view_camera(lo, hi, up, view);
+      EXPECT_EQ(camera_problem(c), "") << view;
+      const Eigen::Vector3d forward = (c.look_at - c.eye).normalized();
+      if (view == "front") {
+        EXPECT_NEAR(forward.dot(-front), 1.0, 1e-12);
+        EXPECT_EQ(c.up, u);
+      } else if (view == "top") {
+        EXPECT_NEAR(forward.dot(-u), 1.0, 1e-12);
+        EXPECT_EQ(c.up, -front);  // the front at the bottom of the picture
+      } else {
+        EXPECT_NEAR(-forward.dot(u), 0.5, 1e-12);
+      }
+      const Eigen::Vector3d right = forward.cross(c.up).normalized(), top = right.cross(forward);
+      const double half = std::tan(0.5 * c.vfov_degrees * M_PI / 180.0);
+      for (int k = 0; k < 8; ++k) {
+        const Eigen::Vector3d p(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(),
+                                k & 4 ? hi.z() : lo.z());
+        const Eigen::Vector3d d = p - c.eye;
+        const double depth = d.dot(forward);
+        ASSERT_GT(depth, 0.0) << view;
+        EXPECT_LT(std::abs(d.dot(right)) / depth, half) << view << k;
+        EXPECT_LT(std::abs(d.dot(top)) / depth, half) << view << k;
+      }
+    }
+  }
+}
+
 }  // namespace lambert
