@@ -104,6 +104,7 @@ int run_solve_matrix(const SolveCommandOptions& opts) {
     warn_about_lighting(loaded.mesh, ff.F);
     check_closed_lossless(loaded.mesh, ff);
     sol = solve_radiosity(problem, so);
+    warn_about_non_reciprocity(sol, ff.options);
   }
   if (!medium) nonzeros = ff.F.nonZeros();
   MatrixSolveResult result;

@@ -156,7 +156,31 @@ void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOpti
   if (r.solution.status != SolveStatus::Converged)
     log_warn("the solver did not converge (" + std::string(to_string(r.solution.status)) +
              "); results are written anyway");
+  warn_about_non_reciprocity(r.solution, F.options);
   if (bases) add_bases(scene, problem, so, r);
+}
+
+void warn_about_non_reciprocity(const RadiositySolution& solution, const FormFactorOptions& ff) {
+  double worst = 0.0;
+  int channel = 0;
+  for (int c = 0; c < 3; ++c) {
+    const EnergyBalance& e = solution.energy[c];
+    const double part = e.emitted > 0.0 ? std::abs(e.non_reciprocity_part) / e.emitted : 0.0;
+    if (part > worst) {
+      worst = part;
+      channel = c;
+    }
+  }
+  if (!(worst > kNonReciprocityWarning)) return;
+  char line[400];
+  std::snprintf(line, sizeof line,
+                "F is not reciprocal (A_i F_ij != A_j F_ji): the energy balance misses %.2g of "
+                "the emitted power (%s) through it, estimator %s with reciprocity %s%s",
+                worst, channel_name(channel), ff.estimator.c_str(), ff.reciprocity.c_str(),
+                ff.reciprocity == "none"
+                    ? "; --reciprocity average balances it (or --estimator hybrid)"
+                    : "");
+  log_warn(line);
 }
 
 void solve_bases(const LoadedScene& scene, const FormFactors& F, const SolveOptions& solver,

@@ -99,6 +99,16 @@ struct RadiosityResult {
 void solve_scene(const LoadedScene& scene, const FormFactors& F, const SolveOptions& solver,
                  const RunArgs& run, RadiosityResult& r, bool bases = false);
 
+/// Above this share of the emitted power, the energy that F's non-reciprocity loses or makes
+/// is a warning: an averaged or symmetric estimator stays at rounding (1e-15), the hemicube on
+/// the Cornell box at 8.7e-4 (its aliasing, documented), while the hemicube on slivers or on
+/// faces lying on others is off by 2e-2 to 0.36 (the heat sink, the atrium's plaques).
+constexpr double kNonReciprocityWarning = 5e-3;
+/// Warns (one line) when F's non-reciprocity part of the energy balance exceeds
+/// kNonReciprocityWarning of the emitted power in some channel, naming the estimator and the
+/// remedy.
+void warn_about_non_reciprocity(const RadiositySolution& solution, const FormFactorOptions& ff);
+
 /// The per-emitter bases of a solved `r` over F (r.bases, r.bases_seconds; relight.hpp), with
 /// the solver options B was solved with.
 void solve_bases(const LoadedScene& scene, const FormFactors& F, const SolveOptions& solver,
