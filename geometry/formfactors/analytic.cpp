@@ -1,7 +1,7 @@
 #include "geometry/formfactors/analytic.hpp"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
-#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -17,17 +17,27 @@
 namespace lambert::ff {
 namespace {
 
-using K = CGAL::Exact_predicates_exact_constructions_kernel;
-using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, CGAL::Default,
-                                                       CGAL::Exact_intersections_tag>;
+// The partition's cells need not follow the event lines to the last bit (the integrand is
+// only smooth on either side of them, and a cell corner rounded off its line by ~1e-16 of
+// the receiver's size moves a sliver of that width to the neighbouring pattern, which the
+// verification at the inset corners does not see and the quadrature does not notice): so
+// exact predicates with constraint crossings rounded to double, which costs a tenth of the
+// exact (GMP rational) crossings.
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using CDT =
+    CGAL::Constrained_Delaunay_triangulation_2<K, CGAL::Default, CGAL::Exact_predicates_tag>;
 using Point2 = K::Point_2;
 
 // Gauss-Legendre orders per direction of a triangle's two rules (the value is the low one's,
-// the estimate their difference). On an analytic integrand the order-8 rule's error is
-// about (h/2d)^6 times the order-5 rule's, so the difference is the order-5 error to a few
-// per cent for cells up to the size of their distance to b, which refinement ensures.
-constexpr int kLowOrder = 5;
-constexpr int kHighOrder = 8;
+// the estimate their difference). On an analytic integrand the order-6 rule's error is
+// about (h/2d)^4 times the order-4 rule's, so the difference is the order-4 error to a few
+// per cent for cells well below the size of their distance to b, which the event cells of
+// an obstructed pair are and refinement ensures. 4/6 (52 points) rather than 5/8 (89): a
+// room's pairs meet --ff-tol 1e-4..1e-6 in their initial cells, so the rule's cost per cell
+// is the cost; 3/5 fell outside ErrorEstimateIsCalibrated's 5 % (estimates > 10x the error
+// at 1e-9, where the order-5 rule's own error is not negligible).
+constexpr int kLowOrder = 4;
+constexpr int kHighOrder = 6;
 // Rounding floor of a pair's error estimate, relative to G: the contour formula and the
 // visible pieces' rounded corners are good to ~1e-15 relative per point, and a sum of cells
 // cannot be trusted below ~10x that (so --tol below it is met at the floor, not chased).
@@ -698,7 +708,7 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
       Cell cell;
       for (int k = 0; k < 3; ++k) {
         const Point2& q = fh->vertex(k)->point();
-        cell.p[k] = f.fa.to3d({CGAL::to_double(q.x()), CGAL::to_double(q.y())});
+        cell.p[k] = f.fa.to3d({q.x(), q.y()});
       }
       if ((cell.p[1] - cell.p[0]).cross(cell.p[2] - cell.p[0]).dot(f.fa.w) <= 0.0) continue;
       cells.push_back(cell);

@@ -31,7 +31,8 @@
 // calibrated, not merely an upper bound). The triangle with the largest estimate is split
 // into four until the estimates sum to at most the tolerance, or an evaluation budget is
 // spent (then `converged` is false). Cost: O(k² log k) event segments for k blockers, a
-// CDT of them, then about 100 point factors per triangle. Thread-safe (no shared state).
+// CDT of them, then about 50 point factors per triangle (orders 4 and 6). Thread-safe (no
+// shared state).
 
 #include <cstdint>
 #include <vector>
