@@ -98,6 +98,10 @@ struct Features {
   Polygon3 emitter;                      // b in front of a's plane
   std::vector<Eigen::Vector2d> emitter2;  // its corners in fb
   std::vector<Polygon3> pieces;          // blockers in front of both planes
+  // Per piece, the plane (n, d) of a face of a closed convex solid, its solid on the side
+  // n . y + d < 0: from a point on that side the face is a back face and hides nothing the
+  // solid's front faces do not (solid_back_planes); zero for any other piece.
+  std::vector<Eigen::Vector4d> back;
   std::vector<Eigen::Vector3d> corners;  // the pieces' distinct corners
   std::vector<std::array<int, 2>> edges;  // the pieces' distinct edges (corner indices)
   std::vector<std::vector<int>> piece_lines;  // per piece, the line of each of its edges
@@ -269,6 +273,7 @@ bool visible_pieces(const Features& f, const Eigen::Vector3d& x, std::vector<Pie
   const double sliver = kSliverArea * f.scale * f.scale;
   out.assign(1, emitter);
   for (size_t p = 0; p < f.pieces.size() && !out.empty(); ++p) {
+    if (f.back[p].head<3>().dot(x) + f.back[p].w() < 0.0) continue;  // a back face of a solid
     const auto sides = cone_sides(f, f.pieces[p], f.piece_lines[p], x);
     if (sides.empty()) continue;
     // The cheapest test: a cone that misses the whole emitter (all of it outside one side)
@@ -628,6 +633,137 @@ bool outside_shaft(const Polygon3& piece, const std::vector<Eigen::Vector4d>& pl
   return false;
 }
 
+// The back planes (Features::back) of the pieces that are faces of closed convex solids,
+// seen from the receiver a towards the emitter b. A convex solid hides from x exactly what
+// its faces turned towards x hide: a segment from x (outside it) to any point behind it
+// enters it through a face with x on that face's outer side. So from x the faces with x on
+// their inner side can be skipped (a box seen from a point: 2 or 3 of its 5 faces), and a
+// face with all of a on its inner side can be dropped from the pair (fewer events, fewer
+// cells). A solid is a set of pieces connected by shared edges (exactly equal corners),
+// each edge in at most two of them, with every corner of the set on one side of each
+// piece's plane (within eps; some corner clear of it: not flat), and the edges in only one
+// piece (its open "cap": a box standing on a floor has no bottom face) all in one plane
+// with both polygons on the solid's side of it (a segment between them then cannot pass
+// through the cap) and a not in it (from a point on the cap the solid may hide everything,
+// not only what its front faces hide). a must lie outside the solid. Anything else gets
+// zero planes (no piece skipped).
+std::vector<Eigen::Vector4d> solid_back_planes(const std::vector<Polygon3>& pieces,
+                                               const Polygon3& a, const Polygon3& b, double eps) {
+  const int n = static_cast<int>(pieces.size());
+  std::vector<Eigen::Vector4d> back(n, Eigen::Vector4d::Zero());
+  // Edges keyed by their corners (ordered), with the piece using them.
+  using Key = std::array<double, 6>;
+  std::vector<std::pair<Key, int>> edges;
+  for (int p = 0; p < n; ++p)
+    for (size_t k = 0; k < pieces[p].size(); ++k) {
+      Eigen::Vector3d u = pieces[p][k], v = pieces[p][(k + 1) % pieces[p].size()];
+      if (std::lexicographical_compare(v.data(), v.data() + 3, u.data(), u.data() + 3))
+        std::swap(u, v);
+      edges.push_back({{u.x(), u.y(), u.z(), v.x(), v.y(), v.z()}, p});
+    }
+  std::sort(edges.begin(), edges.end());
+  std::vector<int> root(n);
+  for (int p = 0; p < n; ++p) root[p] = p;
+  auto find = [&](int p) {
+    while (root[p] != p) p = root[p] = root[root[p]];
+    return p;
+  };
+  std::vector<char> bad(n, 0);                       // by root, after the union
+  std::vector<std::array<Eigen::Vector3d, 2>> open;  // edges in one piece
+  std::vector<int> open_piece;
+  for (size_t e = 0; e < edges.size();) {
+    size_t end = e;
+    while (end < edges.size() && edges[end].first == edges[e].first) ++end;
+    for (size_t k = e + 1; k < end; ++k) root[find(edges[k].second)] = find(edges[e].second);
+    if (end - e > 2) bad[edges[e].second] = 1;  // marked on a piece, moved to its root below
+    if (end - e == 1) {
+      const Key& q = edges[e].first;
+      open.push_back({Eigen::Vector3d(q[0], q[1], q[2]), Eigen::Vector3d(q[3], q[4], q[5])});
+      open_piece.push_back(edges[e].second);
+    }
+    e = end;
+  }
+  for (int p = 0; p < n; ++p)
+    if (bad[p]) bad[find(p)] = 1;
+  for (int r = 0; r < n; ++r) {
+    if (find(r) != r || bad[r]) continue;
+    std::vector<int> members;
+    std::vector<Eigen::Vector3d> corners;
+    for (int p = 0; p < n; ++p)
+      if (find(p) == r) {
+        members.push_back(p);
+        corners.insert(corners.end(), pieces[p].begin(), pieces[p].end());
+      }
+    if (members.size() < 2) continue;
+    // Each piece's plane, oriented with the solid inside (negative); convex and not flat.
+    std::vector<Eigen::Vector4d> planes;
+    bool ok = true, thick = false;
+    for (const int p : members) {
+      const Eigen::Vector3d m = newell_normal(pieces[p]).normalized();
+      const double d = -m.dot(pieces[p][0]);
+      double lo = INFINITY, hi = -INFINITY;
+      for (const auto& c : corners) {
+        lo = std::min(lo, m.dot(c) + d);
+        hi = std::max(hi, m.dot(c) + d);
+      }
+      for (const auto& c : pieces[p]) ok = ok && std::abs(m.dot(c) + d) <= eps;
+      if (hi <= eps)
+        planes.push_back({m.x(), m.y(), m.z(), d});
+      else if (lo >= -eps)
+        planes.push_back({-m.x(), -m.y(), -m.z(), -d});
+      else
+        ok = false;
+      thick = thick || std::max(hi, -lo) > 10.0 * eps;
+    }
+    if (!ok || !thick) continue;
+    // The open edges: all in one plane (the cap), the solid, a and b on one side, a off it.
+    std::vector<Eigen::Vector3d> rim;
+    for (size_t k = 0; k < open.size(); ++k)
+      if (find(open_piece[k]) == r) rim.insert(rim.end(), {open[k][0], open[k][1]});
+    bool outside = false;  // a's centroid outside the solid
+    Eigen::Vector3d ca = Eigen::Vector3d::Zero();
+    for (const auto& c : a) ca += c / static_cast<double>(a.size());
+    for (const auto& pl : planes) outside = outside || pl.head<3>().dot(ca) + pl.w() > eps;
+    if (!rim.empty()) {
+      // The cap's plane through three rim corners far apart.
+      const Eigen::Vector3d& p0 = rim[0];
+      Eigen::Vector3d p1 = p0, normal = Eigen::Vector3d::Zero();
+      for (const auto& c : rim)
+        if ((c - p0).norm() > (p1 - p0).norm()) p1 = c;
+      for (const auto& c : rim) {
+        const Eigen::Vector3d m = (p1 - p0).cross(c - p0);
+        if (m.norm() > normal.norm()) normal = m;
+      }
+      if (!(normal.norm() > eps * (p1 - p0).norm())) continue;
+      normal.normalize();
+      double lo = INFINITY, hi = -INFINITY;
+      for (const auto& c : corners) {
+        lo = std::min(lo, normal.dot(c - p0));
+        hi = std::max(hi, normal.dot(c - p0));
+      }
+      if (hi < -lo) {  // the solid on the other side: turn the normal towards it
+        normal = -normal;
+        const double t = lo;
+        lo = -hi;
+        hi = -t;
+      }
+      bool cap = lo >= -eps && hi > 10.0 * eps;
+      for (const auto& c : rim) cap = cap && std::abs(normal.dot(c - p0)) <= eps;
+      double a_high = -INFINITY;
+      for (const auto& c : a) {
+        cap = cap && normal.dot(c - p0) >= -eps;
+        a_high = std::max(a_high, normal.dot(c - p0));
+      }
+      for (const auto& c : b) cap = cap && normal.dot(c - p0) >= -eps;
+      if (!cap || !(a_high > eps)) continue;
+      outside = outside || normal.dot(ca - p0) < -eps;
+    }
+    if (!outside) continue;
+    for (size_t k = 0; k < members.size(); ++k) back[members[k]] = planes[k];
+  }
+  return back;
+}
+
 }  // namespace
 
 AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
@@ -667,6 +803,21 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
       if (outside_shaft(piece, shaft, plane_eps)) continue;
       f.pieces.push_back(std::move(piece));
     }
+  }
+  // Faces of closed convex solids: those turned away from all of a hide nothing.
+  f.back = solid_back_planes(f.pieces, receiver, f.emitter, plane_eps);
+  {
+    size_t kept = 0;
+    for (size_t p = 0; p < f.pieces.size(); ++p) {
+      bool away = f.back[p] != Eigen::Vector4d::Zero();
+      for (const auto& c : receiver)
+        away = away && f.back[p].head<3>().dot(c) + f.back[p].w() <= 0.0;
+      if (away) continue;
+      if (kept != p) f.pieces[kept] = std::move(f.pieces[p]);  // (a self-move empties it)
+      f.back[kept++] = f.back[p];
+    }
+    f.pieces.resize(kept);
+    f.back.resize(kept);
   }
   auto corner_index = [&](const Eigen::Vector3d& p) {
     for (size_t k = 0; k < f.corners.size(); ++k)
