@@ -102,6 +102,13 @@ struct Features {
   // n . y + d < 0: from a point on that side the face is a back face and hides nothing the
   // solid's front faces do not (solid_back_planes); zero for any other piece.
   std::vector<Eigen::Vector4d> back;
+  // The solids: per piece its solid (-1: none), per solid its pieces and their corners, and
+  // per piece and edge the piece of its solid across that edge (-1: none, or one dropped as
+  // turned away from all of a: either way not a front face).
+  std::vector<int> solid;
+  std::vector<std::vector<int>> solids;
+  std::vector<std::vector<Eigen::Vector3d>> solid_corners;
+  std::vector<std::vector<int>> neighbour;
   std::vector<Eigen::Vector3d> corners;  // the pieces' distinct corners
   std::vector<std::array<int, 2>> edges;  // the pieces' distinct edges (corner indices)
   std::vector<std::vector<int>> piece_lines;  // per piece, the line of each of its edges
@@ -263,6 +270,35 @@ ConeSides cone_sides(const Features& f, const Polygon3& piece, const std::vector
   return sides;
 }
 
+// The half-planes of the cone from x over closed convex solid s: the planes through x and
+// its silhouette edges (between a face turned towards x and one turned away, or on the
+// open cap, which is turned away from every point of a); empty when x sees it edge-on. One
+// convex cone per solid instead of one per front face: fewer cuts of the visible pieces,
+// and a pattern that changes only where the silhouette does (where a face's plane meets
+// a's plane: an event line).
+ConeSides silhouette_sides(const Features& f, int s, const Eigen::Vector3d& x) {
+  const std::vector<int>& members = f.solids[s];
+  auto front = [&](int p) { return f.back[p].head<3>().dot(x) + f.back[p].w() > 0.0; };
+  ConeSides sides;
+  for (const int p : members) {
+    if (!front(p)) continue;
+    const Polygon3& piece = f.pieces[p];
+    for (size_t k = 0; k < piece.size(); ++k) {
+      const int nb = f.neighbour[p][k];
+      if (nb >= 0 && front(nb)) continue;  // between two front faces: inside the silhouette
+      const Eigen::Vector3d m = (piece[k] - x).cross(piece[(k + 1) % piece.size()] - x);
+      double far = 0.0;  // the solid's corner farthest from the edge's plane through x
+      for (const auto& c : f.solid_corners[s])
+        if (std::abs(m.dot(c - x)) > std::abs(far)) far = m.dot(c - x);
+      if (!(std::abs(far) > 1e-12 * m.norm() * f.scale)) return {};  // edge-on
+      const double sign = far > 0.0 ? 1.0 : -1.0;
+      sides.push_back(
+          {sign * Line(m.dot(f.fb.u), m.dot(f.fb.v), m.dot(f.fb.o - x)), f.piece_lines[p][k]});
+    }
+  }
+  return sides;
+}
+
 // The visible pieces of the emitter at x (`next` is scratch); false when there are too many.
 bool visible_pieces(const Features& f, const Eigen::Vector3d& x, std::vector<Piece>& out,
                     std::vector<Piece>& next) {
@@ -273,8 +309,10 @@ bool visible_pieces(const Features& f, const Eigen::Vector3d& x, std::vector<Pie
   const double sliver = kSliverArea * f.scale * f.scale;
   out.assign(1, emitter);
   for (size_t p = 0; p < f.pieces.size() && !out.empty(); ++p) {
-    if (f.back[p].head<3>().dot(x) + f.back[p].w() < 0.0) continue;  // a back face of a solid
-    const auto sides = cone_sides(f, f.pieces[p], f.piece_lines[p], x);
+    const int s = f.solid[p];
+    if (s >= 0 && f.solids[s][0] != static_cast<int>(p)) continue;  // its solid's done
+    const auto sides =
+        s >= 0 ? silhouette_sides(f, s, x) : cone_sides(f, f.pieces[p], f.piece_lines[p], x);
     if (sides.empty()) continue;
     // The cheapest test: a cone that misses the whole emitter (all of it outside one side)
     // changes no piece.
@@ -648,9 +686,11 @@ bool outside_shaft(const Polygon3& piece, const std::vector<Eigen::Vector4d>& pl
 // not only what its front faces hide). a must lie outside the solid. Anything else gets
 // zero planes (no piece skipped).
 std::vector<Eigen::Vector4d> solid_back_planes(const std::vector<Polygon3>& pieces,
-                                               const Polygon3& a, const Polygon3& b, double eps) {
+                                               const Polygon3& a, const Polygon3& b, double eps,
+                                               std::vector<int>& solid) {
   const int n = static_cast<int>(pieces.size());
   std::vector<Eigen::Vector4d> back(n, Eigen::Vector4d::Zero());
+  solid.assign(n, -1);
   // Edges keyed by their corners (ordered), with the piece using them.
   using Key = std::array<double, 6>;
   std::vector<std::pair<Key, int>> edges;
@@ -759,7 +799,10 @@ std::vector<Eigen::Vector4d> solid_back_planes(const std::vector<Polygon3>& piec
       outside = outside || normal.dot(ca - p0) < -eps;
     }
     if (!outside) continue;
-    for (size_t k = 0; k < members.size(); ++k) back[members[k]] = planes[k];
+    for (size_t k = 0; k < members.size(); ++k) {
+      back[members[k]] = planes[k];
+      solid[members[k]] = r;
+    }
   }
   return back;
 }
@@ -805,19 +848,22 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
     }
   }
   // Faces of closed convex solids: those turned away from all of a hide nothing.
-  f.back = solid_back_planes(f.pieces, receiver, f.emitter, plane_eps);
+  std::vector<int> solid_root;
+  f.back = solid_back_planes(f.pieces, receiver, f.emitter, plane_eps, solid_root);
   {
     size_t kept = 0;
     for (size_t p = 0; p < f.pieces.size(); ++p) {
-      bool away = f.back[p] != Eigen::Vector4d::Zero();
+      bool away = solid_root[p] >= 0;
       for (const auto& c : receiver)
         away = away && f.back[p].head<3>().dot(c) + f.back[p].w() <= 0.0;
       if (away) continue;
       if (kept != p) f.pieces[kept] = std::move(f.pieces[p]);  // (a self-move empties it)
-      f.back[kept++] = f.back[p];
+      f.back[kept] = f.back[p];
+      solid_root[kept++] = solid_root[p];
     }
     f.pieces.resize(kept);
     f.back.resize(kept);
+    solid_root.resize(kept);
   }
   auto corner_index = [&](const Eigen::Vector3d& p) {
     for (size_t k = 0; k < f.corners.size(); ++k)
@@ -834,6 +880,31 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
       if (it == f.edges.end()) it = f.edges.insert(f.edges.end(), {i, j});
       lines.push_back(static_cast<int>(f.emitter2.size() + (it - f.edges.begin())));
     }
+  }
+  // The solids, numbered in the order of their first piece, and their pieces' neighbours.
+  f.solid.assign(f.pieces.size(), -1);
+  f.neighbour.resize(f.pieces.size());
+  for (size_t p = 0; p < f.pieces.size(); ++p) {
+    if (solid_root[p] < 0) continue;
+    for (size_t q = 0; q < p && f.solid[p] < 0; ++q)
+      if (solid_root[q] == solid_root[p]) f.solid[p] = f.solid[q];
+    if (f.solid[p] < 0) {
+      f.solid[p] = static_cast<int>(f.solids.size());
+      f.solids.emplace_back();
+      f.solid_corners.emplace_back();
+    }
+    f.solids[f.solid[p]].push_back(static_cast<int>(p));
+    auto& corners = f.solid_corners[f.solid[p]];
+    corners.insert(corners.end(), f.pieces[p].begin(), f.pieces[p].end());
+  }
+  for (size_t p = 0; p < f.pieces.size(); ++p) {
+    f.neighbour[p].assign(f.piece_lines[p].size(), -1);
+    if (f.solid[p] < 0) continue;
+    for (size_t k = 0; k < f.piece_lines[p].size(); ++k)
+      for (const int q : f.solids[f.solid[p]])
+        if (q != static_cast<int>(p) &&
+            std::count(f.piece_lines[q].begin(), f.piece_lines[q].end(), f.piece_lines[p][k]))
+          f.neighbour[p][k] = q;
   }
 
   // The partition of the receiver: its fan, or its CDT with the event segments.

@@ -197,9 +197,9 @@ TEST(AnalyticPair, SquareInAnOpenBoxWithAnOffsetPlateClosesToTheEscapeReference)
 
 // The faces of a box [x0, x1] x [y0, y1] x [z0, z1] (any winding: blockers block from both
 // sides), with its bottom face or not (a box standing on a floor has none). With `halves`
-// each side face is given as two halves, one above the other: the same surface, but its
-// edges no longer pair up with the top's and the neighbours', so the faces are not
-// recognised as a closed convex solid and every one of them is cut from every point.
+// the two sides along x are given as two halves each, one above the other: the same
+// surface, but their vertical edges no longer pair up with the other sides' whole ones, so
+// the faces are not recognised as a closed convex solid and each is cut from every point.
 std::vector<Polygon3> box_faces(double x0, double x1, double y0, double y1, double z0, double z1,
                                 bool bottom, bool halves) {
   std::vector<Polygon3> f{rect(x0, x1, y0, y1, z1, true)};
@@ -207,7 +207,7 @@ std::vector<Polygon3> box_faces(double x0, double x1, double y0, double y1, doub
   const double zm = 0.5 * (z0 + z1);
   auto side = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
     const Eigen::Vector3d up(0, 0, 1);
-    if (!halves) {
+    if (!halves || p.y() != q.y()) {  // only the sides along x in halves
       f.push_back({p + z0 * up, q + z0 * up, q + z1 * up, p + z1 * up});
       return;
     }
@@ -223,7 +223,7 @@ std::vector<Polygon3> box_faces(double x0, double x1, double y0, double y1, doub
 
 TEST(AnalyticPair, FacesOfABoxTurnedAwayHideNothingMore) {
   // A box's faces turned away from the integrated point (or from the whole receiver) are
-  // skipped (solid_back_planes): the same box given with its sides in halves (not a solid,
+  // skipped (solid_back_planes): the same box given with two sides in halves (not a solid,
   // every face cut) must give the same G. Cases: a box standing on the floor seen from the
   // ceiling (its open bottom on the emitter's plane), the same pair integrated over the
   // floor (the cap on the receiver's plane: nothing may be skipped), a closed box floating
