@@ -89,8 +89,17 @@ using Line = Eigen::Vector3d;
 struct Source {
   enum Kind : int { kEmitterCorner, kBlockerCorner, kCrossing } kind;
   int i = 0, j = 0;  // corner index, or the two line indices (i < j) of a crossing
+  bool operator==(const Source& o) const { return kind == o.kind && i == o.i && j == o.j; }
 };
-using Pattern = std::vector<std::vector<Source>>;  // loops of corners
+// The visible region's boundary by what defines it: its distinct corners and its directed
+// edges between them. The convex pieces' edges between two pieces (the same two corners, in
+// opposite directions) cancel in the contour sum term by term (bitwise: the reversed edge's
+// term is the negated one), so they are left out: fewer corners and terms per point.
+struct Pattern {
+  std::vector<Source> sources;
+  std::vector<std::array<int, 2>> edges;
+  bool empty() const { return edges.empty(); }
+};
 
 // The geometry a pair's visible polygon is built from.
 struct Features {
@@ -166,15 +175,18 @@ double unoccluded(const Features& f, const Eigen::Vector3d& x, const Eigen::Vect
 double pattern_factor(const Features& f, const Pattern& pattern, const Eigen::Vector3d& x,
                       const Eigen::Vector3d& n, std::vector<Eigen::Vector3d>& r) {
   const double dx = f.fb.height(x);
-  double sum = 0.0;
-  for (const auto& loop : pattern) {
-    r.clear();
-    for (const Source& s : loop) {
-      Eigen::Vector2d q;
-      if (!f.point(s, x, dx, q)) return std::nan("");
-      r.push_back(f.fb.to3d(q) - x);
-    }
-    sum += contour_sum(n, r.data(), static_cast<int>(r.size()));
+  r.clear();
+  for (const Source& s : pattern.sources) {
+    Eigen::Vector2d q;
+    if (!f.point(s, x, dx, q)) return std::nan("");
+    r.push_back(f.fb.to3d(q) - x);
+  }
+  double sum = 0.0;  // contour_sum's terms, one per edge
+  for (const auto& e : pattern.edges) {
+    const Eigen::Vector3d c = r[e[0]].cross(r[e[1]]);
+    const double cn = c.norm();
+    if (cn <= 0.0) continue;
+    sum += std::atan2(cn, r[e[0]].dot(r[e[1]])) * n.dot(c) / cn;
   }
   return -sum / (2.0 * M_PI);
 }
@@ -363,11 +375,48 @@ double pieces_factor(const Features& f, const std::vector<Piece>& pieces, const 
 
 Pattern pattern_of(const std::vector<Piece>& pieces) {
   Pattern pattern;
-  for (const Piece& p : pieces) {
-    std::vector<Source> loop;
-    for (const PieceCorner& c : p) loop.push_back(c.s);
-    pattern.push_back(std::move(loop));
+  std::vector<Source> all;
+  std::vector<std::array<int, 2>> edges;
+  auto index = [&](const Source& s) {
+    const auto it = std::find(all.begin(), all.end(), s);
+    if (it != all.end()) return static_cast<int>(it - all.begin());
+    all.push_back(s);
+    return static_cast<int>(all.size()) - 1;
+  };
+  for (const Piece& p : pieces)
+    for (size_t k = 0; k < p.size(); ++k)
+      edges.push_back({index(p[k].s), index(p[(k + 1) % p.size()].s)});
+  // An edge and its reverse cancel (sorted by their unordered corners, then direction).
+  std::sort(edges.begin(), edges.end(), [](const auto& a, const auto& b) {
+    const std::array<int, 3> ka{std::min(a[0], a[1]), std::max(a[0], a[1]), a[0]};
+    const std::array<int, 3> kb{std::min(b[0], b[1]), std::max(b[0], b[1]), b[0]};
+    return ka < kb;
+  });
+  std::vector<std::array<int, 2>> kept;
+  for (size_t k = 0; k < edges.size();) {
+    size_t end = k;
+    int net = 0;  // copies from the lower corner to the higher, minus the reverse
+    const int lo = std::min(edges[k][0], edges[k][1]), hi = std::max(edges[k][0], edges[k][1]);
+    while (end < edges.size() && std::min(edges[end][0], edges[end][1]) == lo &&
+           std::max(edges[end][0], edges[end][1]) == hi) {
+      net += edges[end][0] == lo ? 1 : -1;
+      ++end;
+    }
+    for (int c = 0; c < std::abs(net); ++c)
+      kept.push_back(net > 0 ? std::array<int, 2>{lo, hi} : std::array<int, 2>{hi, lo});
+    k = end;
   }
+  // Only the corners the kept edges use, renumbered in order of first use.
+  std::vector<int> renumber(all.size(), -1);
+  for (auto& e : kept)
+    for (int& v : e) {
+      if (renumber[v] < 0) {
+        renumber[v] = static_cast<int>(pattern.sources.size());
+        pattern.sources.push_back(all[v]);
+      }
+      v = renumber[v];
+    }
+  pattern.edges = std::move(kept);
   return pattern;
 }
 
@@ -674,17 +723,17 @@ bool outside_shaft(const Polygon3& piece, const std::vector<Eigen::Vector4d>& pl
 // The back planes (Features::back) of the pieces that are faces of closed convex solids,
 // seen from the receiver a towards the emitter b. A convex solid hides from x exactly what
 // its faces turned towards x hide: a segment from x (outside it) to any point behind it
-// enters it through a face with x on that face's outer side. So from x the faces with x on
-// their inner side can be skipped (a box seen from a point: 2 or 3 of its 5 faces), and a
-// face with all of a on its inner side can be dropped from the pair (fewer events, fewer
-// cells). A solid is a set of pieces connected by shared edges (exactly equal corners),
-// each edge in at most two of them, with every corner of the set on one side of each
-// piece's plane (within eps; some corner clear of it: not flat), and the edges in only one
-// piece (its open "cap": a box standing on a floor has no bottom face) all in one plane
-// with both polygons on the solid's side of it (a segment between them then cannot pass
+// enters it through a face with x on that face's outer side. So from x the solid hides the
+// cone over its silhouette (silhouette_sides), and a face with all of a on its inner side
+// can be dropped from the pair (fewer events, fewer cells). A solid is a set of pieces connected by
+// shared edges (exactly equal corners), each edge in at most two of them, with every corner of the
+// set on one side of each piece's plane (within eps; some corner clear of it: not flat), and the
+// edges in only one piece (its open "cap": a box standing on a floor has no bottom face) all in one
+// plane with both polygons on the solid's side of it (a segment between them then cannot pass
 // through the cap) and a not in it (from a point on the cap the solid may hide everything,
 // not only what its front faces hide). a must lie outside the solid. Anything else gets
-// zero planes (no piece skipped).
+// zero planes and solid -1 (each piece its own cone). `solid` receives each piece's solid
+// (an id, or -1).
 std::vector<Eigen::Vector4d> solid_back_planes(const std::vector<Polygon3>& pieces,
                                                const Polygon3& a, const Polygon3& b, double eps,
                                                std::vector<int>& solid) {
@@ -940,8 +989,12 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
   Integrator in{f, f.fa.w, {}, {}, {}, {}, {}};
   in.out.events = events;
   if (f.pieces.empty()) {  // unoccluded: the whole emitter everywhere
-    Pattern full(1);
-    for (int k = 0; k < static_cast<int>(f.emitter2.size()); ++k) full[0].push_back({Source::kEmitterCorner, k, 0});
+    Pattern full;
+    const int ne = static_cast<int>(f.emitter2.size());
+    for (int k = 0; k < ne; ++k) {
+      full.sources.push_back({Source::kEmitterCorner, k, 0});
+      full.edges.push_back({k, (k + 1) % ne});
+    }
     in.patterns.push_back(full);
     for (Cell& c : cells) c.pattern = 0;
   } else {
