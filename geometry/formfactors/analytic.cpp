@@ -1,6 +1,7 @@
 #include "geometry/formfactors/analytic.hpp"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <Eigen/Geometry>
@@ -17,16 +18,18 @@
 namespace lambert::ff {
 namespace {
 
-// The partition's cells need not follow the event lines to the last bit (the integrand is
-// only smooth on either side of them, and a cell corner rounded off its line by ~1e-16 of
-// the receiver's size moves a sliver of that width to the neighbouring pattern, which the
-// verification at the inset corners does not see and the quadrature does not notice): so
-// exact predicates with constraint crossings rounded to double, which costs a tenth of the
-// exact (GMP rational) crossings.
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using CDT =
-    CGAL::Constrained_Delaunay_triangulation_2<K, CGAL::Default, CGAL::Exact_predicates_tag>;
-using Point2 = K::Point_2;
+// The partition of a along the event segments, a CGAL constrained Delaunay triangulation:
+// first with exact predicates and the constraints' crossings rounded to double (a third of
+// the time of the exact GMP rational crossings on a room), which suffices for --ff-tol down
+// to ~1e-7; a pair that does not converge so (a 4-box room's floor and ceiling at 1e-8 ran
+// out of its budget: cells cut off their event lines by rounding fail their pattern check
+// cell after cell) is done again with exact crossings (analytic_pair_G).
+using RoundedCDT =
+    CGAL::Constrained_Delaunay_triangulation_2<CGAL::Exact_predicates_inexact_constructions_kernel,
+                                               CGAL::Default, CGAL::Exact_predicates_tag>;
+using ExactCDT =
+    CGAL::Constrained_Delaunay_triangulation_2<CGAL::Exact_predicates_exact_constructions_kernel,
+                                               CGAL::Default, CGAL::Exact_intersections_tag>;
 
 // Gauss-Legendre orders per direction of a triangle's two rules (the value is the low one's,
 // the estimate their difference). On an analytic integrand the order-6 rule's error is
@@ -421,6 +424,12 @@ Pattern pattern_of(const std::vector<Piece>& pieces) {
 }
 
 // One triangle of the partition of a.
+struct Cell;
+template <class CDT>
+void partition(const Features& f, const std::vector<Eigen::Vector2d>& r2,
+               const std::vector<std::array<Eigen::Vector2d, 2>>& segments,
+               std::vector<Cell>& cells);
+
 struct Cell {
   std::array<Eigen::Vector3d, 3> p;
   bool fast = true;  // integrand from `pattern`; else from the blockers at every point
@@ -428,6 +437,36 @@ struct Cell {
   bool crude = false;  // over the direct budget: the centroid rule, est = |value|
   double low = 0.0, high = 0.0, est = 0.0;
 };
+
+// The cells of a's partition (r2: a's corners in fa) along the event segments.
+template <class CDT>
+void partition(const Features& f, const std::vector<Eigen::Vector2d>& r2,
+               const std::vector<std::array<Eigen::Vector2d, 2>>& segments,
+               std::vector<Cell>& cells) {
+  using Point2 = typename CDT::Point;
+  CDT cdt;
+  std::vector<Point2> boundary;
+  for (const auto& q : r2) boundary.emplace_back(q.x(), q.y());
+  cdt.insert_constraint(boundary.begin(), boundary.end(), true);
+  for (const auto& s : segments)
+    cdt.insert_constraint(Point2(s[0].x(), s[0].y()), Point2(s[1].x(), s[1].y()));
+  for (auto fh = cdt.finite_faces_begin(); fh != cdt.finite_faces_end(); ++fh) {
+    const Point2 c =
+        CGAL::centroid(fh->vertex(0)->point(), fh->vertex(1)->point(), fh->vertex(2)->point());
+    bool inside = true;
+    for (size_t k = 0; k < boundary.size() && inside; ++k)
+      inside =
+          CGAL::orientation(boundary[k], boundary[(k + 1) % boundary.size()], c) == CGAL::LEFT_TURN;
+    if (!inside) continue;
+    Cell cell;
+    for (int k = 0; k < 3; ++k) {
+      const Point2& q = fh->vertex(k)->point();
+      cell.p[k] = f.fa.to3d({CGAL::to_double(q.x()), CGAL::to_double(q.y())});
+    }
+    if ((cell.p[1] - cell.p[0]).cross(cell.p[2] - cell.p[0]).dot(f.fa.w) <= 0.0) continue;
+    cells.push_back(cell);
+  }
+}
 
 struct Integrator {
   const Features& f;
@@ -856,11 +895,9 @@ std::vector<Eigen::Vector4d> solid_back_planes(const std::vector<Polygon3>& piec
   return back;
 }
 
-}  // namespace
-
-AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
-                                 const std::vector<Polygon3>& blockers, double tol_G,
-                                 std::int64_t max_evaluations) {
+// analytic_pair_G with a's partition by the rounded or the exact CDT.
+AnalyticEstimate pair_G(const Polygon3& a, const Polygon3& b, const std::vector<Polygon3>& blockers,
+                        double tol_G, std::int64_t max_evaluations, bool exact_cdt) {
   Features f;
   f.fa = frame_of(a);
   f.fb = frame_of(b);
@@ -965,25 +1002,10 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
     for (size_t k = 1; k + 1 < receiver.size(); ++k) cells.push_back({{receiver[0], receiver[k], receiver[k + 1]}});
   } else {
     const auto segments = event_segments(f, r2, plane_eps);
-    CDT cdt;
-    std::vector<Point2> boundary;
-    for (const auto& q : r2) boundary.emplace_back(q.x(), q.y());
-    cdt.insert_constraint(boundary.begin(), boundary.end(), true);
-    for (const auto& s : segments) cdt.insert_constraint(Point2(s[0].x(), s[0].y()), Point2(s[1].x(), s[1].y()));
-    for (auto fh = cdt.finite_faces_begin(); fh != cdt.finite_faces_end(); ++fh) {
-      const Point2 c = CGAL::centroid(fh->vertex(0)->point(), fh->vertex(1)->point(), fh->vertex(2)->point());
-      bool inside = true;
-      for (size_t k = 0; k < boundary.size() && inside; ++k)
-        inside = CGAL::orientation(boundary[k], boundary[(k + 1) % boundary.size()], c) == CGAL::LEFT_TURN;
-      if (!inside) continue;
-      Cell cell;
-      for (int k = 0; k < 3; ++k) {
-        const Point2& q = fh->vertex(k)->point();
-        cell.p[k] = f.fa.to3d({q.x(), q.y()});
-      }
-      if ((cell.p[1] - cell.p[0]).cross(cell.p[2] - cell.p[0]).dot(f.fa.w) <= 0.0) continue;
-      cells.push_back(cell);
-    }
+    if (exact_cdt)
+      partition<ExactCDT>(f, r2, segments, cells);
+    else
+      partition<RoundedCDT>(f, r2, segments, cells);
     events = static_cast<std::int64_t>(segments.size());
   }
   Integrator in{f, f.fa.w, {}, {}, {}, {}, {}};
@@ -1068,6 +1090,25 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
   }
   out.G = std::max(0.0, out.G);
   out.error = std::max(pair_error(diff, abs_diff) + crude, kRoundingFloor * out.G);
+  return out;
+}
+
+}  // namespace
+
+AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
+                                 const std::vector<Polygon3>& blockers, double tol_G,
+                                 std::int64_t max_evaluations) {
+  const AnalyticEstimate e = pair_G(a, b, blockers, tol_G, max_evaluations, false);
+  if (e.converged || e.events == 0) return e;
+  // Unconverged with the rounded partition: again with the exact one (see RoundedCDT); the
+  // better of the two, with the point factors both spent.
+  AnalyticEstimate exact = pair_G(a, b, blockers, tol_G, max_evaluations, true);
+  exact.evaluations += e.evaluations;
+  exact.direct_evaluations += e.direct_evaluations;
+  if (exact.converged || exact.error <= e.error) return exact;
+  AnalyticEstimate out = e;
+  out.evaluations = exact.evaluations;
+  out.direct_evaluations = exact.direct_evaluations;
   return out;
 }
 
