@@ -2,6 +2,7 @@
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -17,17 +18,29 @@
 namespace lambert::ff {
 namespace {
 
-using K = CGAL::Exact_predicates_exact_constructions_kernel;
-using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, CGAL::Default,
-                                                       CGAL::Exact_intersections_tag>;
-using Point2 = K::Point_2;
+// The partition of a along the event segments, a CGAL constrained Delaunay triangulation:
+// first with exact predicates and the constraints' crossings rounded to double (a third of
+// the time of the exact GMP rational crossings on a room), which suffices for --ff-tol down
+// to ~1e-7; a pair that does not converge so (a 4-box room's floor and ceiling at 1e-8 ran
+// out of its budget: cells cut off their event lines by rounding fail their pattern check
+// cell after cell) is done again with exact crossings (analytic_pair_G).
+using RoundedCDT =
+    CGAL::Constrained_Delaunay_triangulation_2<CGAL::Exact_predicates_inexact_constructions_kernel,
+                                               CGAL::Default, CGAL::Exact_predicates_tag>;
+using ExactCDT =
+    CGAL::Constrained_Delaunay_triangulation_2<CGAL::Exact_predicates_exact_constructions_kernel,
+                                               CGAL::Default, CGAL::Exact_intersections_tag>;
 
 // Gauss-Legendre orders per direction of a triangle's two rules (the value is the low one's,
-// the estimate their difference). On an analytic integrand the order-8 rule's error is
-// about (h/2d)^6 times the order-5 rule's, so the difference is the order-5 error to a few
-// per cent for cells up to the size of their distance to b, which refinement ensures.
-constexpr int kLowOrder = 5;
-constexpr int kHighOrder = 8;
+// the estimate their difference). On an analytic integrand the order-6 rule's error is
+// about (h/2d)^4 times the order-4 rule's, so the difference is the order-4 error to a few
+// per cent for cells well below the size of their distance to b, which the event cells of
+// an obstructed pair are and refinement ensures. 4/6 (52 points) rather than 5/8 (89): a
+// room's pairs meet --ff-tol 1e-4..1e-6 in their initial cells, so the rule's cost per cell
+// is the cost; 3/5 fell outside ErrorEstimateIsCalibrated's 5 % (estimates > 10x the error
+// at 1e-9, where the order-5 rule's own error is not negligible).
+constexpr int kLowOrder = 4;
+constexpr int kHighOrder = 6;
 // Rounding floor of a pair's error estimate, relative to G: the contour formula and the
 // visible pieces' rounded corners are good to ~1e-15 relative per point, and a sum of cells
 // cannot be trusted below ~10x that (so --tol below it is met at the floor, not chased).
@@ -79,8 +92,17 @@ using Line = Eigen::Vector3d;
 struct Source {
   enum Kind : int { kEmitterCorner, kBlockerCorner, kCrossing } kind;
   int i = 0, j = 0;  // corner index, or the two line indices (i < j) of a crossing
+  bool operator==(const Source& o) const { return kind == o.kind && i == o.i && j == o.j; }
 };
-using Pattern = std::vector<std::vector<Source>>;  // loops of corners
+// The visible region's boundary by what defines it: its distinct corners and its directed
+// edges between them. The convex pieces' edges between two pieces (the same two corners, in
+// opposite directions) cancel in the contour sum term by term (bitwise: the reversed edge's
+// term is the negated one), so they are left out: fewer corners and terms per point.
+struct Pattern {
+  std::vector<Source> sources;
+  std::vector<std::array<int, 2>> edges;
+  bool empty() const { return edges.empty(); }
+};
 
 // The geometry a pair's visible polygon is built from.
 struct Features {
@@ -88,6 +110,17 @@ struct Features {
   Polygon3 emitter;                      // b in front of a's plane
   std::vector<Eigen::Vector2d> emitter2;  // its corners in fb
   std::vector<Polygon3> pieces;          // blockers in front of both planes
+  // Per piece, the plane (n, d) of a face of a closed convex solid, its solid on the side
+  // n . y + d < 0: from a point on that side the face is a back face and hides nothing the
+  // solid's front faces do not (solid_back_planes); zero for any other piece.
+  std::vector<Eigen::Vector4d> back;
+  // The solids: per piece its solid (-1: none), per solid its pieces and their corners, and
+  // per piece and edge the piece of its solid across that edge (-1: none, or one dropped as
+  // turned away from all of a: either way not a front face).
+  std::vector<int> solid;
+  std::vector<std::vector<int>> solids;
+  std::vector<std::vector<Eigen::Vector3d>> solid_corners;
+  std::vector<std::vector<int>> neighbour;
   std::vector<Eigen::Vector3d> corners;  // the pieces' distinct corners
   std::vector<std::array<int, 2>> edges;  // the pieces' distinct edges (corner indices)
   std::vector<std::vector<int>> piece_lines;  // per piece, the line of each of its edges
@@ -145,15 +178,18 @@ double unoccluded(const Features& f, const Eigen::Vector3d& x, const Eigen::Vect
 double pattern_factor(const Features& f, const Pattern& pattern, const Eigen::Vector3d& x,
                       const Eigen::Vector3d& n, std::vector<Eigen::Vector3d>& r) {
   const double dx = f.fb.height(x);
-  double sum = 0.0;
-  for (const auto& loop : pattern) {
-    r.clear();
-    for (const Source& s : loop) {
-      Eigen::Vector2d q;
-      if (!f.point(s, x, dx, q)) return std::nan("");
-      r.push_back(f.fb.to3d(q) - x);
-    }
-    sum += contour_sum(n, r.data(), static_cast<int>(r.size()));
+  r.clear();
+  for (const Source& s : pattern.sources) {
+    Eigen::Vector2d q;
+    if (!f.point(s, x, dx, q)) return std::nan("");
+    r.push_back(f.fb.to3d(q) - x);
+  }
+  double sum = 0.0;  // contour_sum's terms, one per edge
+  for (const auto& e : pattern.edges) {
+    const Eigen::Vector3d c = r[e[0]].cross(r[e[1]]);
+    const double cn = c.norm();
+    if (cn <= 0.0) continue;
+    sum += std::atan2(cn, r[e[0]].dot(r[e[1]])) * n.dot(c) / cn;
   }
   return -sum / (2.0 * M_PI);
 }
@@ -249,6 +285,35 @@ ConeSides cone_sides(const Features& f, const Polygon3& piece, const std::vector
   return sides;
 }
 
+// The half-planes of the cone from x over closed convex solid s: the planes through x and
+// its silhouette edges (between a face turned towards x and one turned away, or on the
+// open cap, which is turned away from every point of a); empty when x sees it edge-on. One
+// convex cone per solid instead of one per front face: fewer cuts of the visible pieces,
+// and a pattern that changes only where the silhouette does (where a face's plane meets
+// a's plane: an event line).
+ConeSides silhouette_sides(const Features& f, int s, const Eigen::Vector3d& x) {
+  const std::vector<int>& members = f.solids[s];
+  auto front = [&](int p) { return f.back[p].head<3>().dot(x) + f.back[p].w() > 0.0; };
+  ConeSides sides;
+  for (const int p : members) {
+    if (!front(p)) continue;
+    const Polygon3& piece = f.pieces[p];
+    for (size_t k = 0; k < piece.size(); ++k) {
+      const int nb = f.neighbour[p][k];
+      if (nb >= 0 && front(nb)) continue;  // between two front faces: inside the silhouette
+      const Eigen::Vector3d m = (piece[k] - x).cross(piece[(k + 1) % piece.size()] - x);
+      double far = 0.0;  // the solid's corner farthest from the edge's plane through x
+      for (const auto& c : f.solid_corners[s])
+        if (std::abs(m.dot(c - x)) > std::abs(far)) far = m.dot(c - x);
+      if (!(std::abs(far) > 1e-12 * m.norm() * f.scale)) return {};  // edge-on
+      const double sign = far > 0.0 ? 1.0 : -1.0;
+      sides.push_back(
+          {sign * Line(m.dot(f.fb.u), m.dot(f.fb.v), m.dot(f.fb.o - x)), f.piece_lines[p][k]});
+    }
+  }
+  return sides;
+}
+
 // The visible pieces of the emitter at x (`next` is scratch); false when there are too many.
 bool visible_pieces(const Features& f, const Eigen::Vector3d& x, std::vector<Piece>& out,
                     std::vector<Piece>& next) {
@@ -259,7 +324,10 @@ bool visible_pieces(const Features& f, const Eigen::Vector3d& x, std::vector<Pie
   const double sliver = kSliverArea * f.scale * f.scale;
   out.assign(1, emitter);
   for (size_t p = 0; p < f.pieces.size() && !out.empty(); ++p) {
-    const auto sides = cone_sides(f, f.pieces[p], f.piece_lines[p], x);
+    const int s = f.solid[p];
+    if (s >= 0 && f.solids[s][0] != static_cast<int>(p)) continue;  // its solid's done
+    const auto sides =
+        s >= 0 ? silhouette_sides(f, s, x) : cone_sides(f, f.pieces[p], f.piece_lines[p], x);
     if (sides.empty()) continue;
     // The cheapest test: a cone that misses the whole emitter (all of it outside one side)
     // changes no piece.
@@ -310,15 +378,58 @@ double pieces_factor(const Features& f, const std::vector<Piece>& pieces, const 
 
 Pattern pattern_of(const std::vector<Piece>& pieces) {
   Pattern pattern;
-  for (const Piece& p : pieces) {
-    std::vector<Source> loop;
-    for (const PieceCorner& c : p) loop.push_back(c.s);
-    pattern.push_back(std::move(loop));
+  std::vector<Source> all;
+  std::vector<std::array<int, 2>> edges;
+  auto index = [&](const Source& s) {
+    const auto it = std::find(all.begin(), all.end(), s);
+    if (it != all.end()) return static_cast<int>(it - all.begin());
+    all.push_back(s);
+    return static_cast<int>(all.size()) - 1;
+  };
+  for (const Piece& p : pieces)
+    for (size_t k = 0; k < p.size(); ++k)
+      edges.push_back({index(p[k].s), index(p[(k + 1) % p.size()].s)});
+  // An edge and its reverse cancel (sorted by their unordered corners, then direction).
+  std::sort(edges.begin(), edges.end(), [](const auto& a, const auto& b) {
+    const std::array<int, 3> ka{std::min(a[0], a[1]), std::max(a[0], a[1]), a[0]};
+    const std::array<int, 3> kb{std::min(b[0], b[1]), std::max(b[0], b[1]), b[0]};
+    return ka < kb;
+  });
+  std::vector<std::array<int, 2>> kept;
+  for (size_t k = 0; k < edges.size();) {
+    size_t end = k;
+    int net = 0;  // copies from the lower corner to the higher, minus the reverse
+    const int lo = std::min(edges[k][0], edges[k][1]), hi = std::max(edges[k][0], edges[k][1]);
+    while (end < edges.size() && std::min(edges[end][0], edges[end][1]) == lo &&
+           std::max(edges[end][0], edges[end][1]) == hi) {
+      net += edges[end][0] == lo ? 1 : -1;
+      ++end;
+    }
+    for (int c = 0; c < std::abs(net); ++c)
+      kept.push_back(net > 0 ? std::array<int, 2>{lo, hi} : std::array<int, 2>{hi, lo});
+    k = end;
   }
+  // Only the corners the kept edges use, renumbered in order of first use.
+  std::vector<int> renumber(all.size(), -1);
+  for (auto& e : kept)
+    for (int& v : e) {
+      if (renumber[v] < 0) {
+        renumber[v] = static_cast<int>(pattern.sources.size());
+        pattern.sources.push_back(all[v]);
+      }
+      v = renumber[v];
+    }
+  pattern.edges = std::move(kept);
   return pattern;
 }
 
 // One triangle of the partition of a.
+struct Cell;
+template <class CDT>
+void partition(const Features& f, const std::vector<Eigen::Vector2d>& r2,
+               const std::vector<std::array<Eigen::Vector2d, 2>>& segments,
+               std::vector<Cell>& cells);
+
 struct Cell {
   std::array<Eigen::Vector3d, 3> p;
   bool fast = true;  // integrand from `pattern`; else from the blockers at every point
@@ -326,6 +437,36 @@ struct Cell {
   bool crude = false;  // over the direct budget: the centroid rule, est = |value|
   double low = 0.0, high = 0.0, est = 0.0;
 };
+
+// The cells of a's partition (r2: a's corners in fa) along the event segments.
+template <class CDT>
+void partition(const Features& f, const std::vector<Eigen::Vector2d>& r2,
+               const std::vector<std::array<Eigen::Vector2d, 2>>& segments,
+               std::vector<Cell>& cells) {
+  using Point2 = typename CDT::Point;
+  CDT cdt;
+  std::vector<Point2> boundary;
+  for (const auto& q : r2) boundary.emplace_back(q.x(), q.y());
+  cdt.insert_constraint(boundary.begin(), boundary.end(), true);
+  for (const auto& s : segments)
+    cdt.insert_constraint(Point2(s[0].x(), s[0].y()), Point2(s[1].x(), s[1].y()));
+  for (auto fh = cdt.finite_faces_begin(); fh != cdt.finite_faces_end(); ++fh) {
+    const Point2 c =
+        CGAL::centroid(fh->vertex(0)->point(), fh->vertex(1)->point(), fh->vertex(2)->point());
+    bool inside = true;
+    for (size_t k = 0; k < boundary.size() && inside; ++k)
+      inside =
+          CGAL::orientation(boundary[k], boundary[(k + 1) % boundary.size()], c) == CGAL::LEFT_TURN;
+    if (!inside) continue;
+    Cell cell;
+    for (int k = 0; k < 3; ++k) {
+      const Point2& q = fh->vertex(k)->point();
+      cell.p[k] = f.fa.to3d({CGAL::to_double(q.x()), CGAL::to_double(q.y())});
+    }
+    if ((cell.p[1] - cell.p[0]).cross(cell.p[2] - cell.p[0]).dot(f.fa.w) <= 0.0) continue;
+    cells.push_back(cell);
+  }
+}
 
 struct Integrator {
   const Features& f;
@@ -618,11 +759,145 @@ bool outside_shaft(const Polygon3& piece, const std::vector<Eigen::Vector4d>& pl
   return false;
 }
 
-}  // namespace
+// The back planes (Features::back) of the pieces that are faces of closed convex solids,
+// seen from the receiver a towards the emitter b. A convex solid hides from x exactly what
+// its faces turned towards x hide: a segment from x (outside it) to any point behind it
+// enters it through a face with x on that face's outer side. So from x the solid hides the
+// cone over its silhouette (silhouette_sides), and a face with all of a on its inner side
+// can be dropped from the pair (fewer events, fewer cells). A solid is a set of pieces connected by
+// shared edges (exactly equal corners), each edge in at most two of them, with every corner of the
+// set on one side of each piece's plane (within eps; some corner clear of it: not flat), and the
+// edges in only one piece (its open "cap": a box standing on a floor has no bottom face) all in one
+// plane with both polygons on the solid's side of it (a segment between them then cannot pass
+// through the cap) and a not in it (from a point on the cap the solid may hide everything,
+// not only what its front faces hide). a must lie outside the solid. Anything else gets
+// zero planes and solid -1 (each piece its own cone). `solid` receives each piece's solid
+// (an id, or -1).
+std::vector<Eigen::Vector4d> solid_back_planes(const std::vector<Polygon3>& pieces,
+                                               const Polygon3& a, const Polygon3& b, double eps,
+                                               std::vector<int>& solid) {
+  const int n = static_cast<int>(pieces.size());
+  std::vector<Eigen::Vector4d> back(n, Eigen::Vector4d::Zero());
+  solid.assign(n, -1);
+  // Edges keyed by their corners (ordered), with the piece using them.
+  using Key = std::array<double, 6>;
+  std::vector<std::pair<Key, int>> edges;
+  for (int p = 0; p < n; ++p)
+    for (size_t k = 0; k < pieces[p].size(); ++k) {
+      Eigen::Vector3d u = pieces[p][k], v = pieces[p][(k + 1) % pieces[p].size()];
+      if (std::lexicographical_compare(v.data(), v.data() + 3, u.data(), u.data() + 3))
+        std::swap(u, v);
+      edges.push_back({{u.x(), u.y(), u.z(), v.x(), v.y(), v.z()}, p});
+    }
+  std::sort(edges.begin(), edges.end());
+  std::vector<int> root(n);
+  for (int p = 0; p < n; ++p) root[p] = p;
+  auto find = [&](int p) {
+    while (root[p] != p) p = root[p] = root[root[p]];
+    return p;
+  };
+  std::vector<char> bad(n, 0);                       // by root, after the union
+  std::vector<std::array<Eigen::Vector3d, 2>> open;  // edges in one piece
+  std::vector<int> open_piece;
+  for (size_t e = 0; e < edges.size();) {
+    size_t end = e;
+    while (end < edges.size() && edges[end].first == edges[e].first) ++end;
+    for (size_t k = e + 1; k < end; ++k) root[find(edges[k].second)] = find(edges[e].second);
+    if (end - e > 2) bad[edges[e].second] = 1;  // marked on a piece, moved to its root below
+    if (end - e == 1) {
+      const Key& q = edges[e].first;
+      open.push_back({Eigen::Vector3d(q[0], q[1], q[2]), Eigen::Vector3d(q[3], q[4], q[5])});
+      open_piece.push_back(edges[e].second);
+    }
+    e = end;
+  }
+  for (int p = 0; p < n; ++p)
+    if (bad[p]) bad[find(p)] = 1;
+  for (int r = 0; r < n; ++r) {
+    if (find(r) != r || bad[r]) continue;
+    std::vector<int> members;
+    std::vector<Eigen::Vector3d> corners;
+    for (int p = 0; p < n; ++p)
+      if (find(p) == r) {
+        members.push_back(p);
+        corners.insert(corners.end(), pieces[p].begin(), pieces[p].end());
+      }
+    if (members.size() < 2) continue;
+    // Each piece's plane, oriented with the solid inside (negative); convex and not flat.
+    std::vector<Eigen::Vector4d> planes;
+    bool ok = true, thick = false;
+    for (const int p : members) {
+      const Eigen::Vector3d m = newell_normal(pieces[p]).normalized();
+      const double d = -m.dot(pieces[p][0]);
+      double lo = INFINITY, hi = -INFINITY;
+      for (const auto& c : corners) {
+        lo = std::min(lo, m.dot(c) + d);
+        hi = std::max(hi, m.dot(c) + d);
+      }
+      for (const auto& c : pieces[p]) ok = ok && std::abs(m.dot(c) + d) <= eps;
+      if (hi <= eps)
+        planes.push_back({m.x(), m.y(), m.z(), d});
+      else if (lo >= -eps)
+        planes.push_back({-m.x(), -m.y(), -m.z(), -d});
+      else
+        ok = false;
+      thick = thick || std::max(hi, -lo) > 10.0 * eps;
+    }
+    if (!ok || !thick) continue;
+    // The open edges: all in one plane (the cap), the solid, a and b on one side, a off it.
+    std::vector<Eigen::Vector3d> rim;
+    for (size_t k = 0; k < open.size(); ++k)
+      if (find(open_piece[k]) == r) rim.insert(rim.end(), {open[k][0], open[k][1]});
+    bool outside = false;  // a's centroid outside the solid
+    Eigen::Vector3d ca = Eigen::Vector3d::Zero();
+    for (const auto& c : a) ca += c / static_cast<double>(a.size());
+    for (const auto& pl : planes) outside = outside || pl.head<3>().dot(ca) + pl.w() > eps;
+    if (!rim.empty()) {
+      // The cap's plane through three rim corners far apart.
+      const Eigen::Vector3d& p0 = rim[0];
+      Eigen::Vector3d p1 = p0, normal = Eigen::Vector3d::Zero();
+      for (const auto& c : rim)
+        if ((c - p0).norm() > (p1 - p0).norm()) p1 = c;
+      for (const auto& c : rim) {
+        const Eigen::Vector3d m = (p1 - p0).cross(c - p0);
+        if (m.norm() > normal.norm()) normal = m;
+      }
+      if (!(normal.norm() > eps * (p1 - p0).norm())) continue;
+      normal.normalize();
+      double lo = INFINITY, hi = -INFINITY;
+      for (const auto& c : corners) {
+        lo = std::min(lo, normal.dot(c - p0));
+        hi = std::max(hi, normal.dot(c - p0));
+      }
+      if (hi < -lo) {  // the solid on the other side: turn the normal towards it
+        normal = -normal;
+        const double t = lo;
+        lo = -hi;
+        hi = -t;
+      }
+      bool cap = lo >= -eps && hi > 10.0 * eps;
+      for (const auto& c : rim) cap = cap && std::abs(normal.dot(c - p0)) <= eps;
+      double a_high = -INFINITY;
+      for (const auto& c : a) {
+        cap = cap && normal.dot(c - p0) >= -eps;
+        a_high = std::max(a_high, normal.dot(c - p0));
+      }
+      for (const auto& c : b) cap = cap && normal.dot(c - p0) >= -eps;
+      if (!cap || !(a_high > eps)) continue;
+      outside = outside || normal.dot(ca - p0) < -eps;
+    }
+    if (!outside) continue;
+    for (size_t k = 0; k < members.size(); ++k) {
+      back[members[k]] = planes[k];
+      solid[members[k]] = r;
+    }
+  }
+  return back;
+}
 
-AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
-                                 const std::vector<Polygon3>& blockers, double tol_G,
-                                 std::int64_t max_evaluations) {
+// analytic_pair_G with a's partition by the rounded or the exact CDT.
+AnalyticEstimate pair_G(const Polygon3& a, const Polygon3& b, const std::vector<Polygon3>& blockers,
+                        double tol_G, std::int64_t max_evaluations, bool exact_cdt) {
   Features f;
   f.fa = frame_of(a);
   f.fb = frame_of(b);
@@ -658,6 +933,24 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
       f.pieces.push_back(std::move(piece));
     }
   }
+  // Faces of closed convex solids: those turned away from all of a hide nothing.
+  std::vector<int> solid_root;
+  f.back = solid_back_planes(f.pieces, receiver, f.emitter, plane_eps, solid_root);
+  {
+    size_t kept = 0;
+    for (size_t p = 0; p < f.pieces.size(); ++p) {
+      bool away = solid_root[p] >= 0;
+      for (const auto& c : receiver)
+        away = away && f.back[p].head<3>().dot(c) + f.back[p].w() <= 0.0;
+      if (away) continue;
+      if (kept != p) f.pieces[kept] = std::move(f.pieces[p]);  // (a self-move empties it)
+      f.back[kept] = f.back[p];
+      solid_root[kept++] = solid_root[p];
+    }
+    f.pieces.resize(kept);
+    f.back.resize(kept);
+    solid_root.resize(kept);
+  }
   auto corner_index = [&](const Eigen::Vector3d& p) {
     for (size_t k = 0; k < f.corners.size(); ++k)
       if (f.corners[k] == p) return static_cast<int>(k);
@@ -674,6 +967,31 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
       lines.push_back(static_cast<int>(f.emitter2.size() + (it - f.edges.begin())));
     }
   }
+  // The solids, numbered in the order of their first piece, and their pieces' neighbours.
+  f.solid.assign(f.pieces.size(), -1);
+  f.neighbour.resize(f.pieces.size());
+  for (size_t p = 0; p < f.pieces.size(); ++p) {
+    if (solid_root[p] < 0) continue;
+    for (size_t q = 0; q < p && f.solid[p] < 0; ++q)
+      if (solid_root[q] == solid_root[p]) f.solid[p] = f.solid[q];
+    if (f.solid[p] < 0) {
+      f.solid[p] = static_cast<int>(f.solids.size());
+      f.solids.emplace_back();
+      f.solid_corners.emplace_back();
+    }
+    f.solids[f.solid[p]].push_back(static_cast<int>(p));
+    auto& corners = f.solid_corners[f.solid[p]];
+    corners.insert(corners.end(), f.pieces[p].begin(), f.pieces[p].end());
+  }
+  for (size_t p = 0; p < f.pieces.size(); ++p) {
+    f.neighbour[p].assign(f.piece_lines[p].size(), -1);
+    if (f.solid[p] < 0) continue;
+    for (size_t k = 0; k < f.piece_lines[p].size(); ++k)
+      for (const int q : f.solids[f.solid[p]])
+        if (q != static_cast<int>(p) &&
+            std::count(f.piece_lines[q].begin(), f.piece_lines[q].end(), f.piece_lines[p][k]))
+          f.neighbour[p][k] = q;
+  }
 
   // The partition of the receiver: its fan, or its CDT with the event segments.
   std::vector<Eigen::Vector2d> r2;
@@ -684,32 +1002,21 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
     for (size_t k = 1; k + 1 < receiver.size(); ++k) cells.push_back({{receiver[0], receiver[k], receiver[k + 1]}});
   } else {
     const auto segments = event_segments(f, r2, plane_eps);
-    CDT cdt;
-    std::vector<Point2> boundary;
-    for (const auto& q : r2) boundary.emplace_back(q.x(), q.y());
-    cdt.insert_constraint(boundary.begin(), boundary.end(), true);
-    for (const auto& s : segments) cdt.insert_constraint(Point2(s[0].x(), s[0].y()), Point2(s[1].x(), s[1].y()));
-    for (auto fh = cdt.finite_faces_begin(); fh != cdt.finite_faces_end(); ++fh) {
-      const Point2 c = CGAL::centroid(fh->vertex(0)->point(), fh->vertex(1)->point(), fh->vertex(2)->point());
-      bool inside = true;
-      for (size_t k = 0; k < boundary.size() && inside; ++k)
-        inside = CGAL::orientation(boundary[k], boundary[(k + 1) % boundary.size()], c) == CGAL::LEFT_TURN;
-      if (!inside) continue;
-      Cell cell;
-      for (int k = 0; k < 3; ++k) {
-        const Point2& q = fh->vertex(k)->point();
-        cell.p[k] = f.fa.to3d({CGAL::to_double(q.x()), CGAL::to_double(q.y())});
-      }
-      if ((cell.p[1] - cell.p[0]).cross(cell.p[2] - cell.p[0]).dot(f.fa.w) <= 0.0) continue;
-      cells.push_back(cell);
-    }
+    if (exact_cdt)
+      partition<ExactCDT>(f, r2, segments, cells);
+    else
+      partition<RoundedCDT>(f, r2, segments, cells);
     events = static_cast<std::int64_t>(segments.size());
   }
   Integrator in{f, f.fa.w, {}, {}, {}, {}, {}};
   in.out.events = events;
   if (f.pieces.empty()) {  // unoccluded: the whole emitter everywhere
-    Pattern full(1);
-    for (int k = 0; k < static_cast<int>(f.emitter2.size()); ++k) full[0].push_back({Source::kEmitterCorner, k, 0});
+    Pattern full;
+    const int ne = static_cast<int>(f.emitter2.size());
+    for (int k = 0; k < ne; ++k) {
+      full.sources.push_back({Source::kEmitterCorner, k, 0});
+      full.edges.push_back({k, (k + 1) % ne});
+    }
     in.patterns.push_back(full);
     for (Cell& c : cells) c.pattern = 0;
   } else {
@@ -783,6 +1090,25 @@ AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
   }
   out.G = std::max(0.0, out.G);
   out.error = std::max(pair_error(diff, abs_diff) + crude, kRoundingFloor * out.G);
+  return out;
+}
+
+}  // namespace
+
+AnalyticEstimate analytic_pair_G(const Polygon3& a, const Polygon3& b,
+                                 const std::vector<Polygon3>& blockers, double tol_G,
+                                 std::int64_t max_evaluations) {
+  const AnalyticEstimate e = pair_G(a, b, blockers, tol_G, max_evaluations, false);
+  if (e.converged || e.events == 0) return e;
+  // Unconverged with the rounded partition: again with the exact one (see RoundedCDT); the
+  // better of the two, with the point factors both spent.
+  AnalyticEstimate exact = pair_G(a, b, blockers, tol_G, max_evaluations, true);
+  exact.evaluations += e.evaluations;
+  exact.direct_evaluations += e.direct_evaluations;
+  if (exact.converged || exact.error <= e.error) return exact;
+  AnalyticEstimate out = e;
+  out.evaluations = exact.evaluations;
+  out.direct_evaluations = exact.direct_evaluations;
   return out;
 }
 

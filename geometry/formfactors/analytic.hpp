@@ -7,7 +7,9 @@
 // F_{dx->b, visible} is exact at every x up to rounding (b minus the cone from x over each
 // convex blocker piece, each cone the intersection of the half-planes of its edges' lines on
 // b's plane, split off in floating point into convex visible pieces; Lambert's contour
-// formula on each piece).
+// formula on each piece). Pieces that form a closed convex solid (a box's faces, also one
+// standing open on a plane both polygons stand on) give one cone, over the solid's
+// silhouette from x, and its faces turned away from all of a are dropped.
 // It is analytic in x except on the event lines where the visible polygon's combinatorics
 // change: for a vertex v and an edge e of two different objects (b, blockers) the points x
 // of a's plane on a line through v and e (EV events), the lines where a blocker's plane
@@ -31,7 +33,8 @@
 // calibrated, not merely an upper bound). The triangle with the largest estimate is split
 // into four until the estimates sum to at most the tolerance, or an evaluation budget is
 // spent (then `converged` is false). Cost: O(k² log k) event segments for k blockers, a
-// CDT of them, then about 100 point factors per triangle. Thread-safe (no shared state).
+// CDT of them, then about 50 point factors per triangle (orders 4 and 6). Thread-safe (no
+// shared state).
 
 #include <cstdint>
 #include <vector>
