@@ -192,6 +192,56 @@ void plan_section(const std::vector<long>& sizes) {
   }
 }
 
+// The adapt section (issue 35, item 7): floor L1 error of the patch constants against patch
+// count, uniform meshing (quads, what a plain run meshes) against --adapt (from the uniform
+// mesh of a quarter of the target, refined until the target), on the partial-shadow scene
+// and the sharper square_shadow_geometry, hybrid `samples` per pair.
+void adapt_section(const std::vector<long>& targets, int samples) {
+  std::printf("\nadaptive vs uniform (floor L1 error of the patch constants, hybrid %d samples)\n",
+              samples);
+  std::printf("%-14s %-9s %8s %12s %12s %12s %9s\n", "scene", "method", "patches", "L1 error",
+              "field L1", "line max", "seconds");
+  for (const std::string name : {"partial", "square"}) {
+    const PartialShadowGeometry g =
+        name == "partial" ? partial_shadow_geometry() : square_shadow_geometry();
+    const double line_y = name == "partial" ? 1.75 : 2.0;
+    const Scene scene = shadow_scene(g);
+    for (const long target : targets)
+      for (const std::string method : {"uniform", "adaptive"}) {
+        Timer t;
+        MeshOptions mo;
+        mo.target_patches = method == "adaptive" ? target / 4 : target;
+        LoadedScene loaded;
+        loaded.scene = scene;
+        loaded.mesh = mesh_scene(scene, mo);
+        Eigen::MatrixX3d B;
+        if (method == "adaptive") {
+          FormFactorArgs ff;
+          ff.estimator = "hybrid";
+          ff.set_param("--samples", samples);
+          RunArgs run;
+          run.quiet = true;
+          AdaptArgs a;
+          a.patches = target;
+          SolveOptions so;
+          so.tol = 1e-10;
+          FormFactors F;
+          RadiositySolution sol;
+          adapt_scene(loaded, ff, so, run, a, F, sol);
+          B = sol.B;
+        } else {
+          B = solve_mesh(loaded.mesh, samples).first;
+        }
+        const double seconds = t.seconds();
+        const PartialShadowErrors e =
+            shadow_errors(g, loaded.mesh, B, interpolate_to_vertices(loaded.mesh, B), line_y);
+        std::printf("%-14s %-9s %8d %12.4g %12.4g %12.4g %9.2f\n", name.c_str(), method.c_str(),
+                    loaded.mesh.size(), e.l1, e.field_l1, e.line, seconds);
+        std::fflush(stdout);
+      }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -270,6 +320,7 @@ int main(int argc, char** argv) {
       }
   }
   if (sections.find("plan") != std::string::npos) plan_section(sizes);
+  if (sections.find("adapt") != std::string::npos) adapt_section(targets, samples);
   if (!plot.empty() && !runs.empty()) {
     Plot l1{"partial shadow: floor L1 error", "patches", "error (W/m^2)", true, true, true, {}};
     Plot line{"partial shadow: max error on y = 1.75", "patches", "error (W/m^2)", true, true, true, {}};
