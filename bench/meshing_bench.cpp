@@ -233,8 +233,12 @@ void adapt_section(const std::vector<long>& targets, int samples) {
           B = solve_mesh(loaded.mesh, samples).first;
         }
         const double seconds = t.seconds();
-        const PartialShadowErrors e =
-            shadow_errors(g, loaded.mesh, B, interpolate_to_vertices(loaded.mesh, B), line_y);
+        // Shaded as `run` shades each (--vertex-interp auto).
+        const VertexField field =
+            interpolate_to_vertices(loaded.mesh, B,
+                                    method == "adaptive" ? VertexInterpolation::LinearFit
+                                                         : VertexInterpolation::Conservative);
+        const PartialShadowErrors e = shadow_errors(g, loaded.mesh, B, field, line_y);
         std::printf("%-14s %-9s %8d %12.4g %12.4g %12.4g %9.2f\n", name.c_str(), method.c_str(),
                     loaded.mesh.size(), e.l1, e.field_l1, e.line, seconds);
         std::fflush(stdout);

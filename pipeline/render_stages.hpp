@@ -37,8 +37,8 @@ struct ShadeArgs {
   bool wireframe = false;  ///< --wireframe: patch edges drawn over the shading
   int antialias = 2;
   std::string exposure = "auto";  ///< "auto" or EV stops
-  /// auto (exact-direct on a --discontinuity mesh with F, else conservative), conservative,
-  /// area or exact-direct (geometry/render/vertex_field.hpp)
+  /// auto (exact-direct on a --discontinuity mesh with F, linear on an --adapt mesh, else
+  /// conservative), conservative, area, linear or exact-direct (geometry/render/vertex_field.hpp)
   std::string vertex_interp = "auto";
 };
 /// The shading the options ask for: --shading, else flat with --flat, raytrace with
