@@ -29,7 +29,8 @@
 // each column, fitted as time ~ c n^p in log-log (bench/power_law.hpp).
 //
 // Usage: meshing_bench [--targets 300,1000,3000] [--samples 64] [--ref-patches 48000]
-//   [--sizes 10000,20000,40000,80000] [--sections shadow,cornell,plan] [--plot meshing.svg]
+//   [--sizes 10000,20000,40000,80000] [--sections shadow,cornell,plan,adapt] [--plot meshing.svg]
+// (adapt is not run by default).
 
 #include <Eigen/Geometry>
 #include <algorithm>
