@@ -7,10 +7,10 @@
 // and two errors against the exact field (partial_shadow_errors): L1, the area-mean
 // |B_i - B(x)| over the floor of the patch constants, and line, the largest |B_h(x) - B(x)|
 // of the Gouraud field at 400 points on the line y = 1.75 across umbra and penumbra, with
-// the vertex values `run` uses (exact direct light on discontinuity meshes, conservative
-// otherwise) and, in the last column, with conservative ones for every method. Adaptive runs start
-// from the uniform mesh of a quarter of the target and refine (pipeline/adapt_stage) until the
-// target.
+// the vertex values `run` uses (exact direct light on discontinuity meshes, the linear fit on
+// adapted ones, conservative otherwise) and, in the last column, with conservative ones for every
+// method. Adaptive runs start from the uniform mesh of a quarter of the target and refine
+// (pipeline/adapt_stage) until the target.
 //
 // Cornell box (built-in): per-surface average radiosity against a reference (uniform,
 // --ref-patches, gather 4096 rays) for uniform and discontinuity meshing (hybrid, 32
@@ -91,6 +91,25 @@ std::pair<Eigen::MatrixX3d, Eigen::MatrixX3d> solve_mesh(const PatchMesh& mesh, 
   return {B, I};
 }
 
+// Refines `loaded` by adapt_scene (hybrid, `samples` per pair) until `target` patches: B and
+// the indirect irradiance I = F (B - E) on the refined mesh.
+std::pair<Eigen::MatrixX3d, Eigen::MatrixX3d> adapt_mesh(LoadedScene& loaded, long target,
+                                                         int samples, bool quiet) {
+  FormFactorArgs ff;
+  ff.estimator = "hybrid";
+  ff.set_param("--samples", samples);
+  RunArgs run;
+  run.quiet = quiet;
+  AdaptArgs a;
+  a.patches = target;
+  SolveOptions so;
+  so.tol = 1e-10;
+  FormFactors F;
+  RadiositySolution sol;
+  adapt_scene(loaded, ff, so, run, a, F, sol);
+  return {sol.B, indirect_irradiance(loaded.mesh, F.F, sol.B)};
+}
+
 // Meshes and solves the partial-shadow scene one way (adaptive ways through adapt_scene).
 Run run_method(const Scene& scene, const std::string& method, long target, int samples) {
   Run r;
@@ -107,25 +126,16 @@ Run run_method(const Scene& scene, const std::string& method, long target, int s
   loaded.discontinuity = disc;
   Eigen::MatrixX3d B, I;
   if (adapt) {
-    FormFactorArgs ff;
-    ff.estimator = "hybrid";
-    ff.set_param("--samples", samples);
-    RunArgs run;
-    AdaptArgs a;
-    a.patches = target;
-    SolveOptions so;
-    so.tol = 1e-10;
-    FormFactors F;
-    RadiositySolution sol;
-    adapt_scene(loaded, ff, so, run, a, F, sol);
-    B = sol.B;
-    I = indirect_irradiance(loaded.mesh, F.F, B);
+    std::tie(B, I) = adapt_mesh(loaded, target, samples, false);
   } else {
     std::tie(B, I) = solve_mesh(loaded.mesh, samples);
   }
   // The vertex values `run` uses by default: exact direct light on discontinuity meshes.
-  const VertexField field = disc ? exact_direct_vertex_field(scene, loaded.mesh, B, I)
-                                 : interpolate_to_vertices(loaded.mesh, B);
+  const VertexField field =
+      disc ? exact_direct_vertex_field(scene, loaded.mesh, B, I)
+           : interpolate_to_vertices(
+                 loaded.mesh, B,
+                 adapt ? VertexInterpolation::LinearFit : VertexInterpolation::Conservative);
   r.seconds = t.seconds();
   r.patches = loaded.mesh.size();
   r.err = partial_shadow_errors(loaded.mesh, B, field);
@@ -217,19 +227,7 @@ void adapt_section(const std::vector<long>& targets, int samples) {
         loaded.mesh = mesh_scene(scene, mo);
         Eigen::MatrixX3d B;
         if (method == "adaptive") {
-          FormFactorArgs ff;
-          ff.estimator = "hybrid";
-          ff.set_param("--samples", samples);
-          RunArgs run;
-          run.quiet = true;
-          AdaptArgs a;
-          a.patches = target;
-          SolveOptions so;
-          so.tol = 1e-10;
-          FormFactors F;
-          RadiositySolution sol;
-          adapt_scene(loaded, ff, so, run, a, F, sol);
-          B = sol.B;
+          B = adapt_mesh(loaded, target, samples, true).first;
         } else {
           B = solve_mesh(loaded.mesh, samples).first;
         }
