@@ -213,6 +213,18 @@ std::int64_t connected_pairs(const SparseF& F, int threads) {
 
 }  // namespace
 
+std::vector<char> gather_direct_patches(const PatchMesh& mesh, std::int64_t rays) {
+  std::vector<char> emitter(mesh.patches.size(), 0);
+  std::int64_t count = 0;
+  for (size_t i = 0; i < emitter.size(); ++i)
+    if (mesh.patches[i].emission.maxCoeff() > 0.0) {
+      emitter[i] = 1;
+      ++count;
+    }
+  if (!gather_direct_pairs(count, mesh.size(), rays)) emitter.clear();
+  return emitter;
+}
+
 FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& options,
                            const Bvh& bvh) {
   if (options.gather.rays < 1) throw UsageError("--rays must be at least 1");
@@ -226,14 +238,12 @@ FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& optio
 
   // The direct light: with few emitting patches (gather_direct_pairs), every pair with an
   // emitter is estimated by the hybrid kernel instead of by the rays (gather.hpp).
-  std::vector<char> is_emitter(n, 0);
+  std::vector<char> is_emitter = gather_direct_patches(mesh, K);
+  const bool direct_pairs = !is_emitter.empty();
+  if (!direct_pairs) is_emitter.assign(n, 0);
   std::vector<std::int32_t> emitters;
   for (std::int32_t i = 0; i < n; ++i)
-    if (mesh.patches[i].emission.maxCoeff() > 0.0) {
-      is_emitter[i] = 1;
-      emitters.push_back(i);
-    }
-  const bool direct_pairs = gather_direct_pairs(static_cast<std::int64_t>(emitters.size()), n, K);
+    if (is_emitter[i]) emitters.push_back(i);
   std::vector<std::vector<RowEntry>> direct;        // row i's pairs with an emitter (G, var)
   std::vector<std::vector<RowEntry>> emitter_rows;  // an emitter's pairs with lower rows
   std::int64_t direct_rays = 0;

@@ -13,6 +13,7 @@
 // with an emitting patch) comes from the hybrid kernel when there are few emitters (below).
 
 #include <cstdint>
+#include <vector>
 
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/visibility/bvh.hpp"
@@ -36,6 +37,11 @@ constexpr int kGatherDirectSamples = 16;
 inline bool gather_direct_pairs(std::int64_t emitters, std::int64_t patches, std::int64_t rays) {
   return emitters > 0 && 8 * emitters <= patches && 4 * emitters <= rays;
 }
+
+/// The patches whose pairs gather estimates by the hybrid kernel with K rays per patch (the
+/// emitting ones, when gather_direct_pairs holds), one flag per patch; empty otherwise.
+/// Reciprocity averaging keeps those pairs as they are (reciprocity.hpp).
+std::vector<char> gather_direct_patches(const PatchMesh& mesh, std::int64_t rays);
 
 /// Estimator "gather": options.gather.rays rays per patch, in replicate_count(rays) independently
 /// shifted Kronecker point sets (replicates.hpp) whose spread gives the standard errors.

@@ -175,6 +175,19 @@ TEST(FormFactorGather, EmitterPairsAreHybridsAndClosedRowsStillSumToOne) {
       EXPECT_NEAR(g.F.coeff(i, j), hy.F.coeff(i, j), 1e-9 * hy.F.coeff(i, j)) << i << " " << j;
     }
   }
+  // Averaged (gather's default): the emitter pairs are held, the other pairs balanced around
+  // them, so every row keeps its own sum and the emitter entries stay the hybrid's. 1e-9:
+  // the balance meets its 1e-12 on the rows' free parts, but rows summing to 1 are left
+  // 1e-11 to 1e-10 below it here (measured; without held pairs 1e-11, EnclosedCube... above).
+  // Not investigated further (issue 35 item 7 notes); far below the estimator's error.
+  const FormFactors avg = gather(mesh, kRays, 3, "average", 1);
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    EXPECT_NEAR(row_sum(avg.F, i), std::min(row_sum(g.F, i), 1.0), 1e-9) << "row " << i;
+    for (std::int32_t j = 0; j < mesh.size(); ++j) {
+      if (!(emitter[i] || emitter[j]) || i == j) continue;
+      EXPECT_NEAR(avg.F.coeff(i, j), hy.F.coeff(i, j), 1e-9 * hy.F.coeff(i, j)) << i << " " << j;
+    }
+  }
   const FormFactors g3 = gather(mesh, kRays, 3, "none", 3);
   ASSERT_EQ(g3.F.nonZeros(), g.F.nonZeros());
   for (std::int64_t k = 0; k < g.F.nonZeros(); ++k) {
@@ -183,16 +196,14 @@ TEST(FormFactorGather, EmitterPairsAreHybridsAndClosedRowsStillSumToOne) {
   }
 }
 
-// The mottle of issue 35 item 7: with K = 1024 rays a floor patch saw the light through
-// some 50 of them (±10 % per patch, visible as blotches on the Cornell walls at 8,000
-// patches). Now the lit floor patches of the partial-shadow scene get their light factors
-// from the hybrid kernel: exact for unoccluded pairs, so they equal a hybrid run's to
-// rounding (1e-9 relative), not to ±10 %.
-TEST(FormFactorGather, DirectLightOfLitPatchesIsExactNotSampled) {
+namespace {
+
+// The lit floor patches' light factors from gather (with `reciprocity`) against hybrid's.
+void direct_light_of_lit_patches_is_exact(const std::string& reciprocity) {
   MeshOptions mo;
   mo.target_patches = 600;
   const PatchMesh mesh = mesh_scene(partial_shadow_scene(), mo);
-  const FormFactors g = gather(mesh, 1024);
+  const FormFactors g = gather(mesh, 1024, 1, reciprocity);
   FormFactorOptions ho;
   ho.estimator = "hybrid";
   ho.run.progress = false;
@@ -217,6 +228,21 @@ TEST(FormFactorGather, DirectLightOfLitPatchesIsExactNotSampled) {
     ++lit;
   }
   EXPECT_GT(lit, 50);
+}
+
+}  // namespace
+
+// The mottle of issue 35 item 7: with K = 1024 rays a floor patch saw the light through
+// some 50 of them (±10 % per patch, visible as blotches on the Cornell walls at 8,000
+// patches). Now the lit floor patches of the partial-shadow scene get their light factors
+// from the hybrid kernel: exact for unoccluded pairs, so they equal a hybrid run's to
+// rounding (1e-9 relative), not to ±10 %; also after reciprocity averaging (gather's
+// default), whose balance holds those pairs as they are.
+TEST(FormFactorGather, DirectLightOfLitPatchesIsExactNotSampled) {
+  for (const std::string reciprocity : {"none", "average"}) {
+    SCOPED_TRACE(reciprocity);
+    direct_light_of_lit_patches_is_exact(reciprocity);
+  }
 }
 
 TEST(FormFactorGather, BacksAndMissesCountForNothing) {
