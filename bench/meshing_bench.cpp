@@ -7,10 +7,10 @@
 // and two errors against the exact field (partial_shadow_errors): L1, the area-mean
 // |B_i - B(x)| over the floor of the patch constants, and line, the largest |B_h(x) - B(x)|
 // of the Gouraud field at 400 points on the line y = 1.75 across umbra and penumbra, with
-// the vertex values `run` uses (exact direct light on discontinuity meshes, conservative
-// otherwise) and, in the last column, with conservative ones for every method. Adaptive runs start
-// from the uniform mesh of a quarter of the target and refine (pipeline/adapt_stage) until the
-// target.
+// the vertex values `run` uses (exact direct light on discontinuity meshes, the linear fit on
+// adapted ones, conservative otherwise) and, in the last column, with conservative ones for every
+// method. Adaptive runs start from the uniform mesh of a quarter of the target and refine
+// (pipeline/adapt_stage) until the target.
 //
 // Cornell box (built-in): per-surface average radiosity against a reference (uniform,
 // --ref-patches, gather 4096 rays) for uniform and discontinuity meshing (hybrid, 32
@@ -29,7 +29,8 @@
 // each column, fitted as time ~ c n^p in log-log (bench/power_law.hpp).
 //
 // Usage: meshing_bench [--targets 300,1000,3000] [--samples 64] [--ref-patches 48000]
-//   [--sizes 10000,20000,40000,80000] [--sections shadow,cornell,plan] [--plot meshing.svg]
+//   [--sizes 10000,20000,40000,80000] [--sections shadow,cornell,plan,adapt] [--plot meshing.svg]
+// (adapt is not run by default).
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -90,6 +91,25 @@ std::pair<Eigen::MatrixX3d, Eigen::MatrixX3d> solve_mesh(const PatchMesh& mesh, 
   return {B, I};
 }
 
+// Refines `loaded` by adapt_scene (hybrid, `samples` per pair) until `target` patches: B and
+// the indirect irradiance I = F (B - E) on the refined mesh.
+std::pair<Eigen::MatrixX3d, Eigen::MatrixX3d> adapt_mesh(LoadedScene& loaded, long target,
+                                                         int samples, bool quiet) {
+  FormFactorArgs ff;
+  ff.estimator = "hybrid";
+  ff.set_param("--samples", samples);
+  RunArgs run;
+  run.quiet = quiet;
+  AdaptArgs a;
+  a.patches = target;
+  SolveOptions so;
+  so.tol = 1e-10;
+  FormFactors F;
+  RadiositySolution sol;
+  adapt_scene(loaded, ff, so, run, a, F, sol);
+  return {sol.B, indirect_irradiance(loaded.mesh, F.F, sol.B)};
+}
+
 // Meshes and solves the partial-shadow scene one way (adaptive ways through adapt_scene).
 Run run_method(const Scene& scene, const std::string& method, long target, int samples) {
   Run r;
@@ -106,25 +126,16 @@ Run run_method(const Scene& scene, const std::string& method, long target, int s
   loaded.discontinuity = disc;
   Eigen::MatrixX3d B, I;
   if (adapt) {
-    FormFactorArgs ff;
-    ff.estimator = "hybrid";
-    ff.set_param("--samples", samples);
-    RunArgs run;
-    AdaptArgs a;
-    a.patches = target;
-    SolveOptions so;
-    so.tol = 1e-10;
-    FormFactors F;
-    RadiositySolution sol;
-    adapt_scene(loaded, ff, so, run, a, F, sol);
-    B = sol.B;
-    I = indirect_irradiance(loaded.mesh, F.F, B);
+    std::tie(B, I) = adapt_mesh(loaded, target, samples, false);
   } else {
     std::tie(B, I) = solve_mesh(loaded.mesh, samples);
   }
   // The vertex values `run` uses by default: exact direct light on discontinuity meshes.
-  const VertexField field = disc ? exact_direct_vertex_field(scene, loaded.mesh, B, I)
-                                 : interpolate_to_vertices(loaded.mesh, B);
+  const VertexField field =
+      disc ? exact_direct_vertex_field(scene, loaded.mesh, B, I)
+           : interpolate_to_vertices(
+                 loaded.mesh, B,
+                 adapt ? VertexInterpolation::LinearFit : VertexInterpolation::Conservative);
   r.seconds = t.seconds();
   r.patches = loaded.mesh.size();
   r.err = partial_shadow_errors(loaded.mesh, B, field);
@@ -189,6 +200,48 @@ void plan_section(const std::vector<long>& sizes) {
     std::printf(
         "cost exponent (time ~ n^p) %-8s plan 2000 p %5.2f  plan n p %5.2f  plan+mesh n p %5.2f\n",
         family.c_str(), fit_power_law(coarse).p, fit_power_law(fine).p, fit_power_law(meshed).p);
+  }
+}
+
+// The adapt section (issue 35, item 7): floor L1 error of the patch constants against patch
+// count, uniform meshing (quads, what a plain run meshes) against --adapt (from the uniform
+// mesh of a quarter of the target, refined until the target), on the partial-shadow scene
+// and the sharper square_shadow_geometry, hybrid `samples` per pair.
+void adapt_section(const std::vector<long>& targets, int samples) {
+  std::printf("\nadaptive vs uniform (floor L1 error of the patch constants, hybrid %d samples)\n",
+              samples);
+  std::printf("%-14s %-9s %8s %12s %12s %12s %9s\n", "scene", "method", "patches", "L1 error",
+              "field L1", "line max", "seconds");
+  for (const std::string name : {"partial", "square"}) {
+    const PartialShadowGeometry g =
+        name == "partial" ? partial_shadow_geometry() : square_shadow_geometry();
+    const double line_y = name == "partial" ? 1.75 : 2.0;
+    const Scene scene = shadow_scene(g);
+    for (const long target : targets)
+      for (const std::string method : {"uniform", "adaptive"}) {
+        Timer t;
+        MeshOptions mo;
+        mo.target_patches = method == "adaptive" ? target / 4 : target;
+        LoadedScene loaded;
+        loaded.scene = scene;
+        loaded.mesh = mesh_scene(scene, mo);
+        Eigen::MatrixX3d B;
+        if (method == "adaptive") {
+          B = adapt_mesh(loaded, target, samples, true).first;
+        } else {
+          B = solve_mesh(loaded.mesh, samples).first;
+        }
+        const double seconds = t.seconds();
+        // Shaded as `run` shades each (--vertex-interp auto).
+        const VertexField field =
+            interpolate_to_vertices(loaded.mesh, B,
+                                    method == "adaptive" ? VertexInterpolation::LinearFit
+                                                         : VertexInterpolation::Conservative);
+        const PartialShadowErrors e = shadow_errors(g, loaded.mesh, B, field, line_y);
+        std::printf("%-14s %-9s %8d %12.4g %12.4g %12.4g %9.2f\n", name.c_str(), method.c_str(),
+                    loaded.mesh.size(), e.l1, e.field_l1, e.line, seconds);
+        std::fflush(stdout);
+      }
   }
 }
 
@@ -270,6 +323,7 @@ int main(int argc, char** argv) {
       }
   }
   if (sections.find("plan") != std::string::npos) plan_section(sizes);
+  if (sections.find("adapt") != std::string::npos) adapt_section(targets, samples);
   if (!plot.empty() && !runs.empty()) {
     Plot l1{"partial shadow: floor L1 error", "patches", "error (W/m^2)", true, true, true, {}};
     Plot line{"partial shadow: max error on y = 1.75", "patches", "error (W/m^2)", true, true, true, {}};

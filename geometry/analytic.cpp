@@ -21,8 +21,17 @@ PartialShadowGeometry partial_shadow_geometry() {
   return g;
 }
 
-Scene partial_shadow_scene() {
-  const PartialShadowGeometry g = partial_shadow_geometry();
+PartialShadowGeometry square_shadow_geometry() {
+  PartialShadowGeometry g;
+  g.floor = {{0, 0, 0}, {4, 0, 0}, {4, 4, 0}, {0, 4, 0}};                          // faces +z
+  g.light = {{1.75, 1.75, 3}, {1.75, 2.25, 3}, {2.25, 2.25, 3}, {2.25, 1.75, 3}};  // faces -z
+  g.blocker = {{1.4, 1.4, 1}, {2.4, 1.4, 1}, {2.4, 2.4, 1}, {1.4, 2.4, 1}};        // faces +z
+  return g;
+}
+
+Scene partial_shadow_scene() { return shadow_scene(partial_shadow_geometry()); }
+
+Scene shadow_scene(const PartialShadowGeometry& g) {
   Scene s;
   add_polygon(s, "floor", grey(), g.floor);
   add_polygon(s, "light", {"light", Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()}, g.light);
@@ -49,6 +58,10 @@ std::pair<std::vector<double>, std::vector<double>> partial_shadow_lines() {
 
 double partial_shadow_floor_radiosity(const Eigen::Vector3d& x) {
   static const PartialShadowGeometry g = partial_shadow_geometry();
+  return shadow_floor_radiosity(g, x);
+}
+
+double shadow_floor_radiosity(const PartialShadowGeometry& g, const Eigen::Vector3d& x) {
   return 0.5 * shadowed_point_factor(x, Eigen::Vector3d::UnitZ(), g.light, {g.blocker});
 }
 
@@ -89,6 +102,14 @@ bool inside_patch(const PatchMesh& m, const Patch& p, const Eigen::Vector3d& x) 
 
 PartialShadowErrors partial_shadow_errors(const PatchMesh& m, const Eigen::MatrixX3d& B,
                                           const VertexField& field) {
+  static const PartialShadowGeometry g = partial_shadow_geometry();
+  return shadow_errors(g, m, B, field, 1.75);
+}
+
+PartialShadowErrors shadow_errors(const PartialShadowGeometry& g, const PatchMesh& m,
+                                  const Eigen::MatrixX3d& B, const VertexField& field,
+                                  double line_y) {
+  const auto exact = [&](const Eigen::Vector3d& x) { return shadow_floor_radiosity(g, x); };
   PartialShadowErrors e;
   double area = 0;
   for (std::int32_t i = 0; i < m.size(); ++i) {
@@ -102,28 +123,38 @@ PartialShadowErrors partial_shadow_errors(const PatchMesh& m, const Eigen::Matri
       // Midpoint rule on the 16 similar sub-triangles (centroids of the 10 upright and 6
       // inverted ones): its own error is O(h²/16 B''), below the O(h B') measured.
       const int n = 4;
-      double err = 0;
+      double err = 0, field_err = 0;
+      auto add = [&](const Eigen::Vector3d& x) {
+        const double bx = exact(x);
+        err += std::abs(bi - bx);
+        const auto w = patch_weights(m, i, x);
+        double f = 0;
+        for (int k = 0; k < p.vertex_count; ++k)
+          f += w[k] * field.values.row(field.patch_corners[i][k]).mean();
+        field_err += std::abs(f - bx);
+      };
       for (int u = 0; u < n; ++u)
         for (int v = 0; u + v < n; ++v) {
           const Eigen::Vector3d o = a + (b - a) * u / n + (c - a) * v / n;
-          err += std::abs(bi - partial_shadow_floor_radiosity(o + ((b - a) + (c - a)) / (3.0 * n)));
-          if (u + v < n - 1)
-            err += std::abs(bi - partial_shadow_floor_radiosity(o + (2.0 * (b - a) + 2.0 * (c - a)) / (3.0 * n)));
+          add(o + ((b - a) + (c - a)) / (3.0 * n));
+          if (u + v < n - 1) add(o + (2.0 * (b - a) + 2.0 * (c - a)) / (3.0 * n));
         }
       e.l1 += A * err / (n * n);
+      e.field_l1 += A * field_err / (n * n);
       area += A;
     }
   }
   e.l1 /= area;
+  e.field_l1 /= area;
   for (int k = 0; k < 400; ++k) {
-    const Eigen::Vector3d x(0.2 + 3.6 * (k + 0.5) / 400, 1.75, 0);
+    const Eigen::Vector3d x(0.2 + 3.6 * (k + 0.5) / 400, line_y, 0);
     for (std::int32_t i = 0; i < m.size(); ++i) {
       const Patch& p = m.patches[i];
       if (m.surface_names[p.surface] != "floor" || !inside_patch(m, p, x)) continue;
       const auto w = patch_weights(m, i, x);
       double value = 0;
       for (int c = 0; c < p.vertex_count; ++c) value += w[c] * field.values.row(field.patch_corners[i][c]).mean();
-      e.line = std::max(e.line, std::abs(value - partial_shadow_floor_radiosity(x)));
+      e.line = std::max(e.line, std::abs(value - exact(x)));
       break;
     }
   }

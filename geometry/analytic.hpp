@@ -56,6 +56,15 @@ struct PartialShadowGeometry {
   std::vector<Eigen::Vector3d> light, blocker, floor;
 };
 PartialShadowGeometry partial_shadow_geometry();
+/// A sharper soft shadow: the same floor, a 0.5 x 0.5 light [1.75, 2.25]² at z = 3 and a
+/// 1 x 1 blocker [1.4, 2.4]² at z = 1 (off centre by 0.1): penumbrae 0.25 wide (light size x
+/// h_b / (H - h_b)) around a 1.25 x 1.25 umbra, the rest of the floor smoothly lit.
+PartialShadowGeometry square_shadow_geometry();
+/// The scene of a floor (z = 0, faces +z, rho 0.5), a light (faces -z, rho 0, E = 1) and a
+/// black blocker (faces +z): only the floor reflects and it cannot see itself, so its
+/// radiosity is exactly 0.5 x shadowed_point_factor (partial_shadow_scene is
+/// shadow_scene(partial_shadow_geometry())).
+Scene shadow_scene(const PartialShadowGeometry& g);
 /// The positions c of its D1/D2 lines on the floor, in x (first) and y (second): every
 /// light corner coordinate projected through every blocker edge coordinate,
 /// s + (b - s) H / (H - h_b), that falls inside the floor.
@@ -64,6 +73,8 @@ std::pair<std::vector<double>, std::vector<double>> partial_shadow_lines();
 /// The exact floor radiosity of partial_shadow_scene at a floor point x (z = 0):
 /// 0.5 x shadowed_point_factor(x, +z, light, {blocker}).
 double partial_shadow_floor_radiosity(const Eigen::Vector3d& x);
+/// The same on shadow_scene(g): 0.5 x shadowed_point_factor(x, +z, g.light, {g.blocker}).
+double shadow_floor_radiosity(const PartialShadowGeometry& g, const Eigen::Vector3d& x);
 /// The exact occluded surface factor F_{floor->light} of partial_shadow_scene: the floor
 /// cut along every line of partial_shadow_lines into rectangles inside which the visible
 /// part of the light changes smoothly, each integrated by a tensor Gauss-Legendre rule of
@@ -75,12 +86,17 @@ double partial_shadow_floor_light_factor(int order = 16);
 struct PartialShadowErrors {
   double l1 = 0.0;    ///< area-mean |B_i - B(x)| of the patch constants (midpoint rule, 16 per triangle)
   double line = 0.0;  ///< largest |f(x) - B(x)| of the interpolated vertex field f on y = 1.75
+  double field_l1 = 0.0;  ///< area-mean |f(x) - B(x)| of the interpolated field (same rule as l1)
 };
 /// `B` (N x 3, its channel mean is used) and its vertex field on a mesh of
 /// partial_shadow_scene: both errors. The line crosses the umbra and both penumbrae in x,
 /// 0.05 from the umbra's edge y = 1.7 (400 points on x in [0.2, 3.8]).
 PartialShadowErrors partial_shadow_errors(const PatchMesh& mesh, const Eigen::MatrixX3d& B,
                                           const VertexField& field);
+/// The same on shadow_scene(g), the line at y = line_y.
+PartialShadowErrors shadow_errors(const PartialShadowGeometry& g, const PatchMesh& mesh,
+                                  const Eigen::MatrixX3d& B, const VertexField& field,
+                                  double line_y);
 
 /// An analytic case: its scene and the exact factor from surface "a" to surface "b".
 struct AnalyticCase {

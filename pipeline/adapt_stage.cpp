@@ -38,6 +38,7 @@ std::vector<AdaptRound> adapt_scene(LoadedScene& scene, const FormFactorArgs& ff
   const int rounds = adapt.rounds > 0 ? adapt.rounds : kAdaptMaxRounds;
   // Bisection needs triangles: quads are split first (the round-0 mesh).
   scene.mesh = triangulate_quads(scene.mesh).mesh;
+  scene.adapted = true;
   scene.bvh.reset();
   FormFactorOptions fo =
       resolve_form_factor_options(make_ff_options(ff_args, run), scene.mesh.size());
@@ -50,13 +51,16 @@ std::vector<AdaptRound> adapt_scene(LoadedScene& scene, const FormFactorArgs& ff
   solution = solve_on(scene, ff, so, run);
   std::int64_t changed_now = scene.mesh.size();  // patches whose factors this round computed
   for (int round = 0;; ++round) {
-    // A discontinuity mesh is shaded with exact direct light at its vertices: its error is
-    // that field's (interpolation of H_d, jumps of the indirect part), not the constants'.
+    // The error of the field that is shaded: on a discontinuity mesh exact direct light at
+    // the vertices (interpolation of H_d, jumps of the indirect part), otherwise the
+    // interpolated B (its mismatch with the constants, not their jumps: refining by jumps
+    // spent the patches on slopes a linear interpolant already follows, and the Gouraud
+    // field of the adapted mesh erred twice as much as uniform meshing's, issue 35 item 7).
     const std::vector<double> e =
         scene.discontinuity ? exact_direct_patch_errors(
                                   scene.scene, scene.mesh,
                                   indirect_irradiance(scene.mesh, ff.F, solution.B), run.threads)
-                            : patch_errors(scene.mesh, solution.B);
+                            : field_patch_errors(scene.mesh, solution.B);
     AdaptRound r;
     r.round = round;
     r.patches = scene.mesh.size();

@@ -79,6 +79,7 @@ struct LoadedScene {
   PatchMesh mesh;
   double max_edge = 0.0;       ///< the --max-edge actually used (0 = one element per face)
   bool discontinuity = false;  ///< meshed with --discontinuity (edges on the shadow lines)
+  bool adapted = false;        ///< refined by --adapt / --adapt-patches (a graded mesh)
   /// The mesh's BVH, built on first use by scene_bvh and shared by every stage of a run.
   mutable std::shared_ptr<const Bvh> bvh;
   /// The patches' mean sun irradiance, computed on first use by sun_patch_part

@@ -501,12 +501,14 @@ std::vector<OptionSpec> make_specs() {
                   "K: K x K stratified samples per pixel"));
   add_row(text("--exposure", "EV|auto", exposure_error, shade.exposure,
                "PNG/PLY exposure in stops (pixel x 2^EV), or auto (key value 0.36)"));
-  add_row(choice("--vertex-interp", {"auto", "conservative", "area", "exact-direct"},
+  add_row(choice("--vertex-interp", {"auto", "conservative", "area", "linear", "exact-direct"},
                  shade.vertex_interp,
                  "Per-vertex reconstruction: conservative (area-weighted, rescaled per surface "
-                 "to conserve power), area (area-weighted only), exact-direct (exact direct "
-                 "light at each vertex plus the area-weighted indirect light), or auto "
-                 "(exact-direct on a --discontinuity mesh, else conservative)"));
+                 "to conserve power), area (area-weighted only), linear (local linear fit of "
+                 "the patches around the vertex, rescaled like conservative), exact-direct "
+                 "(exact direct light at each vertex plus the area-weighted indirect light), "
+                 "or auto (exact-direct on a --discontinuity mesh, linear on an --adapt mesh, "
+                 "else conservative)"));
   add_row(integer("--direct-rays", 0, 1024, "",
                   "N: the emitters' direct light drawn per pixel with N shadow rays per pixel "
                   "sample (crisp shadows; exact where a light is all seen or all hidden) over "

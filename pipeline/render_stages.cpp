@@ -216,8 +216,8 @@ std::string resolve_vertex_interp(const ShadeArgs& args, const LoadedScene& scen
         "--sky or --sun light this scene: use conservative");
   if (args.vertex_interp != "auto") return args.vertex_interp;
   if (scene.scene.daylight.any()) return "conservative";
-  return scene.discontinuity && indirect && !scene.mesh.has_specular() ? "exact-direct"
-                                                                       : "conservative";
+  if (scene.discontinuity && indirect && !scene.mesh.has_specular()) return "exact-direct";
+  return scene.adapted ? "linear" : "conservative";
 }
 
 ShadedField shade_vertices(const LoadedScene& scene, const Eigen::MatrixX3d& B,

@@ -40,8 +40,8 @@ struct ShadeArgs {
   bool wireframe = false;  ///< --wireframe: patch edges drawn over the shading
   int antialias = 2;
   std::string exposure = "auto";  ///< "auto" or EV stops
-  /// auto (exact-direct on a --discontinuity mesh with F, else conservative), conservative,
-  /// area or exact-direct (geometry/render/vertex_field.hpp)
+  /// auto (exact-direct on a --discontinuity mesh with F, linear on an --adapt mesh, else
+  /// conservative), conservative, area, linear or exact-direct (geometry/render/vertex_field.hpp)
   std::string vertex_interp = "auto";
   /// --direct-rays N: shadow rays per pixel sample for the emitters' direct light, drawn per
   /// pixel on Gouraud images (geometry/render/pixel_direct.hpp); 0 = from the vertices like

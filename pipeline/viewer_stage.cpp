@@ -36,7 +36,10 @@ GlbContent viewer_glb(const ViewerInputs& in, double* linearity_error) {
   // The solution's vertex values and the per-surface rescale the bases share.
   std::vector<SurfacePower> power = in.shaded.power;
   Eigen::MatrixX3d solution = field.values;
-  if (in.shaded.interpolation == "exact-direct")
+  // Exact direct light and the linear fit are not linear in the lights: the viewer's bases
+  // (which it sums) are conservative ones.
+  const bool own = in.shaded.interpolation == "exact-direct" || in.shaded.interpolation == "linear";
+  if (own)
     solution =
         interpolate_to_vertices(mesh, in.B, VertexInterpolation::Conservative, &power).values;
 
@@ -94,15 +97,13 @@ GlbContent viewer_glb(const ViewerInputs& in, double* linearity_error) {
   gc.znear = 1e-4 * mesh.scale;
   c.camera = gc;
 
-  Json lambert = {
-      {"quantity", "radiosity"},
-      {"units", "W/m^2 of the scene's length unit; radiance shown = B / pi"},
-      {"interpolation",
-       in.shaded.interpolation == "exact-direct" ? "conservative" : in.shaded.interpolation},
-      {"exposure_ev", in.ev},
-      {"scene", in.scene},
-      {"settings", in.settings},
-      {"emitters", emitters}};
+  Json lambert = {{"quantity", "radiosity"},
+                  {"units", "W/m^2 of the scene's length unit; radiance shown = B / pi"},
+                  {"interpolation", own ? "conservative" : in.shaded.interpolation},
+                  {"exposure_ev", in.ev},
+                  {"scene", in.scene},
+                  {"settings", in.settings},
+                  {"emitters", emitters}};
   if (const Daylight& light = in.daylight; light.has_sky())
     lambert["sky_radiance"] = {light.sky[0], light.sky[1], light.sky[2]};
   if (in.bases.empty())

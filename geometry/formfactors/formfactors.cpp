@@ -545,8 +545,11 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
     std::vector<double> areas(mesh.patches.size());
     for (size_t i = 0; i < areas.size(); ++i) areas[i] = mesh.patches[i].area;
     out.F.makeCompressed();
+    const std::vector<char> kept = o.estimator == "gather"
+                                       ? ff::gather_direct_patches(mesh, o.gather.rays)
+                                       : std::vector<char>{};
     ff::average_reciprocal(out.F, o.run.with_stderr ? &out.stderr_F : nullptr, areas, out.stats,
-                           o.run.threads);
+                           o.run.threads, &kept);
     if (o.estimator == "gather") {  // its pairs: those connected either way = the pattern's
       const std::int64_t n = mesh.size();
       out.stats.pairs_tested = out.F.nonZeros() / 2;

@@ -32,6 +32,7 @@
 #include "geometry/formfactors/assembly.hpp"
 #include "geometry/formfactors/constants.hpp"
 #include "geometry/formfactors/kernels.hpp"
+#include "geometry/formfactors/pairwise.hpp"
 #include "geometry/formfactors/replicates.hpp"
 
 namespace lambert::ff {
@@ -110,6 +111,84 @@ void row_from_hits(std::vector<Hit>& hits, int K, bool with_err, std::vector<dou
   }
 }
 
+// The emitter pairs (direct light) by the hybrid kernel, G_ij for every pair with an
+// emitter: direct[i] holds (j, G_ij, var) for the emitters j of row i (for an emitter i,
+// those j > i), rows computed in parallel, each pair once with its own stream
+// hash_keys(seed, i, j) (bitwise the same for any thread count). With `only`, the pairs
+// with a flagged patch. Returns the rays traced.
+std::int64_t emitter_pairs(const std::vector<PatchGeom>& geom, const Bvh& bvh,
+                           const std::vector<std::int32_t>& emitters,
+                           const std::vector<char>& is_emitter, const FormFactorOptions& options,
+                           double offset, double plane_eps,
+                           std::vector<std::vector<RowEntry>>& direct) {
+  const auto n = static_cast<std::int32_t>(geom.size());
+  const PairContext ctx{geom, bvh, kGatherDirectSamples, options.run.seed, offset};
+  const std::vector<char>& only = options.subset.only;
+  direct.assign(n, {});
+  std::vector<std::int64_t> rays(n, 0);
+  parallel_for(n, 64, options.run.threads, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t r = begin; r < end; ++r) {
+      const auto i = static_cast<std::int32_t>(r);
+      for (const std::int32_t j : emitters) {
+        if (j == i || (is_emitter[i] && j < i)) continue;
+        if (!only.empty() && !only[i] && !only[j]) continue;
+        if (!can_exchange(geom[i], geom[j], plane_eps)) continue;
+        const PairEstimate e = estimate_hybrid(ctx, std::min(i, j), std::max(i, j));
+        rays[i] += e.rays;
+        if (e.G > 0.0) direct[i].push_back({j, e.G, e.var});
+      }
+    }
+  });
+  std::int64_t total = 0;
+  for (const std::int64_t k : rays) total += k;
+  return total;
+}
+
+// Row i with the emitter pairs: an emitter's row is its pairs alone (G / A_i, errors
+// sqrt(var) / A_i); another row traces its K rays, drops the hits on emitters and scales
+// the rest by s = (1 - h_i) / (1 - f_E), h_i = Σ_emitters G_ij / A_i the emitters' exact
+// share of its cosine-weighted hemisphere and f_E the rays' share that hit them: the rays
+// that miss the emitters sample the rest of the hemisphere, whose measure is 1 - h_i (a
+// ratio estimator: consistent, and a closed scene's row still sums to 1 exactly).
+void direct_row(const std::vector<PatchGeom>& geom, const std::vector<Eigen::Vector3d>& normals,
+                const Bvh& bvh, std::int32_t i, int K, const FormFactorOptions& options,
+                double offset, const std::vector<char>& is_emitter,
+                const std::vector<RowEntry>& pairs, const std::vector<RowEntry>& column_pairs,
+                std::vector<Hit>& hits, std::vector<double>& acc,
+                std::vector<std::int32_t>& touched, std::vector<RowEntry>& row) {
+  const double area = geom[i].area;
+  auto entry = [&](const RowEntry& p) {
+    return RowEntry{p.col, p.value / area, std::sqrt(std::max(0.0, p.err)) / area};
+  };
+  row.clear();
+  if (is_emitter[i]) {
+    for (const RowEntry& p : column_pairs) row.push_back(entry(p));
+    for (const RowEntry& p : pairs) row.push_back(entry(p));
+  } else {
+    trace_row(geom, normals, bvh, i, K, options.run.seed, offset, hits);
+    double f_e = 0.0;
+    for (const Hit& h : hits)
+      if (is_emitter[h.j]) f_e += h.w;
+    f_e /= K;
+    hits.erase(std::remove_if(hits.begin(), hits.end(),
+                              [&](const Hit& h) { return is_emitter[h.j] != 0; }),
+               hits.end());
+    row_from_hits(hits, K, options.run.with_stderr, acc, touched, row);
+    double h_i = 0.0;
+    for (const RowEntry& p : pairs) h_i += p.value / area;
+    const double s = f_e < 1.0 ? std::max(0.0, 1.0 - h_i) / (1.0 - f_e) : 1.0;
+    for (RowEntry& e : row) {
+      e.value *= s;
+      e.err *= s;
+    }
+    for (const RowEntry& p : pairs) row.push_back(entry(p));
+  }
+  std::sort(row.begin(), row.end(),
+            [](const RowEntry& a, const RowEntry& b) { return a.col < b.col; });
+  if (!options.run.with_stderr)
+    for (RowEntry& e : row) e.err = 0.0;
+}
+
 // Unordered pairs with an entry on at least one side: every upper entry, plus the lower
 // entries whose mirror is absent (binary search in the mirror's sorted row). O(nnz log).
 std::int64_t connected_pairs(const SparseF& F, int threads) {
@@ -134,6 +213,18 @@ std::int64_t connected_pairs(const SparseF& F, int threads) {
 
 }  // namespace
 
+std::vector<char> gather_direct_patches(const PatchMesh& mesh, std::int64_t rays) {
+  std::vector<char> emitter(mesh.patches.size(), 0);
+  std::int64_t count = 0;
+  for (size_t i = 0; i < emitter.size(); ++i)
+    if (mesh.patches[i].emission.maxCoeff() > 0.0) {
+      emitter[i] = 1;
+      ++count;
+    }
+  if (!gather_direct_pairs(count, mesh.size(), rays)) emitter.clear();
+  return emitter;
+}
+
 FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& options,
                            const Bvh& bvh) {
   if (options.gather.rays < 1) throw UsageError("--rays must be at least 1");
@@ -145,9 +236,29 @@ FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& optio
   std::vector<Eigen::Vector3d> normals(n);
   for (std::int32_t i = 0; i < n; ++i) normals[i] = geom[i].normal;
 
-  // Rows have at most min(K, n - 1) entries; reciprocity averaging may add each entry's
-  // mirror, in place, so its room is reserved too (address space: see assembly.hpp).
-  const double row_max = std::min<double>(K, n - 1.0);
+  // The direct light: with few emitting patches (gather_direct_pairs), every pair with an
+  // emitter is estimated by the hybrid kernel instead of by the rays (gather.hpp).
+  std::vector<char> is_emitter = gather_direct_patches(mesh, K);
+  const bool direct_pairs = !is_emitter.empty();
+  if (!direct_pairs) is_emitter.assign(n, 0);
+  std::vector<std::int32_t> emitters;
+  for (std::int32_t i = 0; i < n; ++i)
+    if (is_emitter[i]) emitters.push_back(i);
+  std::vector<std::vector<RowEntry>> direct;        // row i's pairs with an emitter (G, var)
+  std::vector<std::vector<RowEntry>> emitter_rows;  // an emitter's pairs with lower rows
+  std::int64_t direct_rays = 0;
+  if (direct_pairs) {
+    direct_rays = emitter_pairs(geom, bvh, emitters, is_emitter, options, offset,
+                                kPlaneEps * mesh.scale, direct);
+    emitter_rows.resize(n);
+    for (std::int32_t i = 0; i < n; ++i)
+      for (const RowEntry& e : direct[i]) emitter_rows[e.col].push_back({i, e.value, e.err});
+  }
+  // Rows have at most min(K, n - 1) entries (and their emitters'); reciprocity averaging may
+  // add each entry's mirror, in place, so its room is reserved too (address space: see
+  // assembly.hpp).
+  const double row_max =
+      std::min<double>(K + (direct_pairs ? static_cast<double>(emitters.size()) : 0.0), n - 1.0);
   const double room = std::min(static_cast<double>(n) * (n - 1.0),
                                (options.reciprocity == "average" ? 2.0 : 1.0) * n * row_max);
   CsrAppender csr(n, static_cast<std::int64_t>(room), options.run.with_stderr);
@@ -170,9 +281,15 @@ FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& optio
           rows[r].clear();
           continue;
         }
-        trace_row(geom, normals, bvh, i, K, options.run.seed, offset, hits);
-        row_from_hits(hits, K, options.run.with_stderr, acc, touched, rows[r]);
-        progress.advance(1, K);
+        if (!direct_pairs) {
+          trace_row(geom, normals, bvh, i, K, options.run.seed, offset, hits);
+          row_from_hits(hits, K, options.run.with_stderr, acc, touched, rows[r]);
+          progress.advance(1, K);
+          continue;
+        }
+        direct_row(geom, normals, bvh, i, K, options, offset, is_emitter, direct[i],
+                   emitter_rows[i], hits, acc, touched, rows[r]);
+        progress.advance(1, is_emitter[i] ? 0 : K);
       }
     });
     for (std::int32_t r = 0; r < count; ++r) csr.append_row(rows[r]);
@@ -188,7 +305,10 @@ FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& optio
     out.stats.pairs_tested = connected_pairs(out.F, options.run.threads);
     out.stats.pairs_culled = static_cast<std::int64_t>(n) * (n - 1) / 2 - out.stats.pairs_tested;
   }
-  out.stats.rays = static_cast<std::int64_t>(n) * K;
+  out.stats.rays = static_cast<std::int64_t>(
+                       n - (direct_pairs ? static_cast<std::int32_t>(emitters.size()) : 0)) *
+                       K +
+                   direct_rays;
   out.stats.seconds = timer.seconds();
   return out;
 }

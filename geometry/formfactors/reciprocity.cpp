@@ -166,40 +166,48 @@ void merge_runs(SparseF& F, SparseF* S, const std::vector<std::int64_t>& old,
 }
 
 // Σ_j H_ij d_j for every row (rows in parallel; each row summed in order: deterministic).
-void weighted_row_sums(const SparseF& H, const std::vector<double>& d, int threads,
-                       std::vector<double>& c) {
+void weighted_row_sums(const SparseF& H, const std::vector<double>& d, const char* kept,
+                       int threads, std::vector<double>& c, std::vector<double>& fixed) {
   const Index* outer = H.outerIndexPtr();
   const Index* col = H.innerIndexPtr();
   const double* val = H.valuePtr();
   parallel_for(H.rows(), 1024, threads, [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
-      double s = 0.0;
-      for (std::int64_t k = outer[i]; k < outer[i + 1]; ++k) s += val[k] * d[col[k]];
+      double s = 0.0, f = 0.0;
+      for (std::int64_t k = outer[i]; k < outer[i + 1]; ++k) {
+        if (kept && (kept[i] || kept[col[k]]))
+          f += val[k];
+        else
+          s += val[k] * d[col[k]];
+      }
       c[i] = s;
+      fixed[i] = f;
     }
   });
 }
 
-// The symmetric balancing of reciprocity.hpp: d with Σ_j d_i d_j H_ij = A_i t_i for the rows
-// with a target, by the damped symmetric Sinkhorn-Knopp update (Knight 2008)
-// d_i ← sqrt(d_i A_i t_i / Σ_j H_ij d_j), d_i clamped to [1/kMaxScale, kMaxScale].
+// The symmetric balancing of reciprocity.hpp: d with Σ_j d_i d_j H_ij + K_i = A_i t_i for
+// the rows with a target, K_i the sum of the row's kept pairs (a pair with a `kept` patch is
+// not scaled), by the damped symmetric Sinkhorn-Knopp update (Knight 2008)
+// d_i ← sqrt(d_i (A_i t_i - K_i) / Σ_j H_ij d_j), d_i clamped to [1/kMaxScale, kMaxScale].
 std::vector<double> balance(const SparseF& H, const Eigen::VectorXd& a,
-                            const std::vector<double>& target, int threads,
+                            const std::vector<double>& target, const char* kept, int threads,
                             int& iterations) {
   const auto n = static_cast<std::int64_t>(target.size());
-  std::vector<double> d(n, 1.0), c(n, 0.0);
+  std::vector<double> d(n, 1.0), c(n, 0.0), fixed(n, 0.0);
   for (iterations = 0; iterations < kBalanceIterations; ++iterations) {
-    weighted_row_sums(H, d, threads, c);
+    weighted_row_sums(H, d, kept, threads, c, fixed);
     double worst = 0.0;
     for (std::int64_t i = 0; i < n; ++i) {
-      if (target[i] <= 0.0 || c[i] <= 0.0) continue;
-      const double want = a[i] * target[i], have = d[i] * c[i];
-      worst = std::max(worst, std::abs(have - want) / want);
+      const double want = a[i] * target[i] - fixed[i];
+      if (target[i] <= 0.0 || c[i] <= 0.0 || want <= 0.0) continue;
+      worst = std::max(worst, std::abs(d[i] * c[i] - want) / want);
     }
     if (worst <= kBalanceTolerance) break;
     for (std::int64_t i = 0; i < n; ++i) {
-      if (target[i] <= 0.0 || c[i] <= 0.0) continue;
-      d[i] = std::clamp(std::sqrt(d[i] * a[i] * target[i] / c[i]), 1.0 / kMaxScale, kMaxScale);
+      const double want = a[i] * target[i] - fixed[i];
+      if (target[i] <= 0.0 || c[i] <= 0.0 || want <= 0.0) continue;
+      d[i] = std::clamp(std::sqrt(d[i] * want / c[i]), 1.0 / kMaxScale, kMaxScale);
     }
   }
   return d;
@@ -208,7 +216,10 @@ std::vector<double> balance(const SparseF& H, const Eigen::VectorXd& a,
 }  // namespace
 
 void average_reciprocal(SparseF& F, SparseF* stderr_F, const std::vector<double>& areas,
-                        FormFactorStats& stats, int threads) {
+                        FormFactorStats& stats, int threads, const std::vector<char>* kept_pairs) {
+  LAMBERT_CHECK(!kept_pairs || kept_pairs->empty() || kept_pairs->size() == areas.size(),
+                "reciprocity: kept patches do not match the areas");
+  const char* kept = kept_pairs && !kept_pairs->empty() ? kept_pairs->data() : nullptr;
   const auto n = static_cast<Eigen::Index>(areas.size());
   LAMBERT_CHECK(F.rows() == n && F.cols() == n, "reciprocity: F does not match the areas");
   F.makeCompressed();
@@ -271,11 +282,14 @@ void average_reciprocal(SparseF& F, SparseF* stderr_F, const std::vector<double>
 
   // 2. Balance: G_ij ← d_i d_j G_ij (symmetric, so still reciprocal).
   int iterations = 0;
-  const std::vector<double> d = balance(F, a, target, threads, iterations);
+  const std::vector<double> d = balance(F, a, target, kept, threads, iterations);
   stats.reciprocity_balance_iterations = iterations;
+  auto pair_scale = [&](Eigen::Index i, Index j) {
+    return kept && (kept[i] || kept[j]) ? 1.0 : d[i] * d[j];
+  };
   for (Eigen::Index i = 0; i < n; ++i)
     for (std::int64_t k = outer[i]; k < outer[i + 1]; ++k) {
-      const double s = d[i] * d[col[k]];
+      const double s = pair_scale(i, col[k]);
       val[k] *= s;
       if (err) err[k] *= s;
     }
@@ -302,7 +316,7 @@ void average_reciprocal(SparseF& F, SparseF* stderr_F, const std::vector<double>
     for (std::int64_t k = outer[i]; k < outer[i + 1]; ++k) {
       const Index j = col[k];
       const double s = std::min(scale[i], scale[j]);
-      const double factor = d[i] * d[j] * s;
+      const double factor = pair_scale(i, j) * s;
       lo = std::min(lo, factor);
       hi = std::max(hi, factor);
       val[k] *= s;

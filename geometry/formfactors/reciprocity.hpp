@@ -64,8 +64,12 @@ constexpr double kMaxScale = 4.0;
 
 /// Averages A_i F_ij and A_j F_ji in place (F, and stderr_F when it has F's pattern),
 /// balances and caps the rows (see above), and records the change in `stats` (the
-/// reciprocity_* members). `threads` as for parallel_for (0 = all cores).
+/// reciprocity_* members). `threads` as for parallel_for (0 = all cores). With `kept_pairs`
+/// (one flag per patch, or empty), the pairs with a flagged patch are reciprocal estimates
+/// already (gather's direct light by pairs): the balance holds them as they are and scales
+/// the others so that every row still meets its target.
 void average_reciprocal(SparseF& F, SparseF* stderr_F, const std::vector<double>& areas,
-                        FormFactorStats& stats, int threads = 0);
+                        FormFactorStats& stats, int threads = 0,
+                        const std::vector<char>* kept_pairs = nullptr);
 
 }  // namespace lambert::ff

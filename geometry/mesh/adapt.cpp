@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "core/error.hpp"
+#include "geometry/render/vertex_field.hpp"
 #include "geometry/visibility/direct_light.hpp"
 
 namespace lambert {
@@ -70,6 +71,20 @@ std::vector<double> patch_errors(const PatchMesh& mesh, const Eigen::MatrixX3d& 
   }
   std::vector<double> e(mesh.size());
   for (std::int32_t i = 0; i < mesh.size(); ++i) e[i] = 0.5 * mesh.patches[i].area * jump[i];
+  return e;
+}
+
+std::vector<double> field_patch_errors(const PatchMesh& mesh, const Eigen::MatrixX3d& B) {
+  LAMBERT_CHECK(B.rows() == mesh.size(), "field_patch_errors: B does not match the mesh");
+  const VertexField f = interpolate_to_vertices(mesh, B, VertexInterpolation::LinearFit);
+  std::vector<double> e(mesh.size());
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    const Patch& p = mesh.patches[i];
+    double mean = 0.0;  // the field's mean over the patch (exact on a triangle)
+    for (int k = 0; k < p.vertex_count; ++k) mean += f.values.row(f.patch_corners[i][k]).mean();
+    mean /= p.vertex_count;
+    e[i] = p.area * std::abs(B.row(i).mean() - mean);
+  }
   return e;
 }
 

@@ -30,6 +30,15 @@ RefinedMesh triangulate_quads(const PatchMesh& mesh);
 /// patches get 0. O(N).
 std::vector<double> patch_errors(const PatchMesh& mesh, const Eigen::MatrixX3d& B);
 
+/// Per-patch error estimate of the shaded field (vertex_field.hpp's LinearFit interpolation
+/// of B, the Gouraud field `run` renders on an adapted mesh) on a triangle mesh: the
+/// patch's area times the difference between its constant and the field's mean over it,
+///   e_i = A_i |b_i - (f(a) + f(b) + f(c)) / 3|   (RGB means; W, scene units).
+/// The interpolation reproduces a linear B, so e_i measures what it misses, the curvature
+/// and the kinks inside the patch (O(A h² |B''|)), not the slope (patch_errors' jumps are
+/// O(h |∇B|) where a linear interpolant is already exact). O(N).
+std::vector<double> field_patch_errors(const PatchMesh& mesh, const Eigen::MatrixX3d& B);
+
 /// Per-patch error estimate of a field with exact direct light at the vertices
 /// (exact_direct_vertex_field): its direct part is the linear interpolant of H_d between the
 /// corners, so the patch's error is estimated from H_d at its edge midpoints,

@@ -1,6 +1,8 @@
 #include "geometry/render/vertex_field.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -8,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/sampling.hpp"
+#include "geometry/formfactors/kernels.hpp"
 #include "geometry/visibility/direct_light.hpp"
 
 namespace lambert {
@@ -192,11 +195,15 @@ double relative(const Eigen::Vector3d& value, const Eigen::Vector3d& reference) 
 VertexInterpolation parse_vertex_interpolation(const std::string& name) {
   if (name == "area") return VertexInterpolation::AreaWeighted;
   if (name == "conservative") return VertexInterpolation::Conservative;
-  throw UsageError("unknown vertex interpolation '" + name + "' (use area or conservative)");
+  if (name == "linear") return VertexInterpolation::LinearFit;
+  throw UsageError("unknown vertex interpolation '" + name +
+                   "' (use area, conservative or linear)");
 }
 
 const char* to_string(VertexInterpolation mode) {
-  return mode == VertexInterpolation::AreaWeighted ? "area" : "conservative";
+  return mode == VertexInterpolation::AreaWeighted ? "area"
+         : mode == VertexInterpolation::LinearFit  ? "linear"
+                                                   : "conservative";
 }
 
 double SurfacePower::relative_error() const { return relative(field_power, patch_power); }
@@ -302,6 +309,11 @@ std::vector<SurfacePower> surface_power(const PatchMesh& mesh, const Eigen::Matr
 
 namespace {
 
+// linear_fit's conditioning bound: its centroids must spread at least 1/30 as much (in
+// variance) across as along (about 1:5.5 in extent), else the fit's slope across is
+// unresolved and extrapolating it would amplify the patch values' noise.
+constexpr double kFitCondition = 1.0 / 30.0;
+
 // The area-weighted mean of a per-patch field (N x 3) at every shading vertex of f.
 Eigen::MatrixX3d area_weighted(const PatchMesh& mesh, const VertexField& f,
                                const Eigen::MatrixX3d& patch_values) {
@@ -319,17 +331,70 @@ Eigen::MatrixX3d area_weighted(const PatchMesh& mesh, const VertexField& f,
   return values;
 }
 
+// The value at every shading vertex k of the local linear fit of the patch values around
+// it: weighted least squares b_i ≈ a + g · d_i over its patches i (weights A_i, d_i = c_i -
+// x_k the centroid offsets in the plane of the vertex normal), v_k = a, clamped to the range
+// of those b_i (no new extremum). Where the offsets' weighted mean is 0 (a point-symmetric
+// neighbourhood: uniform grids) a is the area-weighted mean whatever g; elsewhere (graded
+// meshes, where a large patch beside small ones pulls the mean by O(H |∇b|)) it is exact for
+// a linear field. Fans whose centroids do not span the plane (a vertex on a surface's edge
+// with two quads, a corner) keep the area-weighted mean: the smaller in-plane eigenvalue of
+// the offsets' covariance must be at least kFitCondition of the larger.
+Eigen::MatrixX3d linear_fit(const PatchMesh& mesh, const VertexField& f,
+                            const Eigen::MatrixX3d& patch_values) {
+  const Eigen::MatrixX3d mean = area_weighted(mesh, f, patch_values);
+  std::vector<std::vector<std::int32_t>> around(f.size());
+  for (std::int32_t i = 0; i < mesh.size(); ++i)
+    for (int k = 0; k < mesh.patches[i].vertex_count; ++k)
+      around[f.patch_corners[i][k]].push_back(i);
+  Eigen::MatrixX3d values = mean;
+  for (std::int32_t k = 0; k < f.size(); ++k) {
+    const std::vector<std::int32_t>& ps = around[k];
+    if (ps.size() < 3) continue;
+    Eigen::Vector3d t, b;
+    ff::orthonormal_frame(f.normals[k], t, b);
+    double W = 0.0;
+    Eigen::Vector2d Sd = Eigen::Vector2d::Zero();
+    Eigen::Matrix2d Sdd = Eigen::Matrix2d::Zero();
+    Eigen::RowVector3d Sb = Eigen::RowVector3d::Zero();
+    Eigen::Matrix<double, 2, 3> Sdb = Eigen::Matrix<double, 2, 3>::Zero();
+    Eigen::RowVector3d lo = patch_values.row(ps[0]), hi = lo;
+    for (const std::int32_t i : ps) {
+      const double w = mesh.patches[i].area;
+      const Eigen::Vector3d d3 = mesh.patches[i].centroid - f.positions[k];
+      const Eigen::Vector2d d(d3.dot(t), d3.dot(b));
+      W += w;
+      Sd += w * d;
+      Sdd += w * d * d.transpose();
+      Sb += w * patch_values.row(i);
+      Sdb += w * d * patch_values.row(i);
+      lo = lo.cwiseMin(patch_values.row(i));
+      hi = hi.cwiseMax(patch_values.row(i));
+    }
+    if (!(W > 0.0)) continue;
+    const Eigen::Matrix2d C = Sdd - Sd * Sd.transpose() / W;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(C);
+    const double e0 = eig.eigenvalues()[0], e1 = eig.eigenvalues()[1];
+    if (!(e1 > 0.0) || e0 < kFitCondition * e1) continue;
+    const Eigen::Matrix<double, 2, 3> g = C.inverse() * (Sdb - Sd * Sb / W);
+    const Eigen::RowVector3d a = (Sb - Sd.transpose() * g) / W;
+    values.row(k) = a.cwiseMax(lo).cwiseMin(hi);
+  }
+  return values;
+}
+
 }  // namespace
 
 VertexField interpolate_to_vertices(const PatchMesh& mesh, const Eigen::MatrixX3d& patch_values,
                                     VertexInterpolation mode, std::vector<SurfacePower>* power) {
   LAMBERT_CHECK(patch_values.rows() == mesh.size(), "patch field size does not match the mesh");
   VertexField f = build_shading_vertices(mesh);
-  f.values = area_weighted(mesh, f, patch_values);
+  f.values = mode == VertexInterpolation::LinearFit ? linear_fit(mesh, f, patch_values)
+                                                    : area_weighted(mesh, f, patch_values);
   anchor_hanging_vertices(find_hanging_vertices(mesh, f), f);
 
   std::vector<SurfacePower> pw = surface_power(mesh, patch_values, f);
-  if (mode == VertexInterpolation::Conservative) {
+  if (mode == VertexInterpolation::Conservative || mode == VertexInterpolation::LinearFit) {
     for (auto& s : pw) {
       for (int c = 0; c < 3; ++c) {
         // Values are >= 0 for a radiosity field; rescale only where both powers are positive

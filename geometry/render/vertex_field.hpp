@@ -13,7 +13,16 @@
 // around it:  v_k = sum_{i ∋ k} A_i b_i / sum_{i ∋ k} A_i.  A constant field is reproduced
 // exactly; a linear field is reproduced exactly at interior vertices whose neighbourhood is
 // point-symmetric (uniform grids, the mesher's similar-triangle subdivision), since then the
-// area-weighted mean of the patch centroids is the vertex itself.
+// area-weighted mean of the patch centroids is the vertex itself. Elsewhere (a graded mesh
+// from --adapt, where a large patch beside small ones pulls the mean by O(H |∇B|)), LinearFit
+// (`--vertex-interp linear`, auto's choice on an --adapt mesh) takes the local linear fit
+// instead, then rescales like Conservative: weighted least squares
+// b_i ≈ a + g · (c_i - x_k) over the patches around the vertex (weights A_i), v_k = a clamped
+// to the range of their b_i. It is the area-weighted mean wherever the neighbourhood is
+// point-symmetric (the centroids' weighted mean is x_k: a does not depend on g), exact for a
+// linear field wherever the centroids span the plane, and the mean where they do not (a
+// vertex on a surface's edge between two quads, a corner). It is not linear in b (the clamp,
+// and a rescale that is no longer ~1): the viewer's relighting by bases is exact for the others.
 //
 // Power. Linear interpolation on triangles and bilinear interpolation on quads define a
 // continuous field f on each surface. Its integral is computed exactly (triangles:
@@ -88,7 +97,8 @@ constexpr double kPowerTolerance = 1e-9;
 /// How per-vertex values are reconstructed from per-patch values.
 enum class VertexInterpolation {
   AreaWeighted,  ///< area-weighted mean of the patches around each shading vertex
-  Conservative   ///< AreaWeighted, then rescaled per surface and channel to conserve power
+  Conservative,  ///< AreaWeighted, then rescaled per surface and channel to conserve power
+  LinearFit      ///< the local linear fit of the patches around each vertex, rescaled likewise
 };
 
 /// Parses "area" or "conservative"; throws UsageError otherwise.

@@ -296,8 +296,9 @@ TEST(RenderCommand, BadOptionsAreUsageErrors) {
 namespace lambert {
 
 // --vertex-interp auto is exact-direct on a --discontinuity mesh solved here (report and
-// settings say so) and conservative otherwise; exact-direct is refused, before any work,
-// where B comes without its F (--radiosity, --method hierarchical).
+// settings say so), linear on an --adapt mesh and conservative otherwise; exact-direct is
+// refused, before any work, where B comes without its F (--radiosity, --method
+// hierarchical).
 TEST(RunCommand, VertexInterpAutoIsExactDirectOnDiscontinuityMeshes) {
   lambert::testing::TempDir dir;
   write_tiny_scene(dir);
@@ -318,6 +319,9 @@ TEST(RunCommand, VertexInterpAutoIsExactDirectOnDiscontinuityMeshes) {
   EXPECT_EQ(interpolation({}), "conservative");
   EXPECT_EQ(interpolation({"--vertex-interp", "exact-direct"}), "exact-direct");
   EXPECT_EQ(interpolation({"--discontinuity", "--vertex-interp", "area"}), "area");
+  // An --adapt mesh is graded: auto shades it with the local linear fit (issue 35 item 7).
+  EXPECT_EQ(interpolation({"--adapt", "1"}), "linear");
+  EXPECT_EQ(interpolation({"--adapt", "1", "--vertex-interp", "conservative"}), "conservative");
 
   ::testing::internal::CaptureStdout();
   ASSERT_EQ(

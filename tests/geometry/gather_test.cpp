@@ -134,6 +134,117 @@ TEST(FormFactorGather, BitwiseIdenticalForAnyThreadCount) {
   }
 }
 
+// Gather's direct light (gather.hpp): with few emitting patches each pair with an emitter is
+// the hybrid kernel's, the other rays' share scaled to the rest of the hemisphere. In a
+// closed cube with two of the lamp face's 25 patches emitting: the emitter entries are the
+// hybrid's (no occlusion in a cube: both are the exact unoccluded integral, to quadrature:
+// 1e-9 relative covers the rounding of the visible fraction), an emitter's row sums to 1
+// within the quadrature's 1e-6 per pair (25 x 6 pairs: 1e-5), every other row to exactly 1
+// as before (the scale s = (1 - h) / (1 - f_E) makes the rays that reach a front fill the
+// rest of the hemisphere; -2/K allows two rays lost through an edge), and the result is
+// bitwise the same for any thread count.
+TEST(FormFactorGather, EmitterPairsAreHybridsAndClosedRowsStillSumToOne) {
+  PatchMesh mesh = mesh_scene(unit_cube(), {0.2, 0});  // 5x5 patches per face
+  std::vector<char> emitter(mesh.size(), 0);
+  int lamps = 0;
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    Patch& p = mesh.patches[i];
+    if (p.emission.maxCoeff() > 0 && lamps++ < 2) {
+      emitter[i] = 1;
+    } else {
+      p.emission.setZero();
+    }
+  }
+  constexpr int kRays = 1024;
+  ASSERT_TRUE(ff::gather_direct_pairs(2, mesh.size(), kRays));
+  const FormFactors g = gather(mesh, kRays, 3, "none", 1);
+  FormFactorOptions ho;
+  ho.estimator = "hybrid";
+  ho.run.progress = false;
+  const FormFactors hy = compute_form_factors(mesh, ho);
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    const double s = row_sum(g.F, i);
+    if (emitter[i]) {
+      EXPECT_NEAR(s, 1.0, 1e-5) << "emitter row " << i;
+    } else {
+      EXPECT_LE(s, 1.0 + 1e-12) << "row " << i;
+      EXPECT_GE(s, 1.0 - 2.0 / kRays) << "row " << i;
+    }
+    for (std::int32_t j = 0; j < mesh.size(); ++j) {
+      if (!(emitter[i] || emitter[j]) || i == j) continue;
+      EXPECT_NEAR(g.F.coeff(i, j), hy.F.coeff(i, j), 1e-9 * hy.F.coeff(i, j)) << i << " " << j;
+    }
+  }
+  // Averaged (gather's default): the emitter pairs are held, the other pairs balanced around
+  // them, so every row keeps its own sum and the emitter entries stay the hybrid's. 1e-9:
+  // the balance meets its 1e-12 on the rows' free parts, but rows summing to 1 are left
+  // 1e-11 to 1e-10 below it here (measured; without held pairs 1e-11, EnclosedCube... above).
+  // Not investigated further (issue 35 item 7 notes); far below the estimator's error.
+  const FormFactors avg = gather(mesh, kRays, 3, "average", 1);
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    EXPECT_NEAR(row_sum(avg.F, i), std::min(row_sum(g.F, i), 1.0), 1e-9) << "row " << i;
+    for (std::int32_t j = 0; j < mesh.size(); ++j) {
+      if (!(emitter[i] || emitter[j]) || i == j) continue;
+      EXPECT_NEAR(avg.F.coeff(i, j), hy.F.coeff(i, j), 1e-9 * hy.F.coeff(i, j)) << i << " " << j;
+    }
+  }
+  const FormFactors g3 = gather(mesh, kRays, 3, "none", 3);
+  ASSERT_EQ(g3.F.nonZeros(), g.F.nonZeros());
+  for (std::int64_t k = 0; k < g.F.nonZeros(); ++k) {
+    EXPECT_EQ(g3.F.valuePtr()[k], g.F.valuePtr()[k]);
+    EXPECT_EQ(g3.stderr_F.valuePtr()[k], g.stderr_F.valuePtr()[k]);
+  }
+}
+
+namespace {
+
+// The lit floor patches' light factors from gather (with `reciprocity`) against hybrid's.
+void direct_light_of_lit_patches_is_exact(const std::string& reciprocity) {
+  MeshOptions mo;
+  mo.target_patches = 600;
+  const PatchMesh mesh = mesh_scene(partial_shadow_scene(), mo);
+  const FormFactors g = gather(mesh, 1024, 1, reciprocity);
+  FormFactorOptions ho;
+  ho.estimator = "hybrid";
+  ho.run.progress = false;
+  const FormFactors hy = compute_form_factors(mesh, ho);
+  int lit = 0;
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    const Patch& p = mesh.patches[i];
+    if (mesh.surface_names[p.surface] != "floor") continue;
+    // Fully lit: beyond the shadow's far edge y = 2.7 (partial_shadow_lines).
+    bool beyond = true;
+    for (int k = 0; k < p.vertex_count; ++k)
+      beyond = beyond && mesh.vertices[p.vertices[k]].y() > 2.7;
+    if (!beyond) continue;
+    double f = 0, ref = 0;
+    for (std::int32_t j = 0; j < mesh.size(); ++j)
+      if (mesh.surface_names[mesh.patches[j].surface] == "light") {
+        f += g.F.coeff(i, j);
+        ref += hy.F.coeff(i, j);
+      }
+    ASSERT_GT(ref, 0.0);
+    EXPECT_NEAR(f, ref, 1e-9 * ref) << "floor patch " << i;
+    ++lit;
+  }
+  EXPECT_GT(lit, 50);
+}
+
+}  // namespace
+
+// The mottle of issue 35 item 7: with K = 1024 rays a floor patch saw the light through
+// some 50 of them (±10 % per patch, visible as blotches on the Cornell walls at 8,000
+// patches). Now the lit floor patches of the partial-shadow scene get their light factors
+// from the hybrid kernel: exact for unoccluded pairs, so they equal a hybrid run's to
+// rounding (1e-9 relative), not to ±10 %; also after reciprocity averaging (gather's
+// default), whose balance holds those pairs as they are.
+TEST(FormFactorGather, DirectLightOfLitPatchesIsExactNotSampled) {
+  for (const std::string reciprocity : {"none", "average"}) {
+    SCOPED_TRACE(reciprocity);
+    direct_light_of_lit_patches_is_exact(reciprocity);
+  }
+}
+
 TEST(FormFactorGather, BacksAndMissesCountForNothing) {
   // b above a faces +z (away from a): a's rays hit b's back, which absorbs.
   Scene s;

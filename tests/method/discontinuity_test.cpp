@@ -268,13 +268,6 @@ TEST(DiscontinuityMeshSlow, TessellatedBlockersStayWithinTheRequestedSize) {
   expect_conforming(m, /*manifold=*/false);
 }
 
-// The L1 error of the patch-constant floor radiosity against the exact field
-// (partial_shadow_errors: midpoint rule on 16 similar sub-triangles per patch, its own
-// error O(h²/16 B''), below the O(h B') measured).
-double floor_error(const PatchMesh& mesh, const Eigen::MatrixX3d& B) {
-  return partial_shadow_errors(mesh, B, interpolate_to_vertices(mesh, B)).l1;
-}
-
 // The floor radiosity along y = 1.75 (across both penumbrae and the umbra, 0.05 beside the
 // umbra's edge y = 1.7): with the discontinuity mesh refined adaptively and exact direct
 // light at its vertices, the interpolated field's max error is at least 5x below uniform
@@ -394,19 +387,58 @@ TEST(PartialShadowReference, FloorToLightFactorConverges) {
   EXPECT_LT(f20, parallel_rectangles_G(0, 4, 0, 4, 1.5, 2.5, 1.5, 2.5, 3) / 16);
 }
 
-// Adaptive meshing on the partial-shadow scene: the floor error falls round by round, and
-// at the final patch count it is below the uniform mesh's with as many patches.
+// The standard deviation that Monte Carlo noise gives an area-mean error over the floor of
+// the partial-shadow scene, to first order: the floor's light is direct only (the light and
+// the blocker are black), B_i = 0.5 Σ_{j ∈ light} F_ij with independent pairs, so the
+// patches' noises are independent with σ_i = 0.5 sqrt(Σ_j s_ij²) (F's standard errors);
+// an error that moves by at most A_i / A_floor per unit of b_i then has the standard
+// deviation sqrt(Σ_i (A_i σ_i)²) / A_floor.
+double floor_error_stddev(const PatchMesh& mesh, int samples) {
+  FormFactorOptions fo;
+  fo.estimator = "hybrid";
+  fo.pair.samples = samples;
+  fo.run.progress = false;
+  fo.run.with_stderr = true;
+  const FormFactors F = compute_form_factors(mesh, fo);
+  double sum2 = 0, area = 0;
+  for (std::int32_t i = 0; i < mesh.size(); ++i) {
+    if (mesh.surface_names[mesh.patches[i].surface] != "floor") continue;
+    double var = 0;
+    for (SparseF::InnerIterator it(F.stderr_F, i); it; ++it)
+      if (mesh.surface_names[mesh.patches[it.col()].surface] == "light")
+        var += it.value() * it.value();
+    const double a_sigma = mesh.patches[i].area * 0.5 * std::sqrt(var);
+    sum2 += a_sigma * a_sigma;
+    area += mesh.patches[i].area;
+  }
+  return std::sqrt(sum2) / area;
+}
+
+// Adaptive meshing on the partial-shadow scene (issue 35 item 7): 3 rounds of --adapt from
+// 150 patches. The error measured is the one `run` shows, the Gouraud field's (the vertex
+// interpolation of B) area-mean |f(x) - B(x)| over the floor against the exact field: it
+// falls round by round, and at the final patch count it is below uniform meshing's (quads,
+// as a run without --adapt meshes) with at least as many patches. Before (patches refined
+// by the jumps of B between neighbours, vertex values area-weighted means) the adapted
+// field erred 1.2-1.6x more than uniform's at 300 to 3,000 patches (docs/meshing.md).
+// Each mesh is shaded as `run` shades it (auto: linear on the adapted, conservative on the
+// uniform mesh).
+// Margin: 4 standard deviations of the difference of the two errors from the noise
+// (floor_error_stddev for each mesh), each doubled because a patch value reaches the field
+// through the vertex fits, whose weights sum to 1 but may be negative (their absolute sum,
+// 1 for a mean, stays below 2 in the fans the fit's conditioning bound admits).
 TEST(AdaptiveRadiositySlow, ImprovesMonotonicallyAndBeatsUniformAtEqualPatches) {
   const Scene scene = partial_shadow_scene();
+  constexpr int kSamples = 256;
   FormFactorArgs ff;
   ff.estimator = "hybrid";
-  ff.set_param("--samples", 256);
+  ff.set_param("--samples", kSamples);
   RunArgs run;
   run.quiet = true;
   SolveOptions so;
   so.tol = 1e-12;
   std::vector<double> errors;
-  std::int64_t final_patches = 0;
+  PatchMesh adapted;
   for (int rounds = 1; rounds <= 3; ++rounds) {
     LoadedScene loaded;
     loaded.scene = scene;
@@ -426,18 +458,28 @@ TEST(AdaptiveRadiositySlow, ImprovesMonotonicallyAndBeatsUniformAtEqualPatches) 
         ASSERT_NEAR(loaded.mesh.patches[i].area * it.value(),
                     loaded.mesh.patches[it.col()].area * F.F.coeff(it.col(), i),
                     1e-12 * loaded.mesh.patches[i].area * it.value());
-    errors.push_back(floor_error(loaded.mesh, sol.B));
-    final_patches = loaded.mesh.size();
+    // The vertex values `run` shades an adapted mesh with (--vertex-interp auto: linear).
+    const VertexField f =
+        interpolate_to_vertices(loaded.mesh, sol.B, VertexInterpolation::LinearFit);
+    errors.push_back(partial_shadow_errors(loaded.mesh, sol.B, f).field_l1);
+    adapted = loaded.mesh;
   }
   MeshOptions uni;
-  uni.target_patches = final_patches / 2;  // quads, then split in two like adaptive's start
-  const PatchMesh um = triangulate_quads(mesh_scene(scene, uni)).mesh;
-  const double e_uni = floor_error(um, solve_hybrid(um, 256).B);
-  std::printf("adaptive floor error by round: %.3g %.3g %.3g (%lld patches); uniform %.3g (%d)\n",
-              errors[0], errors[1], errors[2], static_cast<long long>(final_patches), e_uni, um.size());
+  uni.target_patches = adapted.size();
+  const PatchMesh um = mesh_scene(scene, uni);
+  ASSERT_GE(um.size(), adapted.size()) << "uniform must not have fewer patches";
+  const Eigen::MatrixX3d ub = solve_hybrid(um, kSamples).B;
+  const double e_uni = partial_shadow_errors(um, ub, interpolate_to_vertices(um, ub)).field_l1;
+  const double sd_a = 2 * floor_error_stddev(adapted, kSamples),
+               sd_u = 2 * floor_error_stddev(um, kSamples);
+  const double margin = 4 * std::sqrt(sd_a * sd_a + sd_u * sd_u);
+  std::printf(
+      "adaptive field L1 error by round: %.3g %.3g %.3g (%d patches); uniform %.3g (%d); "
+      "noise margin %.2g\n",
+      errors[0], errors[1], errors[2], adapted.size(), e_uni, um.size(), margin);
   EXPECT_LT(errors[1], errors[0]);
   EXPECT_LT(errors[2], errors[1]);
-  EXPECT_LT(errors[2], e_uni);
+  EXPECT_LT(errors[2] + margin, e_uni);
 }
 
 }  // namespace
