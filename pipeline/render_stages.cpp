@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 
 #include "core/error.hpp"
@@ -24,11 +25,70 @@ Eigen::Vector3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; 
 
 }  // namespace
 
+namespace {
+
+// Distance along unit `d` from o to triangle (a, b, c) (Moller-Trumbore), or infinity.
+double ray_triangle(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& a,
+                    const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d e1 = b - a, e2 = c - a, p = d.cross(e2);
+  const double det = e1.dot(p);
+  if (std::abs(det) < 1e-300) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d s = o - a;
+  const double u = s.dot(p) / det;
+  if (u < 0.0 || u > 1.0) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d q = s.cross(e1);
+  const double v = d.dot(q) / det;
+  if (v < 0.0 || u + v > 1.0) return std::numeric_limits<double>::infinity();
+  const double t = e2.dot(q) / det;
+  return t > 0.0 ? t : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+bool encloses_its_centre(const Scene& scene) {
+  if (scene.faces.empty() || scene.faces.size() > kMaxEnclosureFaces) return false;
+  const PatchMesh faces = mesh_scene(scene, {});  // one patch per face (or its triangles)
+  const auto [lo, hi] = scene.bounds();
+  const Eigen::Vector3d centre = 0.5 * (lo + hi);
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz) {
+        if (dx == 0 && dy == 0 && dz == 0) continue;
+        const Eigen::Vector3d d = Eigen::Vector3d(dx, dy, dz).normalized();
+        // The nearest face along d, by brute force (no BVH: the run builds its one BVH later).
+        double nearest = std::numeric_limits<double>::infinity();
+        std::int32_t hit = -1;
+        for (std::int32_t i = 0; i < faces.size(); ++i) {
+          const Patch& p = faces.patches[i];
+          const auto& v = faces.vertices;
+          for (int k = 1; k + 1 < p.vertex_count; ++k) {
+            const double t =
+                ray_triangle(centre, d, v[p.vertices[0]], v[p.vertices[k]], v[p.vertices[k + 1]]);
+            if (t < nearest) {
+              nearest = t;
+              hit = i;
+            }
+          }
+        }
+        if (hit < 0 || !(faces.patches[hit].normal.dot(d) < 0.0)) return false;
+      }
+  return true;
+}
+
 Camera make_camera(const Scene& scene, const CameraArgs& args) {
   Camera cam = scene.camera;
   if (!cam.defined) {
     const auto [lo, hi] = scene.bounds();
     cam = framing_camera(lo, hi);
+  }
+  if (cam.automatic && args.view.empty() && args.eye.empty() && args.look_at.empty() &&
+      encloses_its_centre(scene)) {  // a closed room seen from outside shows wall backs
+    const auto [lo, hi] = scene.bounds();
+    const int up = std::abs(cam.up.z()) > std::abs(cam.up.y()) ? 2 : 1;
+    const int width = cam.width, height = cam.height;
+    cam = room_camera(lo, hi, up);
+    cam.width = width;
+    cam.height = height;
   }
   if (!args.view.empty()) {  // about the scene's up axis: z when its camera has z up, else y
     const auto [lo, hi] = scene.bounds();

@@ -28,7 +28,15 @@ struct CameraArgs {
   /// scene's camera (view_camera); empty = the scene's camera.
   std::string view;
 };
-/// The scene's camera (or one framing the scene) with the overrides applied.
+/// Scenes above this many faces are not probed by encloses_its_centre (26 rays against every
+/// face: ~0.1 s at this size; a room users model is far smaller).
+constexpr std::size_t kMaxEnclosureFaces = 200000;
+/// True when the centre of the scene's bounding box sees the front of a face along each of
+/// the 26 directions to the box's corners, edges and faces: a closed room, which a view from
+/// outside would show as the backs of its walls (black). O(26 faces), no BVH.
+bool encloses_its_centre(const Scene& scene);
+/// The scene's camera (or one framing the scene) with the overrides applied; a default view
+/// of a closed room (encloses_its_centre) is replaced by a view from inside (room_camera).
 /// Throws UsageError for a malformed --size or a degenerate view.
 Camera make_camera(const Scene& scene, const CameraArgs& args);
 

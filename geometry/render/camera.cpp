@@ -69,6 +69,7 @@ Camera orbit_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up
   // From straight above the up axis is the view direction: the picture's up is then the
   // back of the scene (its front at the bottom).
   c.up = elevation_degrees >= 90.0 ? Eigen::Vector3d(-front) : u;
+  c.automatic = true;
   return c;
 }
 
@@ -76,6 +77,21 @@ Camera orbit_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up
 
 Camera three_quarter_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up) {
   return orbit_camera(lo, hi, up, 35.0, 30.0);
+}
+
+Camera room_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up) {
+  const Eigen::Vector3d center = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
+  const Eigen::Vector3d u = up == 2 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d front = up == 2 ? -Eigen::Vector3d::UnitY() : -Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d corner = half.cwiseProduct(front + u.cross(front));  // horizontal
+  Camera c;
+  c.eye = center + 0.8 * corner + 0.15 * half.cwiseProduct(u);
+  c.look_at = center - 0.5 * corner - 0.2 * half.cwiseProduct(u);
+  c.up = u;
+  c.vfov_degrees = 70.0;
+  c.defined = true;
+  c.automatic = true;
+  return c;
 }
 
 Camera view_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up,

@@ -15,6 +15,8 @@ struct Camera {
   int width = 512;
   int height = 512;
   bool defined = false;  ///< false until a scene or the user sets it
+  /// True when framed by a rule (a loader's default view), not given by a camera file
+  bool automatic = false;
 
   /// World-space direction (not normalised) through pixel position (px, py), with
   /// (0,0) the top-left corner of the image and (width, height) the bottom-right.
@@ -39,6 +41,11 @@ Camera framing_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 /// it, so a flat part is never seen edge-on and a box shows three faces. The front is -z for
 /// a y-up scene (OBJ's convention) and -y for a z-up one (STL's, CAD's).
 Camera three_quarter_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up);
+
+/// A view from inside a closed room with bounding box [lo, hi]: from near its front-side
+/// corner (the three-quarter view's side), a little above mid-height, across the room to the
+/// far corner, 70° wide. `up` as for three_quarter_camera.
+Camera room_camera(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int up);
 
 /// The named views of a bounding box (--view): front (from the front, level), three-quarter
 /// (three_quarter_camera) or top (from straight above, the front at the bottom of the

@@ -17,6 +17,8 @@
 #include "geometry/render/camera.hpp"
 #include "geometry/visibility/shadow.hpp"
 #include "io/exr.hpp"
+#include "io/obj_loader.hpp"
+#include "pipeline/render_stages.hpp"
 
 namespace lambert {
 namespace {
@@ -161,6 +163,67 @@ TEST(PixelDirect, AnExplicitRayCountIsRefusedWhereNothingDrawsIt) {
   refused({"render", obj, "--radiosity", dir.file("none.csv"), "-o", dir.file("d.exr")},
           "--direct-rays does not apply");
   EXPECT_FALSE(std::filesystem::exists(dir.file("c/ps.exr")));
+}
+
+}  // namespace
+}  // namespace lambert
+
+namespace lambert {
+namespace {
+
+// A closed 6 x 3 x 4 room, faces inward, with an emitting panel under the ceiling (the
+// ceiling left out with `open`).
+std::string write_room(const testing::TempDir& dir, bool open) {
+  const std::vector<std::pair<std::string, Polygon3>> faces = {
+      {"floor", {{0, 0, 0}, {0, 0, 4}, {6, 0, 4}, {6, 0, 0}}},
+      {"ceiling", {{0, 3, 0}, {6, 3, 0}, {6, 3, 4}, {0, 3, 4}}},
+      {"wall_a", {{0, 0, 0}, {6, 0, 0}, {6, 3, 0}, {0, 3, 0}}},
+      {"wall_b", {{0, 0, 4}, {0, 3, 4}, {6, 3, 4}, {6, 0, 4}}},
+      {"wall_c", {{0, 0, 0}, {0, 3, 0}, {0, 3, 4}, {0, 0, 4}}},
+      {"wall_d", {{6, 0, 0}, {6, 0, 4}, {6, 3, 4}, {6, 3, 0}}},
+      {"lamp", {{2.5, 2.9, 1.5}, {3.5, 2.9, 1.5}, {3.5, 2.9, 2.5}, {2.5, 2.9, 2.5}}}};
+  dir.write("room.mtl", "newmtl white\nKd 0.7 0.7 0.7\nnewmtl lamp\nKd 0 0 0\nKe 20 20 20\n");
+  std::string obj = "mtllib room.mtl\n";
+  int v = 0;
+  for (const auto& [name, poly] : faces) {
+    if (open && name == "ceiling") continue;
+    for (const auto& p : poly) obj += point(p);
+    obj += "g " + name + "\nusemtl " + (name == "lamp" ? "lamp" : "white") + "\nf";
+    for (size_t k = 0; k < poly.size(); ++k) obj += ' ' + std::to_string(++v);
+    obj += '\n';
+  }
+  return dir.write("room.obj", obj);
+}
+
+TEST(DefaultView, AClosedRoomIsSeenFromInsideAndAnOpenSceneFromOutside) {
+  // Issue 35: a closed room framed from outside showed the backs of its walls (a black
+  // picture). Its default view is now from inside: every camera ray hits a front face, so
+  // every pixel is lit (the walls all see the lamp). Without its ceiling the room is open
+  // and keeps the three-quarter view from outside, and --view still frames it from outside.
+  testing::TempDir dir;
+  const std::string obj = write_room(dir, false);
+  const Scene closed = load_obj(obj);
+  ASSERT_TRUE(encloses_its_centre(closed));
+  const Camera inside = make_camera(closed, {});
+  const auto [lo, hi] = closed.bounds();
+  EXPECT_TRUE((inside.eye.array() > lo.array()).all() && (inside.eye.array() < hi.array()).all());
+  CameraArgs outside_args;
+  outside_args.view = "three-quarter";
+  const Camera outside = make_camera(closed, outside_args);
+  EXPECT_FALSE((outside.eye.array() > lo.array()).all() &&
+               (outside.eye.array() < hi.array()).all());
+
+  const auto [code, err] = run_capturing({"run", obj, "--size", "48x48", "--antialias", "1", "-q",
+                                          "--max-edge", "1", "-o", dir.file("out/")});
+  ASSERT_EQ(code, kExitOk) << err;
+  const Image img = read_image_exr(dir.file("out/room.exr"));
+  int dark = 0;
+  for (size_t k = 0; k < img.alpha.size(); ++k)
+    dark += !(img.alpha[k] == 1.0f && img.rgb[3 * k + 1] > 0.0f);
+  EXPECT_EQ(dark, 0);
+
+  testing::TempDir open_dir;
+  EXPECT_FALSE(encloses_its_centre(load_obj(write_room(open_dir, true))));
 }
 
 }  // namespace
