@@ -220,6 +220,24 @@ TEST(RenderMedium, CameraRaysAreAttenuatedAndCollectTheVoxelsExactly) {
 
 namespace lambert {
 
+// Each corner of the box [lo, hi], seen from the eye in the camera's frame, lies within the
+// field of view (the frame's half-height tan(vfov/2) at unit depth; the image is square).
+void expect_box_in_frame(const Camera& c, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                         const std::string& view) {
+  const Eigen::Vector3d forward = (c.look_at - c.eye).normalized();
+  const Eigen::Vector3d right = forward.cross(c.up).normalized(), top = right.cross(forward);
+  const double half = std::tan(0.5 * c.vfov_degrees * M_PI / 180.0);
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Vector3d p(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(),
+                            k & 4 ? hi.z() : lo.z());
+    const Eigen::Vector3d d = p - c.eye;
+    const double depth = d.dot(forward);
+    ASSERT_GT(depth, 0.0) << view << k;
+    EXPECT_LT(std::abs(d.dot(right)) / depth, half) << view << k;
+    EXPECT_LT(std::abs(d.dot(top)) / depth, half) << view << k;
+  }
+}
+
 TEST(Camera, TheDefaultViewIsAThreeQuarterViewThatFramesTheWholeBox) {
   // Issue 35: a flat part framed head-on was seen edge-on. The default view looks down at 30°
   // from 35° round the front, along the scene's up axis, and every corner of the box lies
@@ -232,19 +250,7 @@ TEST(Camera, TheDefaultViewIsAThreeQuarterViewThatFramesTheWholeBox) {
     const Eigen::Vector3d forward = (c.look_at - c.eye).normalized();
     EXPECT_NEAR(-forward.dot(u), 0.5, 1e-12);  // sin 30°
     EXPECT_EQ(c.up, u);
-    // Each corner's direction from the eye, in the camera's frame, is within the field of
-    // view (the frame's half-height tan(vfov/2) at unit depth; the image is square).
-    const Eigen::Vector3d right = forward.cross(c.up).normalized(), top = right.cross(forward);
-    const double half = std::tan(0.5 * c.vfov_degrees * M_PI / 180.0);
-    for (int k = 0; k < 8; ++k) {
-      const Eigen::Vector3d p(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(),
-                              k & 4 ? hi.z() : lo.z());
-      const Eigen::Vector3d d = p - c.eye;
-      const double depth = d.dot(forward);
-      ASSERT_GT(depth, 0.0);
-      EXPECT_LT(std::abs(d.dot(right)) / depth, half) << k;
-      EXPECT_LT(std::abs(d.dot(top)) / depth, half) << k;
-    }
+    expect_box_in_frame(c, lo, hi, "three-quarter");
   }
 }
 
@@ -269,17 +275,7 @@ TEST(Camera, TheNamedViewsFrameTheWholeBoxFromTheirSides) {
       } else {
         EXPECT_NEAR(-forward.dot(u), 0.5, 1e-12);
       }
-      const Eigen::Vector3d right = forward.cross(c.up).normalized(), top = right.cross(forward);
-      const double half = std::tan(0.5 * c.vfov_degrees * M_PI / 180.0);
-      for (int k = 0; k < 8; ++k) {
-        const Eigen::Vector3d p(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(),
-                                k & 4 ? hi.z() : lo.z());
-        const Eigen::Vector3d d = p - c.eye;
-        const double depth = d.dot(forward);
-        ASSERT_GT(depth, 0.0) << view;
-        EXPECT_LT(std::abs(d.dot(right)) / depth, half) << view << k;
-        EXPECT_LT(std::abs(d.dot(top)) / depth, half) << view << k;
-      }
+      expect_box_in_frame(c, lo, hi, view);
     }
   }
 }
