@@ -77,7 +77,9 @@ void add_scene_options(CLI::App* cmd, SceneArgs& args) {
   }
   auto* edge = add_declared(cmd, "--max-edge", args.max_edge);
   add_declared(cmd, "--patches", args.patches)->excludes(edge);
+  auto* floor = add_declared(cmd, "--surface-floor", args.surface_floor)->excludes(edge);
   auto* disc = add_declared(cmd, "--discontinuity", args.discontinuity);
+  floor->excludes(disc);
   add_declared(cmd, "--discontinuity-sources", args.discontinuity_sources)->needs(disc);
 }
 

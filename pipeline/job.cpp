@@ -348,6 +348,7 @@ MeshOptions mesh_options(const SceneArgs& args) {
   MeshOptions mo;
   mo.max_edge = args.max_edge;
   mo.target_patches = args.patches > 0 || args.max_edge > 0 ? args.patches : args.default_patches;
+  mo.surface_floor = args.surface_floor;
   mo.discontinuity = args.discontinuity;
   mo.discontinuity_sources = args.discontinuity_sources;
   return mo;
@@ -359,6 +360,7 @@ LoadedScene load_scene(const SceneArgs& args, const JobPlan& plan) {
   MeshOptions mo = mesh_options(args);
   const MeshPlan mesh_plan = plan_mesh(out.scene, mo);
   if (!mesh_plan.note.empty()) log_info(mesh_plan.note);
+  if (!mesh_plan.floor_note.empty()) log_info(mesh_plan.floor_note);
   if (mesh_plan.patches <= kMaxPatches) check_job_memory(mesh_plan.patches, plan);
   // Planned: mesh_scene need not search again (discontinuity meshing plans its own
   // correction from the target).

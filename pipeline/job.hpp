@@ -41,13 +41,14 @@ struct SceneArgs {
   /// --strict, --default-reflectance, --max-reflectance, --vertex-colors-as-reflectance,
   /// --split-angle
   LoadOptions load;
-  bool default_reflectance_given = false;  ///< --default-reflectance was on the command line
-  std::vector<std::string> emit;           ///< --emit NAME_OR_GLOB=R,G,B, parsed by load_scene
-  double max_edge = 0.0;                   ///< --max-edge
-  std::int64_t patches = 0;                ///< --patches
-  std::int64_t default_patches = 0;        ///< used when neither is given
-  bool discontinuity = false;              ///< --discontinuity
-  int discontinuity_sources = 0;           ///< --discontinuity-sources
+  bool default_reflectance_given = false;    ///< --default-reflectance was on the command line
+  std::vector<std::string> emit;             ///< --emit NAME_OR_GLOB=R,G,B, parsed by load_scene
+  double max_edge = 0.0;                     ///< --max-edge
+  std::int64_t patches = 0;                  ///< --patches
+  std::int64_t default_patches = 0;          ///< used when neither is given
+  int surface_floor = kDefaultSurfaceFloor;  ///< --surface-floor
+  bool discontinuity = false;                ///< --discontinuity
+  int discontinuity_sources = 0;             ///< --discontinuity-sources
   /// The command computes B from the emission: a scene where nothing emits (and no
   /// participating medium of the job's plan emits) is refused when loaded, before any work
   /// (UsageError naming --emit), instead of a long run that ends in a black result.

@@ -280,6 +280,11 @@ std::vector<OptionSpec> make_specs() {
               .by_method("matrix"));
   add_row(
       integer("--patches", 1, 1e8, "", "Approximate total number of patches").by_method("matrix"));
+  add_row(integer("--surface-floor", 0, 1000000, std::to_string(kDefaultSurfaceFloor),
+                  "Under a patch target (the default meshing or --patches), every surface gets "
+                  "at least N patches, the floors taking at most a quarter of the target "
+                  "(largest surfaces first); 0 or 1: none")
+              .by_method("matrix"));
   add_row(flag("--discontinuity",
                "Discontinuity meshing: constrained Delaunay triangles whose edges follow the "
                "contact lines of blockers (D0) and the penumbra and umbra boundaries (D1/D2) of "

@@ -504,7 +504,8 @@ using namespace lambert;
 
 PYBIND11_MODULE(_lambert, m) {
   m.doc() = "lambert's compiled core; use the `lambert` package.";
-  m.attr("__version__") = LAMBERT_VERSION;  // project(VERSION) in CMakeLists.txt
+  m.attr("__version__") = LAMBERT_VERSION;                 // project(VERSION) in CMakeLists.txt
+  m.attr("default_surface_floor") = kDefaultSurfaceFloor;  // geometry/mesh/mesh.hpp
   set_log_level(LogLevel::Normal);
 
   // Never destroyed: the translator may run until the interpreter's last call.
@@ -659,10 +660,12 @@ PYBIND11_MODULE(_lambert, m) {
 
   m.def(
       "mesh_scene",
-      [](const Scene& scene, double max_edge, std::int64_t patches, bool discontinuity) {
+      [](const Scene& scene, double max_edge, std::int64_t patches, bool discontinuity,
+         int surface_floor) {
         if (!(max_edge >= 0.0) || !std::isfinite(max_edge))
           throw UsageError("max_edge must be a finite number >= 0");
         if (patches < 0) throw UsageError("patches must be >= 0");
+        if (surface_floor < 0) throw UsageError("surface_floor must be >= 0");
         auto h = std::make_shared<MeshHandle>();
         h->loaded.scene = scene;
         Released release;
@@ -670,6 +673,7 @@ PYBIND11_MODULE(_lambert, m) {
         mo.max_edge = max_edge;
         mo.target_patches = patches;
         mo.discontinuity = discontinuity;
+        mo.surface_floor = surface_floor;
         // As the CLI's load_scene: the planned edge bound, so the mesh is the CLI's.
         const MeshPlan plan = plan_mesh(h->scene, mo);
         if (!mo.discontinuity) mo.max_edge = plan.max_edge;
@@ -678,7 +682,8 @@ PYBIND11_MODULE(_lambert, m) {
         h->loaded.discontinuity = mo.discontinuity;
         return h;
       },
-      py::arg("scene"), py::arg("max_edge"), py::arg("patches"), py::arg("discontinuity"));
+      py::arg("scene"), py::arg("max_edge"), py::arg("patches"), py::arg("discontinuity"),
+      py::arg("surface_floor"));
 
   m.def(
       "form_factors",

@@ -418,47 +418,79 @@ std::vector<SurfaceCount> surface_counts(const std::vector<SurfaceElements>& sur
   return counts;
 }
 
-// The scene's patches at edge bound h (saturating at INT64_MAX): one evaluation.
-std::int64_t scene_patches(const std::vector<SurfaceCount>& counts, double h,
-                           MeshPlanStats& stats) {
-  ++stats.evaluations;
-  std::int64_t t = 0;
-  for (const auto& c : counts) t = add_product(t, 1, count_patches(c, h, stats), 1);
-  return t;
-}
-
 // The patch target is met by area: a surface that the edge h subdivides counts its patches;
 // one that h leaves as its own elements (a detailed object finer than h, or a small face)
 // counts its area share A_s / h², not its element count. So a 3,000-triangle bunny in a box
 // takes its area's share of the budget and the walls keep theirs (it took 3,000 of 3,020 and
 // left every wall one patch); the mesh then exceeds the target by the detail it cannot drop,
-// and the plan says so. Non-increasing in h. One evaluation, O(surfaces + terms).
-double scene_budget(const std::vector<SurfaceCount>& counts, double h, MeshPlanStats& stats) {
+// and the plan says so. A surface under the floor (floor[s] > 0) counts at least the floor.
+// Non-increasing in h. One evaluation, O(surfaces + terms).
+double scene_budget(const std::vector<SurfaceCount>& counts, const std::vector<int>& floor,
+                    double h, MeshPlanStats& stats) {
   ++stats.evaluations;
   double t = 0.0;
-  for (const auto& s : counts) {
+  for (std::size_t k = 0; k < counts.size(); ++k) {
+    const SurfaceCount& s = counts[k];
     const std::int64_t c = count_patches(s, h, stats);
-    t += c > s.elements ? static_cast<double>(c)
-                        : std::min(static_cast<double>(s.elements), s.area / (h * h));
+    const double share = c > s.elements
+                             ? static_cast<double>(c)
+                             : std::min(static_cast<double>(s.elements), s.area / (h * h));
+    t += std::max(share, static_cast<double>(floor[k]));
   }
   return t;
+}
+
+// The floor of each surface (0: none): `floor` patches for the largest surfaces by area
+// (ties by index), as many as a quarter of the target allows (a scene of thousands of small
+// surfaces must not spend its budget on floors); none without a target or with a floor <= 1.
+std::vector<int> surface_floors(const std::vector<SurfaceCount>& counts,
+                                const MeshOptions& options) {
+  std::vector<int> floor(counts.size(), 0);
+  if (options.target_patches <= 0 || options.surface_floor <= 1 || options.discontinuity)
+    return floor;
+  const auto cap = static_cast<std::size_t>(options.target_patches / 4 / options.surface_floor);
+  std::vector<std::size_t> order(counts.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  const std::size_t n = std::min(cap, order.size());
+  std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(n), order.end(),
+                    [&](std::size_t a, std::size_t b) {
+                      return counts[a].area != counts[b].area ? counts[a].area > counts[b].area
+                                                              : a < b;
+                    });
+  for (std::size_t k = 0; k < n; ++k) floor[order[k]] = options.surface_floor;
+  return floor;
+}
+
+// The largest edge bound below h that gives surface s (with fewer than `floor` patches at h)
+// at least `floor` patches: by 64 geometric bisection steps down to h x 1e-6 (counts are
+// non-increasing in the edge; a surface that no edge in that range raises keeps h).
+double floor_edge(const SurfaceCount& s, int floor, double h, MeshPlanStats& stats) {
+  if (floor <= 1 || h <= 0) return h;
+  double lo = h * 1e-6, hi = h;  // count(lo) >= floor > count(hi)
+  if (count_patches(s, lo, stats) < floor) return h;
+  for (int it = 0; it < 64; ++it) {
+    const double mid = std::sqrt(lo * hi);
+    (count_patches(s, mid, stats) >= floor ? lo : hi) = mid;
+  }
+  return lo;
 }
 
 // The edge bound whose budget is closest to `target`: 60 geometric bisection steps between
 // 1e-4 and 1 scene diagonal, so 63 evaluations of scene_budget whatever the input size
 // (O(63 (surfaces + terms)) in all).
-double search_edge(const Scene& scene, const std::vector<SurfaceCount>& counts, double target,
-                   MeshPlanStats& stats) {
+double search_edge(const Scene& scene, const std::vector<SurfaceCount>& counts,
+                   const std::vector<int>& floor, double target, MeshPlanStats& stats) {
   const auto [lo_corner, hi_corner] = scene.bounds();
   double hi = (hi_corner - lo_corner).norm();  // one element per edge or fewer
   double lo = hi * 1e-4;
-  if (scene_budget(counts, lo, stats) < target) return lo;
+  if (scene_budget(counts, floor, lo, stats) < target) return lo;
   for (int it = 0; it < 60; ++it) {
     const double mid = std::sqrt(lo * hi);
-    (scene_budget(counts, mid, stats) > target ? lo : hi) = mid;
+    (scene_budget(counts, floor, mid, stats) > target ? lo : hi) = mid;
   }
   // Pick whichever bracket is closer to the target.
-  const double at_lo = scene_budget(counts, lo, stats), at_hi = scene_budget(counts, hi, stats);
+  const double at_lo = scene_budget(counts, floor, lo, stats),
+               at_hi = scene_budget(counts, floor, hi, stats);
   return std::abs(at_lo - target) < std::abs(at_hi - target) ? lo : hi;
 }
 
@@ -496,21 +528,54 @@ std::string detail_note(const Scene& scene, const std::vector<SurfaceCount>& cou
 }
 
 // The plan from every surface's closed-form count: one evaluation, O(surfaces + terms), for
-// an edge bound; for a patch target 63 for the search, 2 for the count (3 with the note).
+// an edge bound; for a patch target 63 for the search, 2 for the count (3 with the note),
+// and for the surfaces under the floor 65 evaluations of their own count each.
 MeshPlan plan_counts(const Scene& scene, const std::vector<SurfaceCount>& counts,
                      const MeshOptions& options) {
   LAMBERT_CHECK(options.max_edge >= 0 && options.target_patches >= 0, "negative mesh target");
   MeshPlan plan;
   plan.max_edge = options.max_edge;
-  if (plan.max_edge <= 0 && options.target_patches > 0) {
-    const double target = static_cast<double>(options.target_patches);
-    plan.max_edge = search_edge(scene, counts, target, plan.stats);
-    const std::int64_t made = scene_patches(counts, plan.max_edge, plan.stats);
-    if (static_cast<double>(made) > 1.1 * target)
-      plan.note =
-          detail_note(scene, counts, options.target_patches, plan.max_edge, made, plan.stats);
+  const std::vector<int> floor = surface_floors(counts, options);
+  if (plan.max_edge <= 0 && options.target_patches > 0)
+    plan.max_edge =
+        search_edge(scene, counts, floor, static_cast<double>(options.target_patches), plan.stats);
+  // One evaluation of every surface at the edge bound; a surface under its floor gets its own
+  // finer bound (floor_edge) and is counted at it.
+  ++plan.stats.evaluations;
+  std::vector<double> edge(counts.size(), plan.max_edge);
+  std::int64_t added = 0;
+  for (std::size_t k = 0; k < counts.size(); ++k) {
+    std::int64_t c = count_patches(counts[k], plan.max_edge, plan.stats);
+    if (c < floor[k]) {
+      edge[k] = floor_edge(counts[k], floor[k], plan.max_edge, plan.stats);
+      if (edge[k] != plan.max_edge) {
+        const std::int64_t raised = count_patches(counts[k], edge[k], plan.stats);
+        ++plan.floored;
+        added += raised - c;
+        c = raised;
+      }
+    }
+    plan.patches = add_product(plan.patches, 1, c, 1);
   }
-  plan.patches = scene_patches(counts, plan.max_edge, plan.stats);
+  if (plan.floored > 0) {
+    plan.surface_edge = std::move(edge);
+    const auto covered = static_cast<std::int64_t>(
+        std::count_if(floor.begin(), floor.end(), [](int f) { return f > 0; }));
+    plan.floor_note = "meshing: " + thousands(plan.floored) + " small surface" +
+                      (plan.floored == 1 ? "" : "s") + " raised to the floor of " +
+                      std::to_string(options.surface_floor) + " patches (+" + thousands(added) +
+                      " patches";
+    if (covered < static_cast<std::int64_t>(counts.size()))
+      plan.floor_note += "; the floor covers the " + thousands(covered) + " largest of " +
+                         thousands(static_cast<std::int64_t>(counts.size())) +
+                         " surfaces, a quarter of the target";
+    plan.floor_note += "; --surface-floor to change)";
+  }
+  if (options.target_patches > 0 &&
+      static_cast<double>(plan.patches) > 1.1 * static_cast<double>(options.target_patches) &&
+      options.max_edge <= 0)
+    plan.note =
+        detail_note(scene, counts, options.target_patches, plan.max_edge, plan.patches, plan.stats);
   return plan;
 }
 
@@ -570,7 +635,8 @@ PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options) {
   mesh.max_edge = max_edge;
   mesh.scale = scene.faces.empty() ? 1.0 : std::max((hi - lo).norm(), 1e-300);
   for (size_t s = 0; s < surfaces.size(); ++s) {
-    subdivide(surfaces[s], classes[s], max_edge, static_cast<std::int32_t>(s),
+    const double edge = plan.surface_edge.empty() ? max_edge : plan.surface_edge[s];
+    subdivide(surfaces[s], classes[s], edge, static_cast<std::int32_t>(s),
               scene.material_of(static_cast<std::int32_t>(s)), mesh);
   }
   LAMBERT_CHECK(mesh.patches.size() < static_cast<size_t>(INT32_MAX), "too many patches");

@@ -61,11 +61,19 @@ struct PatchMesh {
 /// Largest mesh lambert builds (F would need ~1e16 entries beyond it anyway).
 constexpr std::int64_t kMaxPatches = 100000000;
 
+/// Patches every surface gets at least under a patch target (MeshOptions::surface_floor).
+constexpr int kDefaultSurfaceFloor = 4;
+
 /// Meshing target. Exactly one of max_edge > 0 or target_patches > 0 is used
 /// (max_edge wins when both are set); with neither, every face becomes one element.
 struct MeshOptions {
   double max_edge = 0.0;            ///< longest allowed patch edge, scene units
   std::int64_t target_patches = 0;  ///< approximate total patch count
+  /// With a patch target (and not discontinuity meshing): every surface gets at least this
+  /// many patches (a finer edge bound of its own where the scene's leaves it fewer), the
+  /// floors taking at most a quarter of the target: when more surfaces would need them, the
+  /// largest by area get them. 0 or 1: no floor.
+  int surface_floor = kDefaultSurfaceFloor;
   /// Discontinuity meshing (discontinuity.hpp): constrained Delaunay triangles whose edges
   /// follow the D0 and D1/D2 lines of the emitters (and of the `discontinuity_sources`
   /// brightest other surfaces), instead of the uniform subdivision.
@@ -85,9 +93,16 @@ struct MeshPlanStats {
 struct MeshPlan {
   double max_edge = 0.0;     ///< the edge bound mesh_scene will use
   std::int64_t patches = 0;  ///< the exact patch count it will produce
+  /// Per surface, its own edge bound where the floor (MeshOptions::surface_floor) made it
+  /// finer than max_edge; empty when every surface uses max_edge.
+  std::vector<double> surface_edge;
+  std::int32_t floored = 0;  ///< surfaces the floor raised
   /// For a patch target: a line for the log when the mesh exceeds the target by more than
   /// 10 % (detail that keeps a patch per face), naming the largest such surface; else "".
   std::string note;
+  /// A line for the log when the floor raised some surfaces (how many, the patches it
+  /// added, and when capped how many surfaces it covered); else "".
+  std::string floor_note;
   MeshPlanStats stats;  ///< what the search cost
 };
 /// The edge bound and patch count mesh_scene(scene, options) will use and produce.

@@ -54,11 +54,19 @@ def load_scene(path=None, strict=False, emit=None):
     return _lambert.load_scene(str(path), bool(strict), rules)
 
 
-def _mesh(self, max_edge=None, patches=None, discontinuity=False):
+def _mesh(self, max_edge=None, patches=None, discontinuity=False, surface_floor=None):
     """Meshes the scene: patch edges at most `max_edge` (scene units) or about `patches`
     patches (max_edge wins when both are given); neither: one patch per face (triangulated
-    above 4 corners). The same mesh as the CLI's --max-edge/--patches."""
-    return _lambert.mesh_scene(self, float(max_edge or 0.0), int(patches or 0), bool(discontinuity))
+    above 4 corners). With `patches`, every surface gets at least `surface_floor` patches
+    (default 4; the floors take at most a quarter of the target). The same mesh as the CLI's
+    --max-edge/--patches/--surface-floor; `surface_floor` without `patches`, or with
+    `discontinuity`, is a UsageError (it would not be read)."""
+    if surface_floor is not None and (not patches or max_edge or discontinuity):
+        raise UsageError("surface_floor is read only with patches (and without max_edge or "
+                         "discontinuity)")
+    floor = _lambert.default_surface_floor if surface_floor is None else int(surface_floor)
+    return _lambert.mesh_scene(self, float(max_edge or 0.0), int(patches or 0), bool(discontinuity),
+                               floor)
 
 
 Scene.mesh = _mesh

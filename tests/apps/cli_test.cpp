@@ -35,6 +35,10 @@ TEST(Cli, UsageErrorsExitWithTwo) {
   EXPECT_EQ(run({"info", "--no-such-option"}), kExitUsage);
   EXPECT_EQ(run({"info", "--patches", "-5"}), kExitUsage);
   EXPECT_EQ(run({"info", "--patches", "10", "--max-edge", "3"}), kExitUsage);
+  // The floor is read under a patch target only (issue 35): not with an edge bound or
+  // discontinuity meshing, which do not read it.
+  EXPECT_EQ(run({"info", "--surface-floor", "8", "--max-edge", "3"}), kExitUsage);
+  EXPECT_EQ(run({"info", "--surface-floor", "8", "--discontinuity"}), kExitUsage);
 }
 
 TEST(Cli, InfoDescribesTheBuiltInCornellBox) {

@@ -20,6 +20,17 @@ namespace {
 
 Material white() { return {"white", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()}; }
 
+// A 4 x 4 x 3 room of six one-quad surfaces, facing inward (the patch-target tests).
+void add_room(Scene& s) {
+  const double L = 4.0, H = 3.0;
+  add_polygon(s, "floor", white(), {{0, 0, 0}, {L, 0, 0}, {L, L, 0}, {0, L, 0}});
+  add_polygon(s, "ceiling", white(), {{0, 0, H}, {0, L, H}, {L, L, H}, {L, 0, H}});
+  add_polygon(s, "south", white(), {{0, 0, 0}, {0, 0, H}, {L, 0, H}, {L, 0, 0}});
+  add_polygon(s, "north", white(), {{0, L, 0}, {L, L, 0}, {L, L, H}, {0, L, H}});
+  add_polygon(s, "west", white(), {{0, 0, 0}, {0, L, 0}, {0, L, H}, {0, 0, H}});
+  add_polygon(s, "east", white(), {{L, 0, 0}, {L, 0, H}, {L, L, H}, {L, L, 0}});
+}
+
 // A scene with a quad, a triangle, a concave L-shaped hexagon and a two-face surface
 // whose faces share an edge, all in different orientations.
 Scene mixed_scene() {
@@ -54,8 +65,9 @@ TEST(Mesh, PreservesEverySurfaceAreaAndRespectsTheEdgeBound) {
     for (const auto& p : mesh.patches) {
       area[p.surface] += p.area;
       for (int k = 0; k < p.vertex_count; ++k) {
-        const double len = (mesh.vertices[p.vertices[k]] -
-                            mesh.vertices[p.vertices[(k + 1) % p.vertex_count]]).norm();
+        const double len =
+            (mesh.vertices[p.vertices[k]] - mesh.vertices[p.vertices[(k + 1) % p.vertex_count]])
+                .norm();
         // Sub-edges are exact fractions L/n <= h of the element edges, up to rounding.
         ASSERT_LE(len, h * (1 + 1e-12));
       }
@@ -89,7 +101,7 @@ TEST(Mesh, IsConformingWithinASurface) {
 
 TEST(Mesh, NormalsFollowTheWinding) {
   Scene s;
-  add_polygon(s, "up", white(), {{0, 0, 0}, {1, 0, 0}, {1, 0, -1}, {0, 0, -1}});  // +y
+  add_polygon(s, "up", white(), {{0, 0, 0}, {1, 0, 0}, {1, 0, -1}, {0, 0, -1}});    // +y
   add_polygon(s, "down", white(), {{0, 0, 0}, {0, 0, -1}, {1, 0, -1}, {1, 0, 0}});  // -y
   const PatchMesh mesh = mesh_scene(s, {0.25, 0});
   for (const auto& p : mesh.patches) {
@@ -208,13 +220,7 @@ TEST(Mesh, APatchTargetIsSharedByAreaBesideADetailedObject) {
   // surface's count is within 2 x 1/15 of A_s / h²), the sheet keeps one patch per face,
   // and the plan says why the mesh exceeds the target.
   Scene s;
-  const double L = 4.0, H = 3.0;
-  add_polygon(s, "floor", white(), {{0, 0, 0}, {L, 0, 0}, {L, L, 0}, {0, L, 0}});
-  add_polygon(s, "ceiling", white(), {{0, 0, H}, {0, L, H}, {L, L, H}, {L, 0, H}});
-  add_polygon(s, "south", white(), {{0, 0, 0}, {0, 0, H}, {L, 0, H}, {L, 0, 0}});
-  add_polygon(s, "north", white(), {{0, L, 0}, {L, L, 0}, {L, L, H}, {0, L, H}});
-  add_polygon(s, "west", white(), {{0, 0, 0}, {0, L, 0}, {0, L, H}, {0, 0, H}});
-  add_polygon(s, "east", white(), {{L, 0, 0}, {L, 0, H}, {L, L, H}, {L, L, 0}});
+  add_room(s);
   const int n = 40;
   const double x0 = 1.75, d = 0.5 / n, z = 0.5;
   for (int i = 0; i < n; ++i)
@@ -384,7 +390,7 @@ TEST(MeshPlan, EqualsABruteForceReferenceOnSmallScenes) {
     const Scene scene = plan_reference_scene(seed);
     const PlanReference ref(scene);
     for (std::int64_t target : {1, 7, 40, 300, 2000}) {
-      const MeshPlan plan = plan_mesh(scene, {0, target});
+      const MeshPlan plan = plan_mesh(scene, {0, target, 0});  // the reference has no floor
       const double h = ref.edge_for(static_cast<double>(target));
       ASSERT_EQ(plan.max_edge, h) << "seed " << seed << " target " << target;
       ASSERT_EQ(plan.patches, ref.patches(h)) << "seed " << seed << " target " << target;
@@ -404,16 +410,98 @@ TEST(MeshPlan, SearchWorkDoesNotGrowWithTheElementsOfAConnectedSurface) {
   for (int m : {20, 100}) {  // 800 and 20,000 triangles
     const Scene scene = test::bumpy_grid(m);
     for (std::int64_t target : {2000, 2 * m * m}) {
-      const MeshPlan plan = plan_mesh(scene, {0, target});
+      const MeshPlan plan = plan_mesh(scene, {0, target});  // one surface: never floored
+      EXPECT_EQ(plan.floored, 0) << m;
       EXPECT_LE(plan.stats.evaluations, 66) << m;
       EXPECT_EQ(plan.stats.terms, plan.stats.evaluations) << m;  // one term each
     }
   }
   // With several surfaces, a term per surface and class (pair) at most, never per element.
   const Scene scene = plan_reference_scene(3);
-  const MeshPlan plan = plan_mesh(scene, {0, 500});
+  const MeshPlan plan = plan_mesh(scene, {0, 500, 0});
   EXPECT_LE(plan.stats.terms,
             plan.stats.evaluations * static_cast<std::int64_t>(scene.faces.size()));
+}
+
+namespace {
+
+std::map<std::string, std::int64_t> patches_per_surface(const PatchMesh& mesh) {
+  std::map<std::string, std::int64_t> count;
+  for (const Patch& p : mesh.patches) ++count[mesh.surface_names[p.surface]];
+  return count;
+}
+
+}  // namespace
+
+// Issue 35, item 2: under a patch target every surface gets at least the floor. A 10 cm
+// plaque on the wall of an 80 m² room has an area share of 2,000 x 0.01 / 80 = 0.25 patch and
+// a 1 cm² triangle 0.003: both were one flat patch (the old plan; surface_floor 0 still
+// does); with the default floor of 4 each gets 4 (one quad or triangle split 2 x 2), the
+// room's surfaces are unchanged (their share is far above the floor), the plan's count is the
+// mesh's and the log line says what the floor added.
+TEST(MeshPlan, EverySurfaceGetsTheFloorUnderAPatchTarget) {
+  Scene s;
+  add_room(s);
+  add_polygon(s, "plaque", white(),
+              {{1.0, 0.001, 1.0}, {1.0, 0.001, 1.1}, {1.1, 0.001, 1.1}, {1.1, 0.001, 1.0}});
+  add_polygon(s, "chip", white(), {{2.0, 2.0, 0.001}, {2.01, 2.0, 0.001}, {2.0, 2.02, 0.001}});
+  const PatchMesh before = mesh_scene(s, {0, 2000, 0});
+  EXPECT_EQ(patches_per_surface(before)["plaque"], 1);
+  EXPECT_EQ(patches_per_surface(before)["chip"], 1);
+
+  const MeshOptions options{0, 2000};
+  EXPECT_EQ(options.surface_floor, kDefaultSurfaceFloor);
+  const MeshPlan plan = plan_mesh(s, options);
+  const PatchMesh mesh = mesh_scene(s, options);
+  ASSERT_EQ(plan.patches, mesh.size());
+  auto count = patches_per_surface(mesh), old = patches_per_surface(before);
+  EXPECT_EQ(count["plaque"], 4);
+  EXPECT_EQ(count["chip"], 4);
+  for (const char* wall : {"floor", "ceiling", "south", "north", "west", "east"})
+    EXPECT_EQ(count[wall], old[wall]) << wall;
+  EXPECT_EQ(plan.floored, 2);
+  EXPECT_EQ(plan.floor_note,
+            "meshing: 2 small surfaces raised to the floor of 4 patches (+6 patches; "
+            "--surface-floor to change)");
+  // Areas are kept exactly as ever (the floor only changes a surface's own edge bound).
+  double plaque = 0.0;
+  for (const Patch& p : mesh.patches)
+    if (mesh.surface_names[p.surface] == "plaque") plaque += p.area;
+  EXPECT_NEAR(plaque, 0.01, 1e-15);
+  // A higher floor: 16 = a 4 x 4 split of the plaque's quad and the chip's triangle.
+  MeshOptions sixteen{0, 2000};
+  sixteen.surface_floor = 16;
+  count = patches_per_surface(mesh_scene(s, sixteen));
+  EXPECT_EQ(count["plaque"], 16);
+  EXPECT_EQ(count["chip"], 16);
+  // An edge bound alone has no target and so no floor: the CLI refuses --surface-floor there.
+  EXPECT_EQ(plan_mesh(s, {1.0, 0}).floored, 0);
+}
+
+// Issue 35, item 2 (detail capped): the floors take at most a quarter of the target, given
+// to the largest surfaces first, so a scene of many small surfaces (Sponza's hundreds of
+// ornaments) keeps the budget for its walls. 600 small squares of distinct sizes beside the
+// room, target 2,000, floor 4: 2,000 / 4 / 4 = 125 surfaces are covered (the 6 room surfaces,
+// which are far above the floor, and the 119 largest squares); the other 481 squares keep
+// one patch each, and the log says the floor was capped.
+TEST(MeshPlan, TheFloorTakesAtMostAQuarterOfTheTargetLargestSurfacesFirst) {
+  Scene s;
+  add_room(s);
+  for (int k = 0; k < 600; ++k) {
+    const double a = 0.01 + 1e-5 * k, x = 0.1 + 0.006 * (k % 600), z = 0.5;
+    add_polygon(s, "square" + std::to_string(k), white(),
+                {{x, 0.001, z}, {x, 0.001, z + a}, {x + a, 0.001, z + a}, {x + a, 0.001, z}});
+  }
+  const MeshPlan plan = plan_mesh(s, {0, 2000});
+  const PatchMesh mesh = mesh_scene(s, {0, 2000});
+  ASSERT_EQ(plan.patches, mesh.size());
+  const auto count = patches_per_surface(mesh);
+  for (int k = 0; k < 600; ++k)
+    EXPECT_EQ(count.at("square" + std::to_string(k)), k >= 600 - 119 ? 4 : 1) << k;
+  EXPECT_EQ(plan.floored, 119);
+  EXPECT_NE(plan.floor_note.find("the floor covers the 125 largest of 606 surfaces"),
+            std::string::npos)
+      << plan.floor_note;
 }
 
 }  // namespace lambert

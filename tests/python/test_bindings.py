@@ -659,3 +659,19 @@ def test_show_writes_the_viewer_page_of_a_solution(cornell_mesh, tmp_path):
     assert [e["name"] for e in doc["asset"]["extras"]["lambert"]["emitters"]] == ["light"]
     with pytest.raises(lambert.UsageError, match="mesh"):
         lambert.show(sol.B, open=False)
+
+
+def test_mesh_surface_floor_is_the_clis(cornell):
+    # Issue 35: under a patch target every surface gets at least `surface_floor` patches, the
+    # CLI's --surface-floor: the light (a 1.4 % share of 2,000 patches, 12) is raised to 32
+    # or more, the mesh is the CLI's patch for patch, and the floor is refused where a mesh
+    # would not read it (an edge bound, discontinuity meshing, no target).
+    default = cornell.mesh(patches=2000)
+    light = default.surface_names.index("light")
+    raised = cornell.mesh(patches=2000, surface_floor=32)
+    assert (default.surface_ids == light).sum() < 32 <= (raised.surface_ids == light).sum()
+    out = run_cli("info", "--patches", 2000, "--surface-floor", 32)
+    assert f"patches: {len(raised)} " in out.stdout
+    for bad in ({"max_edge": 50.0, "patches": 100}, {"discontinuity": True, "patches": 100}, {}):
+        with pytest.raises(lambert.UsageError):
+            cornell.mesh(surface_floor=8, **bad)
