@@ -35,4 +35,15 @@ void check_failed(const char* expr, const char* file, int line, const std::strin
                       std::to_string(line) + ": " + msg);
 }
 
+std::string thousands(std::int64_t n) {
+  const std::string digits = std::to_string(n);
+  const std::size_t first = n < 0 ? 1 : 0;  // after the sign
+  std::string out = digits.substr(0, first);
+  for (std::size_t k = first; k < digits.size(); ++k) {
+    if (k > first && (digits.size() - k) % 3 == 0) out += ',';
+    out += digits[k];
+  }
+  return out;
+}
+
 }  // namespace lambert

@@ -1,6 +1,7 @@
 #pragma once
 // Logging to stderr. stdout carries results only.
 
+#include <cstdint>
 #include <string>
 
 namespace lambert {
@@ -19,5 +20,8 @@ void log_info(const std::string& msg);
 void log_warn(const std::string& msg);
 /// Detail on stderr shown only with --verbose.
 void log_debug(const std::string& msg);
+
+/// A count with thousands separators for log lines: 69938 -> "69,938".
+std::string thousands(std::int64_t n);
 
 }  // namespace lambert

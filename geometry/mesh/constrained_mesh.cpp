@@ -19,6 +19,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <set>
 #include <string>
@@ -311,9 +312,45 @@ std::vector<std::array<Point2, 2>> clean_segments(const std::vector<std::array<P
   return split_at_crossings(split, snapped);
 }
 
+// What went short of the plan on the planes of a mesh, summed over them for one warning
+// per cause (a CAD part has hundreds of planes: one line each flooded the log).
+struct PlaneShortfalls {
+  std::size_t stopped = 0;            ///< planes whose refinement hit the vertex budget
+  std::size_t stopped_vertices = 0;   ///< the most vertices such a plane had
+  std::size_t thin = 0;               ///< their triangles below the angle bound
+  std::size_t triangles = 0;          ///< all their triangles
+  double thinnest = 180.0;            ///< the smallest angle among them (degrees)
+  std::string first_stopped;          ///< the surface of the first such plane
+  std::size_t unrefined = 0;          ///< planes meshed without their lines (CGAL failed)
+  std::string first_unrefined, cgal;  ///< the first such surface and CGAL's expression
+};
+
+// An angle in degrees for a log line, 2 significant digits ("0.31", "7.4").
+std::string angle_text(double degrees) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2g", degrees);
+  return buf;
+}
+
+// The smallest angle of a triangle (degrees; 0 when degenerate).
+double smallest_angle(const Point2& a, const Point2& b, const Point2& c) {
+  const Eigen::Vector2d p[3] = {{CGAL::to_double(a.x()), CGAL::to_double(a.y())},
+                                {CGAL::to_double(b.x()), CGAL::to_double(b.y())},
+                                {CGAL::to_double(c.x()), CGAL::to_double(c.y())}};
+  double smallest = 180.0;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector2d u = p[(k + 1) % 3] - p[k], v = p[(k + 2) % 3] - p[k];
+    const double d = u.norm() * v.norm();
+    smallest = std::min(
+        smallest, d > 0 ? std::acos(std::clamp(u.dot(v) / d, -1.0, 1.0)) * 180.0 / M_PI : 0.0);
+  }
+  return smallest;
+}
+
 // Triangles of one planar part, meshed by a refined constrained Delaunay triangulation.
 std::vector<Triangle> triangulate_part(const Scene& scene, const Part& part, double max_edge,
-                                       const std::vector<const DiscontinuitySegment*>& lines) {
+                                       const std::vector<const DiscontinuitySegment*>& lines,
+                                       PlaneShortfalls& shortfalls) {
   CDT cdt;
   std::map<std::pair<double, double>, Eigen::Vector3d> corners;  // exact 3-D input corners
   // Each face as triangles in 2-D, for the point-in-face tests.
@@ -385,6 +422,7 @@ std::vector<Triangle> triangulate_part(const Scene& scene, const Part& part, dou
   // rounding scale (constraints crossing at tiny angles, self-intersecting faces), and stops
   // with a warning: the mesh is still valid and conforming, some triangles are thin.
   double budget = -1.0;  // set once the first pass has marked the domain
+  bool stopped = false;
   // Two passes: the size bound alone first (no angle bound: it only splits triangles larger
   // than the bound, so it ends near the size plan's vertex count), then the angle bound.
   // Where the second pass runs out of budget (constraints at tiny angles), every triangle
@@ -404,15 +442,24 @@ std::vector<Triangle> triangulate_part(const Scene& scene, const Part& part, dou
     }
     while (!mesher.is_refinement_done()) {
       if (static_cast<double>(cdt.number_of_vertices()) > budget) {
-        log_warn("discontinuity meshing: stopped refining a plane of surface '" +
-                 scene.surfaces[scene.faces[part.faces[0]].surface].name + "' at " +
-                 std::to_string(cdt.number_of_vertices()) +
-                 " vertices (constraints meet at angles or distances too small to resolve); "
-                 "some triangles there are thinner than the " +
-                 std::to_string(kMinAngleDegrees).substr(0, 4) + " degree bound");
+        stopped = true;
         break;
       }
       mesher.step_by_step_refine_mesh();
+    }
+  }
+  if (stopped) {  // the size of the effect: how many triangles are thin, and how thin
+    if (shortfalls.stopped++ == 0)
+      shortfalls.first_stopped = scene.surfaces[scene.faces[part.faces[0]].surface].name;
+    shortfalls.stopped_vertices =
+        std::max<std::size_t>(shortfalls.stopped_vertices, cdt.number_of_vertices());
+    for (auto fh : cdt.finite_face_handles()) {
+      if (!fh->is_in_domain()) continue;
+      const double a =
+          smallest_angle(fh->vertex(0)->point(), fh->vertex(1)->point(), fh->vertex(2)->point());
+      ++shortfalls.triangles;
+      if (a < kMinAngleDegrees) ++shortfalls.thin;
+      shortfalls.thinnest = std::min(shortfalls.thinnest, a);
     }
   }
 
@@ -469,19 +516,25 @@ std::vector<const DiscontinuitySegment*> lines_within_budget(
 // alone are simple polygons, which the mesher handles; if even that fails the scene is
 // refused with a SceneError.
 std::vector<Triangle> mesh_part(const Scene& scene, const Part& part, double max_edge,
-                                const std::vector<const DiscontinuitySegment*>& lines) {
+                                const std::vector<const DiscontinuitySegment*>& lines,
+                                PlaneShortfalls& shortfalls) {
   const std::string& name = scene.surfaces[scene.faces[part.faces[0]].surface].name;
   try {
-    return triangulate_part(scene, part, max_edge, lines);
+    PlaneShortfalls attempt = shortfalls;  // kept only if the attempt succeeds
+    std::vector<Triangle> tris = triangulate_part(scene, part, max_edge, lines, attempt);
+    shortfalls = attempt;
+    return tris;
   } catch (const CGAL::Failure_exception& e) {
     if (lines.empty())
       throw SceneError(scene.source + ": surface '" + name +
                        "': constrained Delaunay meshing failed (CGAL: " + e.expression() + ")");
-    log_warn("discontinuity meshing: CGAL could not refine the lines on a plane of surface '" +
-             name + "' (" + e.expression() + "); that plane is meshed without them");
+    if (shortfalls.unrefined++ == 0) {
+      shortfalls.first_unrefined = name;
+      shortfalls.cgal = e.expression();
+    }
   }
   try {
-    return triangulate_part(scene, part, max_edge, {});
+    return triangulate_part(scene, part, max_edge, {}, shortfalls);
   } catch (const CGAL::Failure_exception& e) {
     throw SceneError(scene.source + ": surface '" + name +
                      "': constrained Delaunay meshing failed (CGAL: " + e.expression() + ")");
@@ -602,6 +655,7 @@ PatchMesh mesh_scene_constrained(const Scene& scene, double max_edge,
   for (const auto& s : constraints) by_face.at(s.face).push_back(&s);
   size_t lines_found = 0, lines_kept = 0, surfaces_cut = 0;
   std::string first_cut;
+  PlaneShortfalls shortfalls;
   for (size_t s = 0; s < scene.surfaces.size(); ++s) {
     const auto surface = static_cast<std::int32_t>(s);
     const std::vector<Part> parts = planar_parts(scene, surface, mesh.scale);
@@ -613,7 +667,7 @@ PatchMesh mesh_scene_constrained(const Scene& scene, double max_edge,
       found += lines.size();
       lines = lines_within_budget(scene, part, max_edge, lines);
       kept += lines.size();
-      const auto part_tris = mesh_part(scene, part, max_edge, lines);
+      const auto part_tris = mesh_part(scene, part, max_edge, lines, shortfalls);
       tris.insert(tris.end(), part_tris.begin(), part_tris.end());
     }
     lines_found += found;
@@ -646,6 +700,23 @@ PatchMesh mesh_scene_constrained(const Scene& scene, double max_edge,
                          " patches: choose a larger --max-edge");
     }
   }
+  if (shortfalls.stopped > 0)
+    log_warn("discontinuity meshing: stopped refining " +
+             thousands(static_cast<std::int64_t>(shortfalls.stopped)) +
+             (shortfalls.stopped == 1 ? " plane" : " planes") + " (the first of surface '" +
+             shortfalls.first_stopped + "', the largest at " +
+             thousands(static_cast<std::int64_t>(shortfalls.stopped_vertices)) +
+             " vertices): constraints meet at angles or distances too small to resolve; " +
+             thousands(static_cast<std::int64_t>(shortfalls.thin)) + " of their " +
+             thousands(static_cast<std::int64_t>(shortfalls.triangles)) +
+             " triangles are thinner than the " + std::to_string(kMinAngleDegrees).substr(0, 4) +
+             " degree bound (the thinnest " + angle_text(shortfalls.thinnest) + " degrees)");
+  if (shortfalls.unrefined > 0)
+    log_warn("discontinuity meshing: CGAL could not refine the lines on " +
+             thousands(static_cast<std::int64_t>(shortfalls.unrefined)) +
+             (shortfalls.unrefined == 1 ? " plane" : " planes") + " (the first of surface '" +
+             shortfalls.first_unrefined + "': " + shortfalls.cgal +
+             "); they are meshed without them");
   if (lines_kept < lines_found)
     log_warn("discontinuity meshing: kept " + std::to_string(lines_kept) + " of " +
              std::to_string(lines_found) + " lines, the longest on each plane within a budget of " +

@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 #include "core/sampling.hpp"
 #include "geometry/mesh/discontinuity.hpp"
 #include "geometry/polygon.hpp"
@@ -397,15 +398,6 @@ double elements_area(const SurfaceElements& s) {
     if (e.n == 4) a += 0.5 * (P[e.v[2]] - P[e.v[0]]).cross(P[e.v[3]] - P[e.v[0]]).norm();
   }
   return a;
-}
-
-std::string thousands(std::int64_t n) {  // 69938 -> "69,938"
-  std::string digits = std::to_string(n), out;
-  for (std::size_t k = 0; k < digits.size(); ++k) {
-    if (k > 0 && (digits.size() - k) % 3 == 0) out += ',';
-    out += digits[k];
-  }
-  return out;
 }
 
 // Every surface's closed-form count (SurfaceCount), from its elements and edge classes.

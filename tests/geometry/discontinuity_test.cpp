@@ -124,3 +124,46 @@ TEST(DiscontinuityMesh, SelfIntersectingAndNonManifoldBlockersStillMesh) {
 
 }  // namespace
 }  // namespace lambert
+
+namespace lambert {
+
+// Issue 35, item 5 (warning floods): a CAD part's discontinuity mesh stopped refining
+// hundreds of planes at their vertex budget and said so once per plane (917 lines on the
+// heat sink). Now one line for all of them, with the size of the effect. Three unit squares
+// on three planes, each with a fan of lines 1e-4 rad apart (angles no refinement resolves):
+// every plane hits its budget, the log has one such line naming the count of planes and how
+// many triangles are thin, and the mesh is still complete (area kept).
+TEST(DiscontinuityMesh, PlanesThatStopRefiningAreSummarisedInOneWarning) {
+  Scene scene;
+  const Material grey{"grey", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
+  std::vector<DiscontinuitySegment> lines;
+  for (int k = 0; k < 3; ++k) {
+    const double z = 2.0 * k;
+    add_polygon(scene, "plate" + std::to_string(k), grey,
+                {{0, 0, z}, {1, 0, z}, {1, 1, z}, {0, 1, z}});
+    for (int j = 0; j < 6; ++j) {
+      const double t = 0.3 + 1e-4 * j;  // the fan's directions from (0.05, 0.05)
+      lines.push_back({Eigen::Vector3d(0.05, 0.05, z),
+                       Eigen::Vector3d(0.05 + 0.9 * std::cos(t), 0.05 + 0.9 * std::sin(t), z), 1,
+                       k});
+    }
+  }
+  ::testing::internal::CaptureStderr();
+  const PatchMesh mesh = mesh_scene_constrained(scene, 0.0, lines);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  std::size_t count = 0;
+  for (std::size_t at = err.find("stopped refining"); at != std::string::npos;
+       at = err.find("stopped refining", at + 1))
+    ++count;
+  EXPECT_EQ(count, 1u) << err;
+  EXPECT_NE(err.find("stopped refining 3 planes (the first of surface 'plate0'"), std::string::npos)
+      << err;
+  EXPECT_NE(err.find("triangles are thinner than the 20.7 degree bound (the thinnest "),
+            std::string::npos)
+      << err;
+  double area = 0.0;
+  for (const Patch& p : mesh.patches) area += p.area;
+  EXPECT_NEAR(area, 3.0, 1e-12);
+}
+
+}  // namespace lambert
