@@ -35,6 +35,14 @@
 // spent (then `converged` is false). Cost: O(k² log k) event segments for k blockers, a
 // CDT of them, then about 50 point factors per triangle (orders 4 and 6). Thread-safe (no
 // shared state).
+//
+// At loose tolerances (tol_G >= 1e-6 of a's area) with two or more blocker pieces left, the
+// event partition costs far more than the tolerance needs, so G is the unoccluded integral
+// (one pattern everywhere) minus the hidden part by adaptive quadrature of fresh point
+// factors without events: per cell only the blockers in its shaft to b, a cell with none
+// exactly 0, cells split to their distance to the blockers before a rule is trusted, the
+// value the order-6 sum and the estimate twice the plain sum of |Q_6 - Q_4| (a cell may hold
+// a kink). A pair that spends 1e5 fresh point factors so is integrated along the events.
 
 #include <cstdint>
 #include <vector>

@@ -63,26 +63,47 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
     std::int32_t block_end = block_begin;
     for (std::int64_t pairs = 0; block_end < last && pairs < block_pairs; ++block_end)
       pairs += n - 1 - block_end;
-    parallel_for(block_end - block_begin, 1, options.run.threads,
-                 [&](std::int64_t begin, std::int64_t end) {
-      for (std::int64_t r = begin; r < end; ++r) {
+    // The block's pairs (i, j > i) in row order, in parallel pair by pair (a room's floor
+    // row alone can outweigh the others: rows as the unit left one thread on it); each pair
+    // writes its own slot, gathered into the rows in order below.
+    std::vector<std::int64_t> offset(1, 0);  // per row of the block, its first pair
+    for (std::int32_t i = block_begin; i < block_end; ++i)
+      offset.push_back(offset.back() + n - 1 - i);
+    const std::int64_t count = offset.back();
+    std::vector<PairEstimate> slot(static_cast<size_t>(count));
+    std::vector<char> done(static_cast<size_t>(count), 0);
+    const std::int64_t chunk = std::max<std::int64_t>(
+        1, count / (64 * static_cast<std::int64_t>(resolve_threads(options.run.threads))));
+    parallel_for(count, chunk, options.run.threads, [&](std::int64_t begin, std::int64_t end) {
+      std::int64_t chunk_rays = 0;
+      for (std::int64_t k = begin; k < end; ++k) {
+        const auto r = std::upper_bound(offset.begin(), offset.end(), k) - offset.begin() - 1;
         const auto i = static_cast<std::int32_t>(block_begin + r);
-        std::int64_t row_rays = 0;
+        const auto j = static_cast<std::int32_t>(i + 1 + (k - offset[r]));
         const bool all = options.subset.only.empty();
-        for (std::int32_t j = i + 1; j < n; ++j) {
-          if (!all && !options.subset.only[i] && !options.subset.only[j]) continue;
-          if (!can_exchange(geom[i], geom[j], plane_eps)) continue;
-          ++tested[i];
-          const PairEstimate e = estimator(ctx, i, j);
-          row_rays += e.rays;
-          unverified[i] += e.unverified;
-          if (e.unverified) unverified_g[i] += 2.0 * e.G;  // both entries of the pair
-          if (e.G > 0.0) rows[i].push_back({j, e.G, e.var});
-        }
-        rays[i] = row_rays;
-        progress.advance(n - 1 - i, row_rays);
+        if (!all && !options.subset.only[i] && !options.subset.only[j]) continue;
+        if (!can_exchange(geom[i], geom[j], plane_eps)) continue;
+        slot[k] = estimator(ctx, i, j);
+        done[k] = 1;
+        chunk_rays += slot[k].rays;
       }
+      progress.advance(end - begin, chunk_rays);
     });
+    for (std::int32_t i = block_begin; i < block_end; ++i) {
+      const std::int64_t r = i - block_begin;
+      std::int64_t row_rays = 0;
+      for (std::int64_t k = offset[r]; k < offset[r + 1]; ++k) {
+        if (!done[k]) continue;
+        const PairEstimate& e = slot[k];
+        const auto j = static_cast<std::int32_t>(i + 1 + (k - offset[r]));
+        ++tested[i];
+        row_rays += e.rays;
+        unverified[i] += e.unverified;
+        if (e.unverified) unverified_g[i] += 2.0 * e.G;  // both entries of the pair
+        if (e.G > 0.0) rows[i].push_back({j, e.G, e.var});
+      }
+      rays[i] = row_rays;
+    }
     for (std::int32_t i = block_begin; i < block_end; ++i) {
       upper.append_row(rows[i]);
       std::vector<RowEntry>().swap(rows[i]);  // release the staging as we go
@@ -119,11 +140,12 @@ constexpr double kCsrEntry = sizeof(double) + sizeof(SparseF::StorageIndex);
 // Peak of compute_pairwise for n patches, all n(n-1)/2 pairs exchanging energy (the bound:
 // a closed scene reaches it): the CSR F (16 bytes per entry, both triangles), the same again
 // for standard errors, and the staging of one block of rows (a 24-byte RowEntry per pair of
-// the block, about 1/kBlocks of the pairs).
+// the block, about 1/kBlocks of the pairs) with its pairs' slots (a PairEstimate and a flag).
 double pairwise_peak_bytes(std::int64_t patches, const FormFactorOptions& o) {
   const double n = static_cast<double>(patches), pairs = n * (n - 1.0) / 2.0;
   const double csr = 2.0 * 16.0 * (o.run.with_stderr ? 2.0 : 1.0);
-  const double staging = 24.0 * 2.0 / static_cast<double>(ff::kBlocks);  // 2 blocks' worth
+  const double staging = (24.0 + sizeof(ff::PairEstimate) + 1.0) * 2.0 /
+                         static_cast<double>(ff::kBlocks);  // 2 blocks' worth
   return pairs * (csr + staging);
 }
 

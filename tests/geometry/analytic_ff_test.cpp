@@ -301,15 +301,16 @@ struct Room {
   std::vector<std::string> names;
   std::vector<Polygon3> faces;
   double footprint = 0.0;
+  void add(const std::string& name, Polygon3 p) {
+    names.push_back(name);
+    faces.push_back(std::move(p));
+  }
 };
 
 Room symmetric_room(int boxes) {
   const double X = 10, Y = 8, Z = 3;
   Room r;
-  auto add = [&](const std::string& name, Polygon3 p) {
-    r.names.push_back(name);
-    r.faces.push_back(std::move(p));
-  };
+  auto add = [&](const std::string& name, Polygon3 p) { r.add(name, std::move(p)); };
   add("wall_x0", {{0, 0, 0}, {0, Y, 0}, {0, Y, Z}, {0, 0, Z}});
   add("wall_x1", {{X, 0, 0}, {X, 0, Z}, {X, Y, Z}, {X, Y, 0}});
   add("wall_y0", {{0, 0, 0}, {0, 0, Z}, {X, 0, Z}, {X, 0, 0}});
@@ -335,6 +336,21 @@ Room symmetric_room(int boxes) {
     box(X - x1, X - x0, y0, y1, h);  // the mirror image (its -x face mirrors the +x one)
   }
   return r;
+}
+
+// F of the room, one patch per face.
+FormFactors room_factors(const Room& r, double tol, int threads) {
+  Scene s;
+  const Material grey{"grey", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
+  for (size_t k = 0; k < r.faces.size(); ++k) add_polygon(s, r.names[k], grey, r.faces[k]);
+  const PatchMesh mesh = mesh_scene(s, {});
+  FormFactorOptions o;
+  o.estimator = "analytic";
+  o.analytic.tol = tol;
+  o.run.progress = false;
+  o.run.threads = threads;
+  o.run.with_stderr = true;
+  return compute_form_factors(mesh, o);
 }
 
 double area_of(const Polygon3& p) { return polygon_area(p); }
@@ -438,18 +454,7 @@ TEST(AnalyticRoom, OneBoxRoomIsClosedAndTheSameForAnyThreadCount) {
   // within m tol, check_room) in ~0.1 s; -j 1 and -j 2 give the same F bit for bit.
   check_room(1, 1e-5);
   const Room r = symmetric_room(1);
-  Scene s;
-  const Material grey{"grey", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
-  for (size_t k = 0; k < r.faces.size(); ++k) add_polygon(s, r.names[k], grey, r.faces[k]);
-  const PatchMesh mesh = mesh_scene(s, {});
-  FormFactorOptions o;
-  o.estimator = "analytic";
-  o.analytic.tol = 1e-5;
-  o.run.progress = false;
-  o.run.threads = 1;
-  const FormFactors one = compute_form_factors(mesh, o);
-  o.run.threads = 2;
-  const FormFactors two = compute_form_factors(mesh, o);
+  const FormFactors one = room_factors(r, 1e-5, 1), two = room_factors(r, 1e-5, 2);
   const Eigen::MatrixXd F1(one.F), F2(two.F);
   EXPECT_EQ((F1 - F2).cwiseAbs().maxCoeff(), 0.0);
 }
@@ -498,6 +503,126 @@ TEST(AnalyticRoomSlow, FourBoxFloorAndCeilingConvergeAt1e8) {
   // Converged: its estimate is at most the target (the estimate is calibrated: above).
   EXPECT_LE(e.error, tol * A);
   EXPECT_GT(e.G, 0.0);
+}
+
+// bench/analytic_bench's furnished room: the closed 10 x 8 x 3 room and the first `boxes` of
+// its 19 boxes standing on the floor (five faces each, no bottom), in the bench's order.
+Room bench_room(int boxes) {
+  const double X = 10, Y = 8, Z = 3;
+  Room r;
+  auto add = [&](const std::string& name, Polygon3 p) { r.add(name, std::move(p)); };
+  add("floor", {{0, 0, 0}, {X, 0, 0}, {X, Y, 0}, {0, Y, 0}});
+  add("ceiling", {{0, 0, Z}, {0, Y, Z}, {X, Y, Z}, {X, 0, Z}});
+  add("wall -x", {{0, 0, 0}, {0, Y, 0}, {0, Y, Z}, {0, 0, Z}});
+  add("wall +x", {{X, 0, 0}, {X, 0, Z}, {X, Y, Z}, {X, Y, 0}});
+  add("wall -y", {{0, 0, 0}, {0, 0, Z}, {X, 0, Z}, {X, 0, 0}});
+  add("wall +y", {{0, Y, 0}, {X, Y, 0}, {X, Y, Z}, {0, Y, Z}});
+  int n = 0;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 4; ++j) {
+      if ((i == 2 && j == 2) || n == boxes) continue;
+      const double x0 = 0.6 + 1.9 * i + 0.1 * (j % 2), y0 = 0.7 + 1.8 * j + 0.15 * (i % 3);
+      const double x1 = x0 + 0.8 + 0.1 * ((i + j) % 3), y1 = y0 + 0.6 + 0.1 * ((i * j) % 4);
+      const double h = 0.5 + 0.25 * ((i + 2 * j) % 5);
+      const std::string name = "box " + std::to_string(n++);
+      r.footprint += (x1 - x0) * (y1 - y0);
+      add(name, {{x0, y0, h}, {x1, y0, h}, {x1, y1, h}, {x0, y1, h}});
+      add(name, {{x0, y0, 0}, {x1, y0, 0}, {x1, y0, h}, {x0, y0, h}});
+      add(name, {{x1, y1, 0}, {x0, y1, 0}, {x0, y1, h}, {x1, y1, h}});
+      add(name, {{x0, y1, 0}, {x0, y0, 0}, {x0, y0, h}, {x0, y1, h}});
+      add(name, {{x1, y0, 0}, {x1, y1, 0}, {x1, y1, h}, {x1, y0, h}});
+    }
+  return r;
+}
+
+TEST(AnalyticPair, HiddenPartByDirectQuadratureKeepsItsEstimateWhereShadowBandsAreNarrow) {
+  // Issue 36 item 1: at loose tolerances a pair with several blocker pieces is the unoccluded
+  // integral minus the hidden part by quadrature of fresh point factors (no event lines). The
+  // bench room's ceiling seen from the wall x = 0 past its 4 boxes: the boxes hide the far
+  // ceiling only from a band z < ~0.3 m of the 8 x 3 m wall, which the rules of two cells
+  // over the whole wall both all but miss; they agreed to 2.7e-3 where the error was 6.3e-3.
+  // Cells are now split to the scale of their distance to the blockers before a rule is
+  // trusted. Reference: the event partition at 1e-7 x A (below kDirectMinRelTol: events
+  // only; estimate 1e-6, calibrated above), far below the tolerances checked.
+  const Room r = bench_room(4);
+  std::vector<Polygon3> blockers;
+  for (size_t k = 0; k < r.faces.size(); ++k)
+    if (k != 1 && k != 2) blockers.push_back(r.faces[k]);
+  const Polygon3& wall = r.faces[2];
+  const double A = polygon_area(wall);
+  const ff::AnalyticEstimate ref = ff::analytic_pair_G(wall, r.faces[1], blockers, 1e-7 * A);
+  ASSERT_TRUE(ref.converged);
+  ASSERT_GT(ref.events, 0);
+  for (double tol : {1e-2, 3e-3, 1e-3}) {
+    const ff::AnalyticEstimate e = ff::analytic_pair_G(wall, r.faces[1], blockers, tol * A);
+    EXPECT_TRUE(e.converged) << tol;
+    EXPECT_EQ(e.events, 0) << tol << ": by direct quadrature";
+    EXPECT_LE(e.error, tol * A) << tol;
+    // The true error within the estimate (plus the reference's own).
+    EXPECT_LE(std::abs(e.G - ref.G), e.error + ref.error) << tol << " estimate " << e.error;
+  }
+}
+
+TEST(AnalyticRoomSlow, FourBoxRoomEntriesLieWithinTheirStatedErrors) {
+  // Issue 36 item 1: every entry of the bench's 4-box room at --tol 1e-4 and 1e-5 (most pairs
+  // by the unoccluded integral minus the hidden part's direct quadrature) lies within its own
+  // stated error (stderr_F) of the 1e-8 reference plus the reference's stated error, and
+  // within tol; -j 1 and -j 2 give the same F bit for bit. About 15 s on 2 busy cores
+  // (the reference: 10 s).
+  const Room r = bench_room(4);
+  const FormFactors ref = room_factors(r, 1e-8, 2);
+  ASSERT_EQ(ref.stats.pairs_unverified, 0);
+  const Eigen::MatrixXd Fr(ref.F), Er(ref.stderr_F);
+  for (double tol : {1e-4, 1e-5}) {
+    const FormFactors two = room_factors(r, tol, 2);
+    EXPECT_EQ(two.stats.pairs_unverified, 0) << tol;
+    const Eigen::MatrixXd F(two.F), E(two.stderr_F);
+    int checked = 0;
+    double worst = 0.0;  // the largest error / stated error, at F(wi, wj)
+    Eigen::Index wi = 0, wj = 0;
+    for (Eigen::Index i = 0; i < F.rows(); ++i)
+      for (Eigen::Index j = 0; j < F.cols(); ++j) {
+        const double err = std::abs(F(i, j) - Fr(i, j));
+        EXPECT_LE(err, E(i, j) + Er(i, j) + 1e-15)
+            << "tol " << tol << ", F(" << i << "," << j << ")";
+        EXPECT_LE(err, tol) << "tol " << tol << ", F(" << i << "," << j << ")";
+        if (F(i, j) != 0.0 || Fr(i, j) != 0.0) {
+          ++checked;
+          const double ratio = err / (E(i, j) + Er(i, j) + 1e-300);
+          if (ratio > worst) {
+            worst = ratio;
+            wi = i;
+            wj = j;
+          }
+        }
+      }
+    std::printf("tol %.0e: %d entries, largest error / stated %.3f at F(%d,%d) = %.6e\n", tol,
+                checked, worst, static_cast<int>(wi), static_cast<int>(wj), Fr(wi, wj));
+    if (tol == 1e-4) {
+      const FormFactors one = room_factors(r, tol, 1);
+      EXPECT_EQ((Eigen::MatrixXd(one.F) - F).cwiseAbs().maxCoeff(), 0.0);
+      EXPECT_EQ((Eigen::MatrixXd(one.stderr_F) - E).cwiseAbs().maxCoeff(), 0.0);
+    }
+  }
+}
+
+TEST(AnalyticRoomSlow, NineteenBoxRoomClosesAt1e4) {
+  // Issue 36 item 1's target: the bench's 19-box room (101 polygons) at --tol 1e-4 closes
+  // within 1e-4 (View3D: 7.9e-3 in 9.4 s). It took 420 s with the event partition alone;
+  // now ~10 s of CPU. Each row sum is within the sum of its entries' stated errors of its
+  // exact value (1; the floor's 1 - footprint / 80, under the boxes it sees their insides),
+  // and, measured 6.5e-5 at worst, within the target 1e-4.
+  const Room r = bench_room(19);
+  ASSERT_EQ(r.faces.size(), 101u);
+  const FormFactors ff = room_factors(r, 1e-4, 2);
+  EXPECT_EQ(ff.stats.pairs_unverified, 0);
+  const Eigen::MatrixXd F(ff.F), E(ff.stderr_F);
+  for (Eigen::Index i = 0; i < F.rows(); ++i) {
+    const double exact = i == 0 ? 1.0 - r.footprint / 80.0 : 1.0;
+    const double err = std::abs(F.row(i).sum() - exact);
+    EXPECT_LE(err, E.row(i).sum()) << "row " << i << " (" << r.names[i] << ")";
+    EXPECT_LE(err, 1e-4) << "row " << i << " (" << r.names[i] << ")";
+  }
 }
 
 // The inside of the unit cube with a two-sided plate (two faces back to back), tilted so that
