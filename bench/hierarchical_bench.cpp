@@ -27,8 +27,10 @@
 // power law t = c e^p fitted to its runs whose error exceeds twice the reference's, and the
 // cheapest measured run at or below it. At the reference's size: its time against
 // hierarchical's time at the reference's estimated error (fit), and against the hierarchical
-// run with the nearest leaf count. Last, per surface, the signed difference of the finest run
-// of each method.
+// run with the nearest leaf count. Per surface, the signed difference of the finest run of
+// each method. Last, the independent reference: light tracing of --photons photons
+// (geometry/render/light_trace.hpp: no F, no solve, no discretisation of B; its own standard
+// error printed) and every run's error against it, the matrix reference's included.
 //
 // Furnace: the closed unit cube, E = 1 and rho = 1/2 on every face (B = 2 exactly), at
 // --epsilons: the escaped share of the emitted power (0 for exact factors) and the worst
@@ -37,7 +39,7 @@
 // Usage: hierarchical_bench [--sections family,cornell,furnace] [--sizes 1000,10000,100000,1000000]
 //   [--epsilon E] [--link-rays K] [--family-matrix-patches N] [--family-rays K]
 //   [--epsilons 1e-2,1e-3,1e-4,3e-5,1e-5] [--patches 100,300,1000,3000] [--ref-patches N]
-//   [--samples S] [--seed S] [-j N] [--plot cornell.svg]
+//   [--photons N (0: no light tracing)] [--samples S] [--seed S] [-j N] [--plot cornell.svg]
 // The machine is shared: compare ratios, and rerun for medians.
 
 #include <sys/resource.h>
@@ -61,6 +63,8 @@
 #include "geometry/analytic.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/hierarchical/hierarchical.hpp"
+#include "geometry/render/light_trace.hpp"
+#include "geometry/visibility/bvh.hpp"
 #include "io/obj_loader.hpp"
 #include "io/plot.hpp"
 #include "pipeline/problem.hpp"
@@ -83,6 +87,7 @@ struct Settings {
   std::vector<double> epsilons = {1e-2, 1e-3, 1e-4, 3e-5, 1e-5};
   std::vector<double> patches = {100, 300, 1000, 3000};
   std::int64_t ref_patches = 10000;
+  std::int64_t photons = 20000000;  ///< the independent light-traced reference
   int samples = 4;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -486,6 +491,39 @@ void write_cornell_plot(const std::string& path, const std::vector<Point>& matri
   std::printf("wrote %s\n", path.c_str());
 }
 
+// The independent reference: per-surface radiosity by light tracing (no F, no solve, no
+// discretisation of B), with its own standard error; every run's error against it.
+void print_against_light_tracing(const Scene& scene, const Settings& s, const Reference& ref,
+                                 const std::vector<Point>& matrix, const std::vector<Point>& hier) {
+  const PatchMesh mesh = mesh_scene(scene, {});
+  const Bvh bvh(mesh, s.threads);
+  Timer t;
+  const LightTraceResult lt = light_trace(mesh, bvh, s.photons, s.seed, s.threads);
+  std::vector<SurfaceRadiosity> traced;
+  double worst_se = 0.0;
+  for (const TracedSurface& ts : lt.surfaces) {
+    traced.push_back({ts.name, ts.area, 0, ts.average});
+    for (int c = 0; c < 3; ++c)
+      if (ts.average[c] > 0) worst_se = std::max(worst_se, ts.stderr_[c] / ts.average[c]);
+  }
+  std::printf(
+      "\nindependent reference: light tracing, %.3g photons (%.3g rays) in %.1f s, escaped "
+      "%.2f %% (G); its worst per-surface standard error %.2e\n",
+      static_cast<double>(lt.photons), static_cast<double>(lt.rays), t.seconds(),
+      100 * lt.escaped[1], worst_se);
+  auto row = [&](const char* method, const std::string& label, double seconds,
+                 const std::vector<SurfaceRadiosity>& a) {
+    const SurfaceDiff d = surface_difference(a, traced);
+    std::printf("  %-12s %-22s %9.2f %10.2e %10.2e %+10.2e  %s/%c\n", method, label.c_str(),
+                seconds, d.worst, d.mean, d.bias, traced[std::max(d.surface, 0)].name.c_str(),
+                "RGB"[std::max(d.channel, 0)]);
+  };
+  row("reference", std::to_string(ref.fine.patches) + " patches", ref.fine.seconds,
+      ref.fine.surfaces);
+  for (const Point& p : matrix) row("matrix", p.label, p.seconds, p.surfaces);
+  for (const Point& p : hier) row("hierarchical", p.label, p.seconds, p.surfaces);
+}
+
 void run_cornell(const Settings& s) {
   const Scene scene = load_obj(builtin_cornell_box_path());
   std::printf("== Cornell box: reference = hybrid, %d samples, gauss-seidel 1e-10 ==\n", s.samples);
@@ -500,6 +538,7 @@ void run_cornell(const Settings& s) {
   print_time_to_target("hierarchical", hier, ref.own.worst);
   print_equal_error(ref, hier);
   if (!matrix.empty() && !hier.empty()) print_surfaces(ref, matrix.back(), hier.back());
+  if (s.photons > 0) print_against_light_tracing(scene, s, ref, matrix, hier);
   if (!s.plot.empty()) write_cornell_plot(s.plot, matrix, hier, ref);
   std::printf("\n");
 }
@@ -575,6 +614,8 @@ bool parse(int argc, char** argv, Settings& s) {
       s.patches = numbers(v);
     else if (!std::strcmp(k, "--ref-patches"))
       s.ref_patches = std::atoll(v);
+    else if (!std::strcmp(k, "--photons"))
+      s.photons = std::atoll(v);
     else if (!std::strcmp(k, "--samples"))
       s.samples = std::atoi(v);
     else if (!std::strcmp(k, "--seed"))

@@ -645,7 +645,8 @@ void conform_creases(const Scene& scene, const std::vector<Part>& parts,
 }  // namespace
 
 PatchMesh mesh_scene_constrained(const Scene& scene, double max_edge,
-                                 const std::vector<DiscontinuitySegment>& constraints) {
+                                 const std::vector<DiscontinuitySegment>& constraints,
+                                 const ConstrainedLimits& limits) {
   PatchMesh mesh;
   copy_surfaces(scene, mesh);
   const auto [lo, hi] = scene.bounds();
@@ -669,6 +670,15 @@ PatchMesh mesh_scene_constrained(const Scene& scene, double max_edge,
       kept += lines.size();
       const auto part_tris = mesh_part(scene, part, max_edge, lines, shortfalls);
       tris.insert(tris.end(), part_tris.begin(), part_tris.end());
+      const auto made = static_cast<std::int64_t>(mesh.patches.size() + tris.size());
+      if (made > limits.max_patches)
+        throw UsageError(
+            "discontinuity meshing passed " + thousands(made) + " patches" +
+            (limits.planned > 0 ? " (" + thousands(limits.planned) + " planned)" : "") +
+            " on surface '" + scene.surfaces[s].name +
+            "': its shadow lines meet at angles or distances too small to resolve (CAD "
+            "slivers, coincident faces); mesh it without --discontinuity, or raise "
+            "--patches or --max-edge");
     }
     lines_found += found;
     lines_kept += kept;
@@ -695,12 +705,9 @@ PatchMesh mesh_scene_constrained(const Scene& scene, double max_edge,
       p.emission = mat.emission;
       p.surface = surface;
       mesh.patches.push_back(p);
-      if (mesh.patches.size() > static_cast<size_t>(kMaxPatches))
-        throw UsageError("discontinuity meshing made more than " + std::to_string(kMaxPatches) +
-                         " patches: choose a larger --max-edge");
     }
   }
-  if (shortfalls.stopped > 0)
+  if (limits.warn && shortfalls.stopped > 0)
     log_warn("discontinuity meshing: stopped refining " +
              thousands(static_cast<std::int64_t>(shortfalls.stopped)) +
              (shortfalls.stopped == 1 ? " plane" : " planes") + " (the first of surface '" +
@@ -711,13 +718,13 @@ PatchMesh mesh_scene_constrained(const Scene& scene, double max_edge,
              thousands(static_cast<std::int64_t>(shortfalls.triangles)) +
              " triangles are thinner than the " + std::to_string(kMinAngleDegrees).substr(0, 4) +
              " degree bound (the thinnest " + angle_text(shortfalls.thinnest) + " degrees)");
-  if (shortfalls.unrefined > 0)
+  if (limits.warn && shortfalls.unrefined > 0)
     log_warn("discontinuity meshing: CGAL could not refine the lines on " +
              thousands(static_cast<std::int64_t>(shortfalls.unrefined)) +
              (shortfalls.unrefined == 1 ? " plane" : " planes") + " (the first of surface '" +
              shortfalls.first_unrefined + "': " + shortfalls.cgal +
              "); they are meshed without them");
-  if (lines_kept < lines_found)
+  if (limits.warn && lines_kept < lines_found)
     log_warn("discontinuity meshing: kept " + std::to_string(lines_kept) + " of " +
              std::to_string(lines_found) + " lines, the longest on each plane within a budget of " +
              std::to_string(kLineBudget).substr(0, 3) + " x its area / the edge bound (" +

@@ -68,8 +68,18 @@ std::vector<std::int32_t> discontinuity_sources(const Scene& scene, int secondar
 /// faces of one surface meet at a crease, the Steiner points either side placed on the
 /// shared edge are inserted on the other side too (fan splits), so the mesh is conforming
 /// within each surface. Triangles tile each face exactly (area to rounding).
+/// With `limits`: refused (UsageError, naming the surface and the planned count) as soon as
+/// the mesh passes limits.max_patches, not after meshing the rest (a CAD part's sliver facets
+/// made 2.5 million patches for a target of 2,000 in 10 minutes); limits.warn false keeps the
+/// shortfall warnings out of the log (a first pass that is meshed again).
+struct ConstrainedLimits {
+  std::int64_t max_patches = kMaxPatches;
+  std::int64_t planned = 0;  ///< the patches the caller planned, for the refusal's message
+  bool warn = true;
+};
 PatchMesh mesh_scene_constrained(const Scene& scene, double max_edge,
-                                 const std::vector<DiscontinuitySegment>& constraints);
+                                 const std::vector<DiscontinuitySegment>& constraints,
+                                 const ConstrainedLimits& limits = {});
 
 /// The smallest angle the refinement guarantees away from small constraint angles:
 /// arcsin(1 / (2 B)) for CGAL's shape bound B = sqrt(2) (the circumradius-to-shortest-edge

@@ -611,12 +611,26 @@ PatchMesh mesh_scene(const Scene& scene, const MeshOptions& options) {
     d.piece = max_edge / 2.0;  // 0 (one element per face): discontinuity.hpp's default
     d.threads = options.threads;
     const std::vector<DiscontinuitySegment> lines = discontinuity_segments(scene, d);
-    PatchMesh mesh = mesh_scene_constrained(scene, max_edge, lines);
-    if (options.max_edge <= 0 && options.target_patches > 0 && max_edge > 0 && mesh.size() > 0) {
+    // Lines add patches beyond the uniform plan (a few times it on the Cornell box); the
+    // final mesh passing 16 times the plan means lines at the rounding scale: refused at once,
+    // not after minutes (kMaxPatches at the most). A first pass that the correction step
+    // meshes again may pass it legitimately (a tessellated sphere's lines: 40 times a target
+    // of 2,000, corrected to under 5 times), so it gets up to 200,000 patches.
+    const bool corrected = options.max_edge <= 0 && options.target_patches > 0 && max_edge > 0;
+    ConstrainedLimits limits;
+    limits.planned = std::max<std::int64_t>(plan.patches, options.target_patches);
+    const std::int64_t final_cap =
+        std::min<std::int64_t>(kMaxPatches, 16 * std::max<std::int64_t>(limits.planned, 1000));
+    limits.max_patches = corrected ? std::max<std::int64_t>(final_cap, 200000) : final_cap;
+    limits.warn = !corrected;  // the correction's pass says what went short
+    PatchMesh mesh = mesh_scene_constrained(scene, max_edge, lines, limits);
+    if (corrected && mesh.size() > 0) {
       // Patches scale as 1 / max_edge^2 away from the constraints: one correction step.
       const double h = max_edge * std::sqrt(static_cast<double>(mesh.size()) /
                                             static_cast<double>(options.target_patches));
-      mesh = mesh_scene_constrained(scene, h, lines);
+      limits.warn = true;
+      limits.max_patches = final_cap;
+      mesh = mesh_scene_constrained(scene, h, lines, limits);
     }
     return mesh;
   }
