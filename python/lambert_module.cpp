@@ -506,6 +506,7 @@ PYBIND11_MODULE(_lambert, m) {
   m.doc() = "lambert's compiled core; use the `lambert` package.";
   m.attr("__version__") = LAMBERT_VERSION;                 // project(VERSION) in CMakeLists.txt
   m.attr("default_surface_floor") = kDefaultSurfaceFloor;  // geometry/mesh/mesh.hpp
+  m.attr("default_hierarchical_epsilon") = HierarchicalOptions{}.epsilon;
   set_log_level(LogLevel::Normal);
 
   // Never destroyed: the translator may run until the interpreter's last call.

@@ -41,7 +41,7 @@ namespace lambert {
 
 /// Settings of a hierarchical solve.
 struct HierarchicalOptions {
-  double epsilon = 1e-4;   ///< link power-error bound, as a fraction of the emitted power
+  double epsilon = 1e-5;   ///< link power-error bound, as a fraction of the emitted power
   double min_area = 0.0;   ///< smallest element area (scene units^2); 0 = total area x 1e-5
   int link_rays = 16;      ///< visibility rays per element link (samples per cluster link)
   double tol = 1e-6;       ///< stopping rule of the Jacobi sweeps (relative change of B)

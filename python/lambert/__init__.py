@@ -318,14 +318,16 @@ def heat(mesh, F, surfaces, ambient_temperature=0.0, length_unit="m", solver="ga
                          _int(threads, "threads"), bool(conductors))
 
 
-def solve_hierarchical(scene, epsilon=1e-4, min_area=0.0, link_rays=16, tol=1e-6,
+def solve_hierarchical(scene, epsilon=None, min_area=0.0, link_rays=16, tol=1e-6,
                        max_iterations=1000, max_passes=10, seed=1, threads=0):
     """The CLI's --method hierarchical: refines links and elements of `scene` to the power
-    error bound `epsilon` and solves. Returns (leaves, B, report): the leaf Mesh (use it with
+    error bound `epsilon` (default: the CLI's, 1e-5) and solves. Returns (leaves, B, report): the leaf Mesh (use it with
     vertex_radiosity, render, write_vertex_exr), B (leaves, 3), and the report (status,
     leaves, links, rays, passes, seconds, energy per channel, error_bound per leaf)."""
     if not isinstance(scene, Scene):
         raise TypeError(f"expected a lambert.Scene (load_scene(...)), got {type(scene).__name__}")
+    if epsilon is None:
+        epsilon = _lambert.default_hierarchical_epsilon
     return _lambert.solve_hierarchical(scene, float(epsilon), float(min_area),
                                        _int(link_rays, "link_rays"), float(tol),
                                        _int(max_iterations, "max_iterations"),

@@ -86,7 +86,7 @@ TEST(CorpusSlow, TheAtriumSolvesHierarchicallyWithItsCoincidentPlaquesAlight) {
   // Hierarchical radiosity (the method that crashed on Sponza) with the plaques, faces lying
   // exactly on the end walls, as the emitters: energy balances to rounding (its sweeps'
   // bookkeeping is exact), and agrees with the matrix method on the walls to 10 % (its
-  // default epsilon 1e-4 against hybrid at 4 samples per pair).
+  // default epsilon 1e-5 against hybrid at 4 samples per pair).
   testing::TempDir dir;
   const std::string atrium = kData + "/atrium/atrium.obj";
   const std::vector<std::string> emit = {"--emit", "plaques=2000,2000,2000"};

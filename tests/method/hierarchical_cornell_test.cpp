@@ -5,6 +5,8 @@
 
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/hierarchical/hierarchical.hpp"
+#include "geometry/render/light_trace.hpp"
+#include "geometry/visibility/bvh.hpp"
 #include "io/obj_loader.hpp"
 #include "pipeline/problem.hpp"
 #include "solvers/radiosity.hpp"
@@ -63,6 +65,28 @@ TEST(HierarchicalCornellSlow, AgreesWithTheMatrixMethodAndConvergesAsEpsilonFall
   EXPECT_LT(worst[1], worst[0]);
   EXPECT_LT(worst[2], worst[1]);
   EXPECT_LE(worst[2], 0.01) << "worst per-surface difference at epsilon 1e-5";
+}
+
+// Issue 37, item 3 (hierarchical accurate by default): at its default settings the Cornell
+// box is within 1 % worst per surface of an independent reference, light tracing (no F, no
+// discretisation of B; geometry/render/light_trace.hpp). 2e7 photons give per-surface
+// standard errors <= 8e-4 relative (measured; asserted below, <= 1.2e-3), so the bound is 1 %
+// plus 4 of the reference's own standard errors. Measured: 0.78 % at the default 1e-5; the
+// old default 1e-4 gave 1.96 % and fails here.
+TEST(HierarchicalCornellSlow, DefaultIsWithinOnePercentOfLightTracing) {
+  const Scene scene = load_obj(builtin_cornell_box_path());
+  const HierarchicalResult h = solve_hierarchical(scene, HierarchicalOptions{});
+  const auto m = surface_means(h.mesh, h.B);
+  const PatchMesh faces = mesh_scene(scene, {});
+  const LightTraceResult lt = light_trace(faces, Bvh(faces, 0), 20000000, 1, 0);
+  ASSERT_EQ(m.size(), lt.surfaces.size());
+  for (std::size_t s = 0; s < m.size(); ++s)
+    for (int c = 0; c < 3; ++c) {
+      const double ref = lt.surfaces[s].average[c], se = lt.surfaces[s].stderr_[c] / ref;
+      if (!(ref > 0)) continue;
+      EXPECT_LE(se, 1.2e-3) << lt.surfaces[s].name;
+      EXPECT_LE(std::abs(m[s][c] / ref - 1), 0.01 + 4 * se) << lt.surfaces[s].name << " " << c;
+    }
 }
 
 TEST(HierarchicalCornell, BitwiseIdenticalForAnyThreadCount) {
