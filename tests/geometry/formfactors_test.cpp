@@ -504,7 +504,9 @@ TEST(KernelSampler, LongSliverNearThePointNeverGivesUp) {
 
 // The contour kernel's atan-free series (kernels.hpp: contour_edge_term) against closed
 // forms. Unit roundoff u = 2^-53; glibc's atan, sqrt and division are within 1 ulp (2u).
+namespace {
 constexpr double kUnitRoundoff = 0x1p-53;
+}  // namespace
 
 // atan_ratio_series(s) against atan(√s) / √s over its whole domain [0, 1/16]. The reference
 // rounds √s (u), atan (2u) and the division (u), and atan(t) / t changes by a relative
@@ -527,10 +529,12 @@ TEST(ContourKernel, SeriesMatchesAtanOverItsDomain) {
 // normal through a corner (Howell's catalogue B-3):
 //   F = 1/(2π) [X/√(1+X²) atan(Y/√(1+X²)) + Y/√(1+Y²) atan(X/√(1+Y²))],  X = a/h, Y = b/h.
 // Both terms are positive: it rounds to a relative 16u (8 operations of <= 2u each).
+namespace {
 double corner_point_factor(double a, double b, double h) {
   const double X = a / h, Y = b / h, sx = std::sqrt(1 + X * X), sy = std::sqrt(1 + Y * Y);
   return (X / sx * std::atan(Y / sx) + Y / sy * std::atan(X / sy)) / (2 * M_PI);
 }
+}  // namespace
 
 // point_to_patch (contour_sum of contour_edge_term) against the closed form, for points
 // below a corner and below an inner point of a 1 x 0.5 rectangle (the sum of the four
