@@ -121,7 +121,8 @@ inline double atan_ratio_series(double s) {
 /// One edge's term of the contour sum, θ n · c / |c| with c = r_a × r_b and θ the angle
 /// between r_a and r_b (0 for a degenerate edge, c = 0); dimensionless.
 ///
-/// Edges seen under θ <= 14° (kContourSeriesMin), nearly all of a scene's, are evaluated
+/// Edges seen under θ <= 14° (kContourSeriesMin: most of a meshed room's, few of a CAD
+/// mesh's near sliver pairs, whose long edges are seen under larger angles) are evaluated
 /// without atan2 or a square root: with d = r_a · r_b > 0 and t = |c| / d = tan θ,
 /// θ / |c| = atan(t) / (t d) = atan_ratio_series(t²) / d, exact to under 1e-17 relative
 /// (see there), so the term is exact to a few ulps as atan2's form is (both share the
