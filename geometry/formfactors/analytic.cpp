@@ -185,12 +185,7 @@ double pattern_factor(const Features& f, const Pattern& pattern, const Eigen::Ve
     r.push_back(f.fb.to3d(q) - x);
   }
   double sum = 0.0;  // contour_sum's terms, one per edge
-  for (const auto& e : pattern.edges) {
-    const Eigen::Vector3d c = r[e[0]].cross(r[e[1]]);
-    const double cn = c.norm();
-    if (cn <= 0.0) continue;
-    sum += std::atan2(cn, r[e[0]].dot(r[e[1]])) * n.dot(c) / cn;
-  }
+  for (const auto& e : pattern.edges) sum += contour_edge_term(n, r[e[0]], r[e[1]]);
   return -sum / (2.0 * M_PI);
 }
 

@@ -156,8 +156,10 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
           y = on_b(u[3], u[4], rng.uniform());
           const Eigen::Vector3d d = y - x;
           const double r2 = d.squaredNorm();
-          const double kern = r2 > 0.0 ? a.normal.dot(d) * -b.normal.dot(d) / (r2 * r2) : 0.0;
-          exhausted = !(rng.uniform() * modes[c].kmax < kern);
+          // Accept with probability K / K_max, K = heights / r⁴: compared as u K_max r⁴ < heights
+          // (no division per try).
+          const double heights = a.normal.dot(d) * -b.normal.dot(d), accept = rng.uniform();
+          exhausted = !(r2 > 0.0 && accept * modes[c].kmax * (r2 * r2) < heights);
           for (double& v : u) v = rng.uniform();
         }
       } else {

@@ -62,14 +62,7 @@ int clip_to_horizon(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const P
 
 double contour_sum(const Eigen::Vector3d& nx, const Eigen::Vector3d* r, int m) {
   double sum = 0.0;
-  for (int k = 0; k < m; ++k) {
-    const Eigen::Vector3d& a = r[k];
-    const Eigen::Vector3d& b = r[(k + 1) % m];
-    const Eigen::Vector3d c = a.cross(b);
-    const double cn = c.norm();
-    if (cn <= 0.0) continue;
-    sum += std::atan2(cn, a.dot(b)) * nx.dot(c) / cn;
-  }
+  for (int k = 0; k < m; ++k) sum += contour_edge_term(nx, r[k], r[k + 1 < m ? k + 1 : 0]);
   return sum;
 }
 

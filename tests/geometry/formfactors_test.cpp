@@ -502,4 +502,83 @@ TEST(KernelSampler, LongSliverNearThePointNeverGivesUp) {
   EXPECT_EQ(gave_up, 0);
 }
 
+// The contour kernel's atan-free series (kernels.hpp: contour_edge_term) against closed
+// forms. Unit roundoff u = 2^-53; glibc's atan, sqrt and division are within 1 ulp (2u).
+namespace {
+constexpr double kUnitRoundoff = 0x1p-53;
+}  // namespace
+
+// atan_ratio_series(s) against atan(√s) / √s over its whole domain [0, 1/16]. The reference
+// rounds √s (u), atan (2u) and the division (u), and atan(t) / t changes by a relative
+// 2t² / 3 <= 1/24 of a relative change of t: <= 4u. The series truncates below 1e-17
+// (8.3e-18 / 0.98, kernels.hpp) and its Estrin evaluation rounds 9 times, each a relative
+// u of a partial sum whose weight in the result is <= 1: <= 9u + 0.1u. Together 14u.
+TEST(ContourKernel, SeriesMatchesAtanOverItsDomain) {
+  double worst = 0.0;
+  for (int k = 0; k <= 4096; ++k) {
+    const double s = k / 4096.0 / ff::kContourSeriesMin;
+    const double t = std::sqrt(s), exact = k ? std::atan(t) / t : 1.0;
+    const double err = std::abs(ff::atan_ratio_series(s) - exact) / exact;
+    EXPECT_LE(err, 14 * kUnitRoundoff) << "s " << s;
+    worst = std::max(worst, err);
+  }
+  std::printf("worst relative error %.2f u\n", worst / kUnitRoundoff);
+}
+
+// The point factor of a rectangle a x b parallel to the point's plane at height h, the
+// normal through a corner (Howell's catalogue B-3):
+//   F = 1/(2π) [X/√(1+X²) atan(Y/√(1+X²)) + Y/√(1+Y²) atan(X/√(1+Y²))],  X = a/h, Y = b/h.
+// Both terms are positive: it rounds to a relative 16u (8 operations of <= 2u each).
+namespace {
+double corner_point_factor(double a, double b, double h) {
+  const double X = a / h, Y = b / h, sx = std::sqrt(1 + X * X), sy = std::sqrt(1 + Y * Y);
+  return (X / sx * std::atan(Y / sx) + Y / sy * std::atan(X / sy)) / (2 * M_PI);
+}
+}  // namespace
+
+// point_to_patch (contour_sum of contour_edge_term) against the closed form, for points
+// below a corner and below an inner point of a 1 x 0.5 rectangle (the sum of the four
+// rectangles at that point: no cancellation in the reference), from 1e-3 to 1e3 of its size
+// above: near edges take atan2, far ones (from ~4 sizes) the series. Error bound of the
+// contour sum: r_k = p_k - x rounds by u|r_k| and each component of c = r_a x r_b by
+// 2u|r_a||r_b| (|r_a,y r_b,z| + |r_a,z r_b,y| <= |r_a||r_b|), so |δc| <= 4√3 u |r_a||r_b|
+// and c's direction turns by <= 4√3 u / sin θ: the term θ n·c/|c| moves by <= 4√3 u θ / sin θ.
+// Its own evaluation (series: above; atan2 form: 4 roundings) adds <= 16u θ. So
+// |δF| <= Σ_k (4√3 θ_k / sin θ_k + 16 θ_k) u / 2π over the edges, plus the reference's 16u F.
+TEST(ContourKernel, PointFactorMatchesTheParallelRectangleClosedForm) {
+  const double a = 1.0, b = 0.5;
+  int series_edges = 0, atan2_edges = 0;
+  double worst = 0.0;
+  for (double h : {1e-3, 1e-2, 0.1, 0.3, 1.0, 3.0, 10.0, 100.0, 1e3})
+    for (const Eigen::Vector2d& at : {Eigen::Vector2d(0, 0), Eigen::Vector2d(0.3, 0.1)}) {
+      ff::PatchGeom g;  // at z = h facing down, wound as point_to_patch expects
+      g.n = 4;
+      g.p = {Eigen::Vector3d(0, 0, h), Eigen::Vector3d(0, b, h), Eigen::Vector3d(a, b, h),
+             Eigen::Vector3d(a, 0, h)};
+      g.normal = -Eigen::Vector3d::UnitZ();
+      g.area = a * b;
+      const Eigen::Vector3d x(at.x(), at.y(), 0), n = Eigen::Vector3d::UnitZ();
+      double exact = 0.0;  // the four corner rectangles around x's foot
+      for (double u : {at.x(), a - at.x()})
+        for (double v : {at.y(), b - at.y()})
+          if (u > 0 && v > 0) exact += corner_point_factor(u, v, h);
+      double bound = 16 * kUnitRoundoff * exact;
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector3d ra = g.p[k] - x, rb = g.p[(k + 1) % 4] - x, c = ra.cross(rb);
+        const double theta = std::atan2(c.norm(), ra.dot(rb));
+        bound += (4 * std::sqrt(3.0) * theta / std::sin(theta) + 16 * theta) * kUnitRoundoff /
+                 (2 * M_PI);
+        const double d = ra.dot(rb);
+        (d > 0 && d * d >= ff::kContourSeriesMin * c.squaredNorm() ? series_edges : atan2_edges)++;
+      }
+      const double f = ff::point_to_patch(x, n, g);
+      EXPECT_NEAR(f, exact, bound) << "h " << h << " at " << at.transpose();
+      worst = std::max(worst, std::abs(f - exact) / bound);
+    }
+  EXPECT_GT(series_edges, 0);  // both branches of contour_edge_term were checked
+  EXPECT_GT(atan2_edges, 0);
+  std::printf("worst error %.3f of its bound; %d series edges, %d atan2 edges\n", worst,
+              series_edges, atan2_edges);
+}
+
 }  // namespace lambert
