@@ -520,8 +520,8 @@ std::string detail_note(const Scene& scene, const std::vector<SurfaceCount>& cou
 }
 
 // The plan from every surface's closed-form count: one evaluation, O(surfaces + terms), for
-// an edge bound; for a patch target 63 for the search, 2 for the count (3 with the note),
-// and for the surfaces under the floor 65 evaluations of their own count each.
+// an edge bound; for a patch target 63 for the search, 1 for the count (2 with the note),
+// and for each surface under its floor up to 66 counts of its own (terms, not evaluations).
 MeshPlan plan_counts(const Scene& scene, const std::vector<SurfaceCount>& counts,
                      const MeshOptions& options) {
   LAMBERT_CHECK(options.max_edge >= 0 && options.target_patches >= 0, "negative mesh target");

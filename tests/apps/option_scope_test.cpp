@@ -84,6 +84,10 @@ std::map<std::string, Trial> trials(const std::string& ff_file, const std::strin
       {"--emit", {{{"floor=1,2,3"}}}},
       {"--max-edge", {{{"0.3"}}, {}, {"--patches"}}},
       {"--patches", {{{"30"}}}},
+      // The floor is inert at the walk's 12-patch target (a quarter of 12 covers no surface at
+      // 4 patches each): it comes with a 200-patch target, where a floor of 12 raises the
+      // blocker from 9 patches to 16 (MeshPlan.* test the floor's effect itself).
+      {"--surface-floor", {{{"12", "--patches", "200"}}, {}, {"--patches"}}},
       {"--discontinuity", {{{}}}},
       {"--discontinuity-sources", {{{"1"}}, {"--discontinuity"}}},
       {"--epsilon", {{{"0.2"}}}},
