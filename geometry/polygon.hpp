@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -40,6 +41,23 @@ double polygon_diameter(const std::vector<Eigen::Vector3d>& poly);
 /// Diagonal of the bounding box, between the diameter and sqrt(3) times it (O(n)).
 double polygon_extent(const std::vector<Eigen::Vector3d>& poly);
 
+/// How far a point sampled on quad (p0, p1, p2, p3) (unit normal n) can lie below the
+/// surface Embree traces for it, along n: |(p0 - p1 + p2 - p3) · n| / 2 (0 when planar).
+/// Embree traces a quad as the triangles (0, 1, 3), (2, 3, 1); the samplers place points on
+/// the bilinear surface (sample_patch) or on the triangles (0, 1, 2), (0, 2, 3)
+/// (KernelSampler). With corner heights h_k along n and w = h0 - h1 + h2 - h3, the bilinear
+/// surface strays from either triangle pair by at most |w| / 4 (at the centre, where it is the
+/// corners' mean and the diagonals' midpoints differ from it by ±w / 4), and the two triangle
+/// pairs -- the upper and lower faces of the corners' tetrahedron, which holds every sampled
+/// point -- by at most |w| / 2. The OBJ loader keeps quads up to 1e-4 of their extent off
+/// their plane; on a 52 cm tile that is 5e-3 cm, more than the rays' offset (1e-6 of the
+/// scene's size), so a ray whose end lies below its own patch's traced triangles would be
+/// counted as blocked by that patch: every ray end on a patch is lifted by offset + warp.
+inline double quad_warp(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
+                        const Eigen::Vector3d& p2, const Eigen::Vector3d& p3,
+                        const Eigen::Vector3d& n) {
+  return 0.5 * std::abs((p0 - p1 + p2 - p3).dot(n));
+}
 
 /// A planar polygon's frame: origin o (its first corner), unit front normal w (Newell), and
 /// in-plane axes u (along the longest edge from o) and v = w x u, so counter-clockwise about

@@ -280,7 +280,7 @@ PointFactors point_form_factors(const PatchMesh& mesh, const Eigen::Vector3d& po
       int seen = 0, exhausted = 0;
       for (int rep = 0; rep < R; ++rep) {
         const int k = ff::replicate_size(options.pair.samples, rep);
-        const int v = ff::count_visible(bvh, point, n, geom[j], k,
+        const int v = ff::count_visible(bvh, point, n, offset, geom[j], k,
                                         hash_keys(options.run.seed, 0xFFFFFFFFull,
                                                   hash_keys(j, static_cast<std::uint64_t>(rep))),
                                         offset, exhausted);

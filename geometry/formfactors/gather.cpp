@@ -64,7 +64,7 @@ void trace_row(const std::vector<PatchGeom>& geom, const std::vector<Eigen::Vect
       double jac;
       const Eigen::Vector3d x = sample_patch(g, seq.get(s, 0), seq.get(s, 1), jac);
       const Eigen::Vector3d dir = cosine_direction(g.normal, t, b, seq.get(s, 2), seq.get(s, 3));
-      const Eigen::Vector3d origin = x + offset * g.normal;
+      const Eigen::Vector3d origin = x + end_lift(g, offset) * g.normal;
       const RayHit hit = bvh.intersect(origin.cast<float>(), dir.cast<float>());
       if (hit.patch < 0 || hit.patch == i) continue;
       if (dir.dot(normals[hit.patch]) >= 0.0) continue;  // the back of j: absorbed

@@ -171,7 +171,8 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
       }
       unverified = unverified || exhausted;
       ++est.rays;
-      const bool v = visible(ctx.bvh, x, a.normal, y, b.normal, ctx.offset);
+      const bool v = visible(ctx.bvh, x, a.normal, end_lift(a, ctx.offset), y, b.normal,
+                             end_lift(b, ctx.offset));
       rnum += v ? w : 0.0;
       rden += w;
     }

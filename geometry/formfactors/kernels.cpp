@@ -19,6 +19,7 @@ std::vector<PatchGeom> patch_geometry(const PatchMesh& mesh) {
     g.area = p.area;
     for (int a = 0; a < g.n; ++a)
       for (int b = a + 1; b < g.n; ++b) g.diameter = std::max(g.diameter, (g.p[a] - g.p[b]).norm());
+    g.warp = quad_warp(g.p, g.n, g.normal);
   }
   return out;
 }

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "geometry/mesh/mesh.hpp"
+#include "geometry/polygon.hpp"
 
 namespace lambert::ff {
 
@@ -37,7 +38,18 @@ struct PatchGeom {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   double area = 0.0;
   double diameter = 0.0;
+  double warp = 0.0;  ///< quad_warp: how far rays' ends on this patch are lifted beyond the offset
 };
+
+/// geometry/polygon.hpp's quad_warp of a quad patch; 0 for triangles.
+inline double quad_warp(const std::array<Eigen::Vector3d, 4>& p, int n,
+                        const Eigen::Vector3d& normal) {
+  return n == 4 ? lambert::quad_warp(p[0], p[1], p[2], p[3], normal) : 0.0;
+}
+
+/// How far a ray's end on patch g is lifted along its normal: the rays' offset (scene units)
+/// plus the patch's warp. Planar patches: exactly `offset`.
+inline double end_lift(const PatchGeom& g, double offset) { return offset + g.warp; }
 
 /// Copies corners and frame of every patch.
 std::vector<PatchGeom> patch_geometry(const PatchMesh& mesh);

@@ -66,7 +66,9 @@ PairEstimate estimate_mc(const PairContext& ctx, std::int32_t i, std::int32_t j)
       const double ci = a.normal.dot(d), cj = -b.normal.dot(d);
       if (ci <= 0.0 || cj <= 0.0 || r2 <= 0.0) continue;
       ++est.rays;
-      if (!visible(ctx.bvh, x, a.normal, y, b.normal, ctx.offset)) continue;
+      if (!visible(ctx.bvh, x, a.normal, end_lift(a, ctx.offset), y, b.normal,
+                   end_lift(b, ctx.offset)))
+        continue;
       sum += ci * cj / (M_PI * r2 * r2) * ja * jb;
     }
     total += sum;

@@ -136,7 +136,7 @@ Row patch_row(const PatchMesh& mesh, const std::vector<ff::PatchGeom>& geom, con
   for (int k = 0; k < o.rays; ++k) {
     double jac;
     const double u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
-    const Eigen::Vector3d x = ff::sample_patch(g, u0, u1, jac) + offset * g.normal;
+    const Eigen::Vector3d x = ff::sample_patch(g, u0, u1, jac) + ff::end_lift(g, offset) * g.normal;
     const Eigen::Vector3d dir = ff::cosine_direction(g.normal, t, b, u2, u3);
     const RayHit hit = bvh.intersect(x.cast<float>(), dir.cast<float>());
     const bool reaches =

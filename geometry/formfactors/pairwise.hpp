@@ -63,11 +63,13 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
                              const Bvh& bvh, PairEstimator estimator);
 
 /// True when the segment between x (on a patch with normal nx) and y (normal ny) is free,
-/// with both ends lifted by `offset` along their normals so the end patches never occlude.
+/// with the ends lifted by `x_lift` and `y_lift` along their normals so the end patches never
+/// occlude (end_lift: the rays' offset plus the patch's warp).
 inline bool visible(const Bvh& bvh, const Eigen::Vector3d& x, const Eigen::Vector3d& nx,
-                    const Eigen::Vector3d& y, const Eigen::Vector3d& ny, double offset) {
-  const Eigen::Vector3d a = x + offset * nx;
-  const Eigen::Vector3d b = y + offset * ny;
+                    double x_lift, const Eigen::Vector3d& y, const Eigen::Vector3d& ny,
+                    double y_lift) {
+  const Eigen::Vector3d a = x + x_lift * nx;
+  const Eigen::Vector3d b = y + y_lift * ny;
   return !bvh.occluded(a.cast<float>(), (b - a).cast<float>(), 0.0f, 1.0f);
 }
 

@@ -84,7 +84,7 @@ void trace_row(const PatchMesh& mesh, const std::vector<PatchGeom>& geom, const 
       double jac;
       const Eigen::Vector3d x = sample_patch(g, seq.get(s, 0), seq.get(s, 1), jac);
       Eigen::Vector3d dir = cosine_direction(g.normal, t, b, seq.get(s, 2), seq.get(s, 3));
-      Eigen::Vector3d origin = x + offset * g.normal;
+      Eigen::Vector3d origin = x + end_lift(g, offset) * g.normal;
       double w = jac / g.area;
       for (int bounce = 0;; ++bounce) {
         const RayHit hit = bvh.intersect(origin.cast<float>(), dir.cast<float>());

@@ -164,10 +164,11 @@ Eigen::Vector3d KernelSampler::sample(double u0, double u1, double u2, Rng& rng,
 }
 
 int count_visible(const Bvh& bvh, const Eigen::Vector3d& x, const Eigen::Vector3d& nx,
-                  const PatchGeom& b, int rays, std::uint64_t stream, double offset,
+                  double x_lift, const PatchGeom& b, int rays, std::uint64_t stream, double offset,
                   int& exhausted) {
   const KernelSampler sampler(x, nx, b);
   if (sampler.empty()) return 0;
+  const double y_lift = end_lift(b, offset);
   const Kronecker4 seq(stream);
   Rng rng(mix64(stream));
   int seen = 0;
@@ -176,7 +177,7 @@ int count_visible(const Bvh& bvh, const Eigen::Vector3d& x, const Eigen::Vector3
     const Eigen::Vector3d y =
         sampler.sample(seq.get(r, 0), seq.get(r, 1), seq.get(r, 2), rng, gave_up);
     exhausted += gave_up;
-    seen += visible(bvh, x, nx, y, b.normal, offset);
+    seen += visible(bvh, x, nx, x_lift, y, b.normal, y_lift);
   }
   return seen;
 }

@@ -58,9 +58,9 @@ class KernelSampler {
 
 /// Number of `rays` visibility rays from x (normal nx, on a patch) to points of b drawn by
 /// KernelSampler that reach b unblocked. `stream` seeds the lattice; `exhausted` counts
-/// rejection give-ups. Ray ends are lifted by `offset` along their normals.
+/// rejection give-ups. The rays leave x + x_lift nx and end lifted by end_lift(b, offset).
 int count_visible(const Bvh& bvh, const Eigen::Vector3d& x, const Eigen::Vector3d& nx,
-                  const PatchGeom& b, int rays, std::uint64_t stream, double offset,
+                  double x_lift, const PatchGeom& b, int rays, std::uint64_t stream, double offset,
                   int& exhausted);
 
 }  // namespace lambert::ff

@@ -163,6 +163,7 @@ void Hierarchy::split_element(std::int32_t i) {
   const Node parent = nodes_[i];
   for (auto& kid : kids) {
     kid.normal = g.normal;
+    kid.warp = g.warp;  // its corners lie on the face's bilinear surface: inside its tetrahedron
     finish_geom(kid);
     Node n;
     n.parent = i;
@@ -179,7 +180,7 @@ void Hierarchy::split_element(std::int32_t i) {
 }
 
 Eigen::Vector3d Hierarchy::sample_point(std::int32_t i, double u, double v, double w,
-                                        Eigen::Vector3d& normal) const {
+                                        Eigen::Vector3d& normal, double& warp) const {
   // Descend by area: u in [0,1) picks a child with probability A_child / A_node and is
   // rescaled to [0,1) within that child's share, so one number serves every level (its
   // precision, 53 bits, covers any depth lambert builds).
@@ -199,6 +200,7 @@ Eigen::Vector3d Hierarchy::sample_point(std::int32_t i, double u, double v, doub
   // area with u's remainder; a triangle is sampled by the folded parallelogram (exact).
   const ff::PatchGeom& g = geom_[i];
   normal = g.normal;
+  warp = g.warp;
   Eigen::Vector3d a = g.p[0], b = g.p[1], c = g.p[2];
   if (g.n == 4) {
     const double a1 = (g.p[1] - g.p[0]).cross(g.p[2] - g.p[0]).norm();

@@ -68,9 +68,10 @@ class Hierarchy {
 
   /// A point of the surfaces below node i, uniform in area, with its element's normal;
   /// descends the tree choosing children by area (u picks the child, its remainder is
-  /// reused), then samples the element with (v, w).
+  /// reused), then samples the element with (v, w); `warp` is the element's (ff::quad_warp of
+  /// the face it lies on: the surface the BVH traces).
   Eigen::Vector3d sample_point(std::int32_t i, double u, double v, double w,
-                               Eigen::Vector3d& normal) const;
+                               Eigen::Vector3d& normal, double& warp) const;
 
   /// Bytes held by nodes and element geometry.
   double bytes() const;

@@ -135,7 +135,7 @@ struct Visibility {
 };
 
 Visibility trace_from(const LinkContext& ctx, const Eigen::Vector3d& x, const Eigen::Vector3d& nx,
-                      const ff::PatchGeom& gq, int rays, std::uint64_t stream) {
+                      double x_lift, const ff::PatchGeom& gq, int rays, std::uint64_t stream) {
   Visibility v;
   const ff::KernelSampler sampler(x, nx, gq);
   if (sampler.empty()) return v;
@@ -145,7 +145,7 @@ Visibility trace_from(const LinkContext& ctx, const Eigen::Vector3d& x, const Ei
     bool gave_up = false;  // never seen in practice (KernelSampler)
     const Eigen::Vector3d y = sampler.sample(seq.get(r, 0), seq.get(r, 1), seq.get(r, 2), rng, gave_up);
     v.ends += y;
-    v.seen += ff::visible(ctx.bvh, x, nx, y, gq.normal, ctx.offset);
+    v.seen += ff::visible(ctx.bvh, x, nx, x_lift, y, gq.normal, ff::end_lift(gq, ctx.offset));
   }
   v.traced = rays;
   return v;
@@ -171,8 +171,8 @@ Action element_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, cons
   double seen_weight = 0.0, weight = 0.0;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (int k = 0; k < u.count; ++k) {
-    const Visibility v = trace_from(ctx, u.points[k].x, gp.normal, gq, per_point,
-                                    hash_keys(ctx.seed, link_key(p, q), k));
+    const Visibility v = trace_from(ctx, u.points[k].x, gp.normal, ff::end_lift(gp, ctx.offset), gq,
+                                    per_point, hash_keys(ctx.seed, link_key(p, q), k));
     if (v.traced == 0) continue;
     count(v);
     seen_weight += u.points[k].weight * v.seen / v.traced;
@@ -187,8 +187,9 @@ Action element_link(const LinkContext& ctx, std::int32_t p, std::int32_t q, cons
   for (int k = 0; k < gp.n; ++k) {
     corner_f[k] = ff::point_to_patch(corner_point(gp, k), gp.normal, gq);
     if (!(corner_f[k] > 0.0)) continue;
-    const Visibility v = trace_from(ctx, corner_point(gp, k), gp.normal, gq, per_point,
-                                    hash_keys(ctx.seed, link_key(p, q), 4 + k));
+    const Visibility v =
+        trace_from(ctx, corner_point(gp, k), gp.normal, ff::end_lift(gp, ctx.offset), gq, per_point,
+                   hash_keys(ctx.seed, link_key(p, q), 4 + k));
     if (v.traced == 0) continue;
     count(v);
     corner_vis[k] = static_cast<double>(v.seen) / v.traced;
@@ -238,15 +239,18 @@ double cluster_transfer(const LinkContext& ctx, std::int32_t p, std::int32_t q,
   double sum = 0.0, share[6] = {0, 0, 0, 0, 0, 0};
   for (int s = 0; s < ctx.rays; ++s) {
     Eigen::Vector3d nx, ny;
-    const Eigen::Vector3d x = ctx.h.sample_point(p, sx.get(s, 0), sx.get(s, 1), sx.get(s, 2), nx);
-    const Eigen::Vector3d y = ctx.h.sample_point(q, sy.get(s, 0), sy.get(s, 1), sy.get(s, 2), ny);
+    double wx = 0.0, wy = 0.0;
+    const Eigen::Vector3d x =
+        ctx.h.sample_point(p, sx.get(s, 0), sx.get(s, 1), sx.get(s, 2), nx, wx);
+    const Eigen::Vector3d y =
+        ctx.h.sample_point(q, sy.get(s, 0), sy.get(s, 1), sy.get(s, 2), ny, wy);
     const Eigen::Vector3d r = y - x;
     const double r2 = r.squaredNorm();
     if (r2 <= 0.0) continue;
     const double cx = nx.dot(r), cy = -ny.dot(r);
     if (cx <= 0.0 || cy <= 0.0) continue;
     ++rays;
-    if (!ff::visible(ctx.bvh, x, nx, y, ny, ctx.offset)) continue;
+    if (!ff::visible(ctx.bvh, x, nx, ctx.offset + wx, y, ny, ctx.offset + wy)) continue;
     const double k = cx * cy / (kPi * r2 * r2);
     sum += k;
     // Where it arrived: the receiving face's orientation, n_a^2 to the bin of n_a's sign.

@@ -70,6 +70,7 @@ LightTraceResult light_trace(const PatchMesh& mesh, const Bvh& bvh, std::int64_t
         Eigen::Vector3d w = src.emission * (total / src.emission.sum()) * (jacobian / src.area) /
                             static_cast<double>(per_batch);
         Eigen::Vector3d normal = src.normal;
+        double lift = ff::end_lift(geom[i], eps);  // x is on the emitter's bilinear surface
         Eigen::Vector3d t, bt;
         int bounces = 0;
         for (;; ++bounces) {
@@ -79,7 +80,7 @@ LightTraceResult light_trace(const PatchMesh& mesh, const Bvh& bvh, std::int64_t
           }
           orthonormal_frame(normal, t, bt);
           const Eigen::Vector3d d = cosine_direction(normal, t, bt, rng.uniform(), rng.uniform());
-          const Eigen::Vector3d o = x + eps * normal;
+          const Eigen::Vector3d o = x + lift * normal;
           ++out.rays;
           const RayHit hit = bvh.intersect(o.cast<float>(), d.cast<float>());
           if (hit.patch < 0) {
@@ -93,8 +94,9 @@ LightTraceResult light_trace(const PatchMesh& mesh, const Bvh& bvh, std::int64_t
           const double survive = p.rho.maxCoeff();
           if (!(survive > 0.0) || rng.uniform() >= survive) break;
           w = reflected / survive;
-          x = o + hit.t * d;
+          x = o + hit.t * d;  // on the traced triangles
           normal = p.normal;
+          lift = eps;
         }
       }
     }

@@ -23,6 +23,7 @@ ff::PatchGeom piece_of(const std::vector<Eigen::Vector3d>& corners) {
   g.centroid = Eigen::Vector3d::Zero();
   for (const auto& c : corners) g.centroid += c / g.n;
   g.diameter = polygon_diameter(corners);
+  g.warp = ff::quad_warp(g.p, g.n, g.normal);
   return g;
 }
 
@@ -95,7 +96,7 @@ Eigen::Vector3d PixelDirectLight::irradiance(const Bvh& bvh, const Eigen::Vector
     const Eigen::Vector3d y = samplers[k].sample(u0, seq.get(r, 1), seq.get(r, 2), rng, gave_up);
     ++cast;
     const ff::PatchGeom& g = pieces_[which[k]];
-    if (!ff::visible(bvh, x, n, y, g.normal, offset_)) continue;
+    if (!ff::visible(bvh, x, n, offset_, y, g.normal, ff::end_lift(g, offset_))) continue;
     // E_e F / p_e = E_e F total / w_e = E_e total / ΣE_e.
     H += emission_[which[k]] * (total / emission_[which[k]].sum());
   }

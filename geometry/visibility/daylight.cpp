@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "core/parallel.hpp"
 #include "core/sampling.hpp"
+#include "geometry/polygon.hpp"
 
 namespace lambert {
 namespace {
@@ -73,11 +74,18 @@ Eigen::MatrixX3d sun_patch_irradiance(const PatchMesh& mesh, const Bvh& bvh, con
       if (!(cosine > 0.0)) continue;
       Rng rng(hash_keys(seed, static_cast<std::uint64_t>(i), 0x73756eull));  // "sun"
       int lit = 0;
+      // Points on a quad's bilinear surface can lie below the triangles Embree traces.
+      const double lift =
+          offset +
+          (p.vertex_count == 4
+               ? quad_warp(mesh.vertices[p.vertices[0]], mesh.vertices[p.vertices[1]],
+                           mesh.vertices[p.vertices[2]], mesh.vertices[p.vertices[3]], p.normal)
+               : 0.0);
       for (int a = 0; a < k; ++a)
         for (int b = 0; b < k; ++b) {
           const Eigen::Vector3d x =
               patch_point(mesh, p, (a + rng.uniform()) / k, (b + rng.uniform()) / k);
-          const Eigen::Vector3d origin = x + offset * p.normal;
+          const Eigen::Vector3d origin = x + lift * p.normal;
           if (!bvh.occluded(origin.cast<float>(), to_sun.cast<float>(), 0.0f,
                             std::numeric_limits<float>::infinity()))
             ++lit;
