@@ -112,6 +112,7 @@ DistributedF distributed_form_factors(const dist::Session& s, const LoadedScene&
   st.pairs_culled = dist::sum(partial.stats.pairs_culled);
   st.pairs_unverified = dist::sum(partial.stats.pairs_unverified);
   st.unverified_exchange = dist::sum(partial.stats.unverified_exchange);
+  st.pairs_short_of_target = dist::sum(partial.stats.pairs_short_of_target);
   st.rays = dist::sum(partial.stats.rays);
   st.seconds = dist::max(timer.seconds());
   out.seconds_per_rank = dist::gather(compute_seconds);

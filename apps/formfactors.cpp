@@ -48,6 +48,7 @@ Json diagnostics_json(const LoadedScene& s, const FormFactors& ff, const FormFac
           {"pairs_culled", ff.stats.pairs_culled},
           {"pairs_unverified", ff.stats.pairs_unverified},
           {"unverified_exchange_share", unverified_exchange_share(ff, s.mesh)},
+          {"pairs_short_of_target", ff.stats.pairs_short_of_target},
           {"rays", ff.stats.rays},
           {"seconds", ff.stats.seconds},
           {"rays_per_second", ff.stats.seconds > 0 ? ff.stats.rays / ff.stats.seconds : 0.0},

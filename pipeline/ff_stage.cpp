@@ -205,6 +205,12 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
                                       " of them on specular paths (depth " +
                                       std::to_string(ff.options.specular.depth) + ")"
                                 : ""));
+  if (ff.stats.pairs_short_of_target > 0)
+    log_warn(std::to_string(ff.stats.pairs_short_of_target) + " of " +
+             std::to_string(ff.stats.pairs_tested) +
+             " patch pairs stayed above --target-stderr at " + std::to_string(kMaxPairSamples) +
+             " samples (their entries carry larger errors; --stderr shows them): raise the "
+             "target or mesh more coarsely");
   if (ff.stats.pairs_unverified > 0) {
     // The size of the effect: the share of the pairs and of the exchange Σ A_i F_ij.
     const double exchange = unverified_exchange_share(ff, scene.mesh);

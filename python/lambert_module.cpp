@@ -181,6 +181,7 @@ py::dict ff_result(FormFactors&& ff, const MeshHandle& m) {
   stats["pairs_tested"] = ff.stats.pairs_tested;
   stats["pairs_culled"] = ff.stats.pairs_culled;
   stats["pairs_unverified"] = ff.stats.pairs_unverified;
+  stats["pairs_short_of_target"] = ff.stats.pairs_short_of_target;
   stats["rays"] = ff.stats.rays;
   stats["seconds"] = ff.stats.seconds;
   out["stats"] = stats;

@@ -29,6 +29,37 @@ namespace ff {
 // block of rows.
 constexpr std::int64_t kBlocks = 64;
 
+// --target-stderr s: the pair is estimated again with 4 times the samples (the error halves)
+// until its error -- the larger of F_ij's and F_ji's, sqrt(var) / min(A_i, A_j) -- is at most
+// s, or the samples reach kMaxPairSamples (then it is counted short of the target). Where
+// the rays all agree (every one seen, or none) the replicates have no spread to read, yet a
+// visible fraction from n rays only resolves 1/n: the error is taken as at least the pair's
+// larger unoccluded factor (its centroids' point factors stand for it) over n. Each estimate
+// uses the pair's own stream, so the result does not depend on the thread count; the last
+// one is kept (the rule reads its spread, not its mean: a bias of the order of its variance).
+PairEstimate estimate_to_target(const PairContext& ctx, PairEstimator estimator, std::int32_t i,
+                                std::int32_t j, double target) {
+  const PatchGeom &a = ctx.geom[i], &b = ctx.geom[j];
+  const double area = std::min(a.area, b.area);
+  const double unoccluded =
+      std::max(point_to_patch(a.centroid, a.normal, b), point_to_patch(b.centroid, b.normal, a));
+  auto error = [&](const PairEstimate& e, int samples) {
+    return std::max(std::sqrt(e.var) / area,
+                    std::max(unoccluded, e.G / area) / static_cast<double>(samples));
+  };
+  PairContext c = ctx;
+  PairEstimate e = estimator(c, i, j);
+  std::int64_t rays = e.rays;
+  while (error(e, c.samples) > target && c.samples < kMaxPairSamples) {
+    c.samples = static_cast<int>(std::min<std::int64_t>(4LL * c.samples, kMaxPairSamples));
+    e = estimator(c, i, j);
+    rays += e.rays;
+  }
+  e.rays = rays;
+  e.short_of_target = error(e, c.samples) > target;
+  return e;
+}
+
 FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& options,
                              const Bvh& bvh, PairEstimator estimator) {
   Timer timer;
@@ -41,6 +72,7 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
                         kRayOffset * mesh.scale,
                         options.analytic.tol};
   const double plane_eps = kPlaneEps * mesh.scale;
+  const double target = estimator_param(options, "--target-stderr");
   const std::int64_t total_pairs = static_cast<std::int64_t>(n) * (n - 1) / 2;
   // A row range (distributed form factors) computes the pairs of rows [first, last) only;
   // every pair keeps its stream hash_keys(seed, i, j), so its entries are the same doubles.
@@ -54,7 +86,7 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
   // energy are never written, so they cost address space only.
   CsrAppender upper(n, 2 * range_pairs, options.run.with_stderr);
   std::vector<std::vector<RowEntry>> rows(n);
-  std::vector<std::int64_t> tested(n, 0), rays(n, 0), unverified(n, 0);
+  std::vector<std::int64_t> tested(n, 0), rays(n, 0), unverified(n, 0), short_of(n, 0);
   std::vector<double> unverified_g(n, 0.0);
   Progress progress("form factors", options.run.progress ? range_pairs : 0, "rays");
   const std::int64_t block_pairs = std::max<std::int64_t>(1, total_pairs / kBlocks);
@@ -83,7 +115,8 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
         const bool all = options.subset.only.empty();
         if (!all && !options.subset.only[i] && !options.subset.only[j]) continue;
         if (!can_exchange(geom[i], geom[j], plane_eps)) continue;
-        slot[k] = estimator(ctx, i, j);
+        slot[k] =
+            target > 0.0 ? estimate_to_target(ctx, estimator, i, j, target) : estimator(ctx, i, j);
         done[k] = 1;
         chunk_rays += slot[k].rays;
       }
@@ -99,6 +132,7 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
         ++tested[i];
         row_rays += e.rays;
         unverified[i] += e.unverified;
+        short_of[i] += e.short_of_target;
         if (e.unverified) unverified_g[i] += 2.0 * e.G;  // both entries of the pair
         if (e.G > 0.0) rows[i].push_back({j, e.G, e.var});
       }
@@ -119,6 +153,7 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
     out.stats.pairs_tested += tested[i];
     out.stats.rays += rays[i];
     out.stats.pairs_unverified += unverified[i];
+    out.stats.pairs_short_of_target += short_of[i];
     out.stats.unverified_exchange += unverified_g[i];
   }
   out.stats.pairs_culled = range_pairs - out.stats.pairs_tested;
@@ -208,10 +243,19 @@ using O = FormFactorOptions;
 
 EstimatorParam samples_param() {
   EstimatorParam p = first_count<&O::pair, &PairEstimatorParams::samples>(
-      integer_param("--samples", "samples", 1, 1 << 20, PairEstimatorParams{}.samples,
+      integer_param("--samples", "samples", 1, kMaxPairSamples, PairEstimatorParams{}.samples,
                     "Sample pairs (rays) per patch pair (pair estimators mc, hybrid)"),
       "estimator_requested");
   p.required = true;
+  return p;
+}
+
+// Read by compute_pairwise for mc and hybrid (estimate_to_target); 0 = off.
+EstimatorParam target_stderr_param() {
+  EstimatorParam p = real_param(
+      "--target-stderr", "target_stderr", 0.0, 1.0, 0.0,
+      "Sample each pair (from --samples, 4x at a time) until the standard error of both its "
+      "factors is at most this (0: off; pair estimators mc, hybrid)");
   return p;
 }
 
@@ -265,8 +309,9 @@ std::vector<FormFactorEstimator> make_registry() {
   // clang-format off
   return {
       {"hybrid", true, true, true, "samples", false, run_hybrid, pairwise_peak_bytes,
-       {samples_param()}},
-      {"mc", true, true, true, "samples", false, run_mc, pairwise_peak_bytes, {samples_param()}},
+       {samples_param(), target_stderr_param()}},
+      {"mc", true, true, true, "samples", false, run_mc, pairwise_peak_bytes,
+       {samples_param(), target_stderr_param()}},
       {"hemicube", false, false, false, "", false, run_hemicube, hemicube_peak_bytes,
        {hemicube_resolution_param()}},
       {"gather", false, true, true, "rays", true, run_gather, gather_peak_bytes, {rays_param()}},
@@ -515,6 +560,10 @@ FormFactors compute_form_factors(const PatchMesh& mesh, const FormFactorOptions&
   // Standard errors come from the spread of independent replicates (replicates.hpp),
   // which needs at least two of them, and Student's t with so few is wide: ask for four.
   const std::string count = e.count_option;
+  if (count == "samples" && estimator_param(o, "--target-stderr") > 0.0 && o.pair.samples < 4)
+    throw UsageError(
+        "--target-stderr needs --samples of at least 4 (standard errors come from independent "
+        "replicates of the samples)");
   if (e.traces_rays && o.run.with_stderr && (count == "rays" ? o.gather.rays : o.pair.samples) < 4)
     throw UsageError("--stderr needs --" + count +
                      " of at least 4 (standard errors come from "

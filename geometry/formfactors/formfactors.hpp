@@ -25,6 +25,9 @@ struct PairEstimatorParams {
   int samples = 32;  ///< sample pairs (rays) per patch pair
 };
 
+/// The most samples per pair (--samples, and where --target-stderr stops).
+constexpr int kMaxPairSamples = 1 << 20;
+
 /// Parameters of the estimator "gather".
 struct GatherParams {
   int rays = 1024;  ///< rays per patch
@@ -141,6 +144,9 @@ struct FormFactorStats {
   /// Σ A_i F_ij + A_j F_ji of those pairs (scene units²): with the total exchange
   /// Σ_i A_i Σ_j F_ij, the share of F they carry (the size of the warning's effect).
   double unverified_exchange = 0.0;
+  /// Pairs (mc, hybrid with --target-stderr) whose standard error was still above the
+  /// target at kMaxPairSamples samples.
+  std::int64_t pairs_short_of_target = 0;
   double seconds = 0.0;           ///< wall time of the computation
   /// Reciprocity averaging (0 when not applied; see reciprocity.hpp), of its averaging step
   /// alone (G = A_i F_ij before, G' = (A_i F_ij + A_j F_ji) / 2): the largest relative change

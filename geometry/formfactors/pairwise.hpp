@@ -32,6 +32,7 @@ struct PairEstimate {
   double var = 0.0;  ///< estimated variance of G (0 when unknown)
   std::int64_t rays = 0;
   bool unverified = false;  ///< visibility could not be sampled as designed (see stats)
+  bool short_of_target = false;  ///< --target-stderr not met at kMaxPairSamples
 };
 
 /// Signature of a pair estimator.

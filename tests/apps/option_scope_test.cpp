@@ -94,6 +94,7 @@ std::map<std::string, Trial> trials(const std::string& ff_file, const std::strin
       {"--min-area", {{{"0.05"}}}},
       {"--link-rays", {{{"2"}}}},
       {"--samples", {{{"3"}}}},
+      {"--target-stderr", {{{"1e-3"}}}},
       {"--rays", {{{"20"}}}},
       // analytic is exact to ~1e-6 on this scene already at a loose target.
       {"--ff-tol", {{{"0.9"}, {"1e-8"}}}},

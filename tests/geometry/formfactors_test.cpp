@@ -430,6 +430,42 @@ TEST(FormFactors, WarpedQuadsKeptByTheLoaderAreNotTheirOwnBlockers) {
     }
 }
 
+TEST(FormFactors, TargetStderrSamplesEveryPairUntilItsErrorMeetsTheTarget) {
+  // Two unit squares 1 apart with a strip halfway across the middle, meshed at 0.5 (4 patches
+  // each): partly shaded pairs, unblocked ones and the strip's. From 4 samples per pair the
+  // estimators' errors reach ~5e-2; with --target-stderr 2e-3 every stored error is at most
+  // 2e-3 and every entry lies within 4 of them of the analytic estimator's (stated error
+  // 2.5e-7): 4 sigma, a false alarm in 1.6e4 entries (here ~100).
+  Scene s = parallel_squares(1.0);
+  Material grey{"grey", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
+  add_polygon(s, "strip", grey, {{0.3, -1, 0.5}, {0.7, -1, 0.5}, {0.7, 2, 0.5}, {0.3, 2, 0.5}});
+  const PatchMesh mesh = mesh_scene(s, {0.5, 0});
+  const FormFactors exact = compute(s, "analytic", 1, 1, 0.5);
+  constexpr double kTarget = 2e-3;
+  for (const std::string est : {"mc", "hybrid"}) {
+    FormFactorOptions o;
+    o.estimator = est;
+    o.pair.samples = 4;
+    o.run.with_stderr = true;
+    o.run.progress = false;
+    const FormFactors plain = compute_form_factors(mesh, o);
+    set_estimator_param(o, "--target-stderr", kTarget);
+    const FormFactors ff = compute_form_factors(mesh, o);
+    EXPECT_EQ(ff.stats.pairs_short_of_target, 0) << est;
+    EXPECT_GT(ff.stats.rays, 4 * plain.stats.rays) << est;
+    double worst_plain = 0.0;
+    for (std::int64_t k = 0; k < plain.stderr_F.nonZeros(); ++k)
+      worst_plain = std::max(worst_plain, plain.stderr_F.valuePtr()[k]);
+    EXPECT_GT(worst_plain, 5 * kTarget) << est;  // the target did raise the samples
+    for (Eigen::Index i = 0; i < ff.F.rows(); ++i)
+      for (SparseF::InnerIterator it(ff.F, i), st(ff.stderr_F, i); it; ++it, ++st) {
+        EXPECT_LE(st.value(), kTarget) << est << " " << i << " " << it.col();
+        EXPECT_NEAR(it.value(), exact.F.coeff(i, it.col()), 4 * kTarget)
+            << est << " " << i << " " << it.col();
+      }
+  }
+}
+
 TEST(KernelSampler, WarpedNeighbourQuadClipsToAHexagonAndSamplesOnIt) {
   // A unit tile whose corners alternate between z = 0 and delta (5e-5 of it off its mean
   // plane: the OBJ loader keeps it a quad), seen from a point of a flat neighbour that lies

@@ -675,3 +675,22 @@ def test_mesh_surface_floor_is_the_clis(cornell):
     for bad in ({"max_edge": 50.0, "patches": 100}, {"discontinuity": True, "patches": 100}, {}):
         with pytest.raises(lambert.UsageError):
             cornell.mesh(surface_floor=8, **bad)
+
+
+def test_target_stderr_is_the_clis(tmp_path, cornell):
+    # Issue 36: --target-stderr samples each pair until both its factors' standard errors are
+    # at most the target: the keyword gives the CLI's F bit for bit, every stored error is
+    # within the target, and an estimator that does not read it refuses it.
+    mesh = cornell.mesh(patches=60)
+    ff = lambert.form_factors(mesh, estimator="hybrid", samples=4, target_stderr=2e-3,
+                              stderr=True, seed=3)
+    assert ff.stderr.max() <= 2e-3 and ff.stats["pairs_short_of_target"] == 0
+    plain = lambert.form_factors(mesh, estimator="hybrid", samples=4, stderr=True, seed=3)
+    assert plain.stderr.max() > 2e-3 and ff.stats["rays"] > plain.stats["rays"]
+    cli = tmp_path / "F.bin"
+    run_cli("formfactors", "--patches", 60, "--estimator", "hybrid", "--samples", 4,
+            "--target-stderr", 2e-3, "--stderr", "--seed", 3, "-q", "-o", cli)
+    G = lambert.load_form_factors(cli, mesh).matrix
+    assert ff.matrix.data.tobytes() == G.data.tobytes()
+    with pytest.raises(lambert.UsageError, match="target_stderr does not apply"):
+        lambert.form_factors(mesh, estimator="gather", target_stderr=1e-3)
