@@ -209,15 +209,22 @@ void write_formfactors_outputs(const FormFactorsOptions& opts, const LoadedScene
   print_diagnostics(scene, ff, d);
   Json j = diagnostics_json(scene, ff, d, "");
   Eigen::VectorXd zone_area;
+  // With a medium the table's errors need the surfaces' F before the zones are appended.
+  const FormFactors surface = medium && opts.by_surface ? ff : FormFactors();
   if (medium) j["medium"] = extend_with_zones(scene, *medium, opts.medium, opts.run, ff, zone_area);
+  SurfaceFactors table;
+  if (medium && opts.by_surface)
+    table = medium_surface_table(scene, surface, ff, *medium, make_zones(*medium), opts.medium,
+                                 opts.run);
+  else if (opts.by_surface)
+    table = surface_factors(scene.mesh, ff);
   const std::string settings = settings_string(ff.options, scene);
   j["settings"] = settings;
   const std::string ext = fs::path(opts.output).extension().string();
   const ValuePrecision precision =
       opts.precision == "float" ? ValuePrecision::Float : ValuePrecision::Double;
   if (opts.by_surface) {
-    write_json_file(opts.output,
-                    surface_json(surface_factors(scene.mesh, ff, medium ? &zone_area : nullptr)));
+    write_json_file(opts.output, surface_json(table));
   } else if (ext == ".mtx") {
     write_matrix_market(opts.output, ff.F, {mesh_hash(scene.mesh), settings}, precision);
   } else {
@@ -252,8 +259,9 @@ int run_formfactors(const FormFactorsOptions& opts) {
     throw UsageError(
         "--point and --stderr do not combine with a participating medium yet: save F (-o F.bin "
         "or F.mtx) and read the zone columns, or --by-surface for the exchange areas");
-  // The surface table carries standard errors, except with a medium (its zones have none).
-  const bool with_stderr = opts.with_stderr || (opts.by_surface && !medium);
+  // The surface table carries standard errors (with a medium: the surfaces' F's and the
+  // spread of the medium's replicates, medium_surface_factors).
+  const bool with_stderr = opts.with_stderr || opts.by_surface;
   JobPlan plan = job_plan(opts.run);
   plan.outputs = {{"-o", opts.output}};
   plan.medium = medium.get();

@@ -90,15 +90,30 @@ void check_medium_scene(const PatchMesh& mesh, const ShadeArgs* shade) {
   check_vertex_interp(*shade, false, "a participating medium");
 }
 
-FormFactors medium_form_factors(const LoadedScene& scene, const FormFactors& surface,
-                                const Medium& medium, const Zones& zones, const MediumArgs& args,
-                                const RunArgs& run) {
+namespace {
+MediumFactorOptions medium_factor_options(const MediumArgs& args, const RunArgs& run) {
   MediumFactorOptions mo;
   mo.rays = args.rays;
   mo.transmittance_samples = args.transmittance_samples;
   mo.seed = run.seed;
   mo.threads = run.threads;
-  return extend_with_medium(scene.mesh, medium, zones, surface, mo, scene_bvh(scene, run.threads));
+  return mo;
+}
+}  // namespace
+
+FormFactors medium_form_factors(const LoadedScene& scene, const FormFactors& surface,
+                                const Medium& medium, const Zones& zones, const MediumArgs& args,
+                                const RunArgs& run) {
+  return extend_with_medium(scene.mesh, medium, zones, surface, medium_factor_options(args, run),
+                            scene_bvh(scene, run.threads));
+}
+
+SurfaceFactors medium_surface_table(const LoadedScene& scene, const FormFactors& surface,
+                                    const FormFactors& extended, const Medium& medium,
+                                    const Zones& zones, const MediumArgs& args,
+                                    const RunArgs& run) {
+  return medium_surface_factors(scene.mesh, surface, extended, medium, zones,
+                                medium_factor_options(args, run), scene_bvh(scene, run.threads));
 }
 
 MediumResult solve_scene_with_medium(const LoadedScene& scene, const FormFactors& surface,

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/formfactors/analysis.hpp"
 #include "geometry/formfactors/media.hpp"
 #include "geometry/media/medium.hpp"
 #include "geometry/render/render.hpp"
@@ -57,6 +58,12 @@ void check_medium_scene(const PatchMesh& mesh, const ShadeArgs* shade);
 FormFactors medium_form_factors(const LoadedScene& scene, const FormFactors& surface,
                                 const Medium& medium, const Zones& zones, const MediumArgs& args,
                                 const RunArgs& run);
+
+/// The surface table of `extended` (medium_form_factors of `surface`) with standard errors
+/// (medium_surface_factors: the medium's estimate repeated in independent replicates).
+SurfaceFactors medium_surface_table(const LoadedScene& scene, const FormFactors& surface,
+                                    const FormFactors& extended, const Medium& medium,
+                                    const Zones& zones, const MediumArgs& args, const RunArgs& run);
 
 /// What the extended solve produced.
 struct MediumResult {

@@ -254,6 +254,47 @@ SurfaceFactors surface_factors(const PatchMesh& mesh, const FormFactors& ff,
   return out;
 }
 
+SurfaceFactors medium_surface_factors(const PatchMesh& mesh, const FormFactors& surface,
+                                      const FormFactors& extended, const Medium& medium,
+                                      const Zones& zones, const MediumFactorOptions& o,
+                                      const Bvh& bvh) {
+  constexpr int R = kMediumReplicates;
+  MediumFactorOptions part = o;
+  part.rays = std::max(1, (o.rays + R - 1) / R);
+  part.transmittance_samples = std::max(1, (o.transmittance_samples + R - 1) / R);
+  std::vector<SurfaceFactors> tables;
+  for (int r = 0; r < R; ++r) {
+    part.seed = hash_keys(o.seed, 0x7265706cull, static_cast<std::uint64_t>(r));  // "repl"
+    tables.push_back(surface_factors(
+        mesh, extend_with_medium(mesh, medium, zones, surface, part, bvh), &zones.area));
+  }
+  SurfaceFactors out = surface_factors(mesh, extended, &zones.area);
+  const Eigen::Index s = out.F.rows(), m = s - 1;  // the medium's group is the last
+  Eigen::MatrixXd var = Eigen::MatrixXd::Zero(s, s);
+  for (Eigen::Index g = 0; g < s; ++g)
+    for (Eigen::Index h = 0; h < s; ++h) {
+      double est[R];
+      for (int r = 0; r < R; ++r) est[r] = tables[r].F(g, h);
+      var(g, h) = ff::replicate_variance(est, R);
+    }
+  const SurfaceFactors plain = surface_factors(mesh, surface);
+  if (plain.has_stderr) {
+    const Eigen::MatrixXd vf = plain.stderr_F.cwiseAbs2();
+    var.topLeftCorner(m, m) += vf;
+    double into_medium = 0.0;
+    for (Eigen::Index g = 0; g < m; ++g) {
+      var(g, m) += vf.row(g).sum();
+      const double r = out.areas[g] / out.areas[m];
+      var(m, g) += vf.row(g).sum() * r * r;
+      into_medium += vf.row(g).sum() * r * r;
+    }
+    var(m, m) += into_medium;
+  }
+  out.stderr_F = var.cwiseSqrt();
+  out.has_stderr = true;
+  return out;
+}
+
 PointFactors point_form_factors(const PatchMesh& mesh, const Eigen::Vector3d& point,
                                 const Eigen::Vector3d& normal, const FormFactorOptions& options) {
   if (!point.allFinite() || !(normal.norm() > 0.0) || !normal.allFinite())

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "geometry/formfactors/formfactors.hpp"
+#include "geometry/formfactors/media.hpp"
 
 namespace lambert {
 
@@ -94,6 +95,26 @@ inline constexpr const char* kMediumGroup = "(medium)";
 /// and A_medium F_medium,H are the zonal method's direct exchange areas (gs, sg, gg).
 SurfaceFactors surface_factors(const PatchMesh& mesh, const FormFactors& ff,
                                const Eigen::VectorXd* zone_area = nullptr);
+
+/// Independent replicates of the medium's factors in medium_surface_factors.
+inline constexpr int kMediumReplicates = 8;
+
+/// surface_factors of `extended` (the surfaces' F `surface` extended by the medium's zones
+/// with options o: extend_with_medium), with standard errors. The medium's part comes from
+/// its estimate repeated with o's rays and transmittance samples split into kMediumReplicates
+/// independent replicates (streams hash_keys(o.seed, salt, r)): the variance of their mean
+/// (replicates.hpp), which has the samples of the one estimate, stands for that estimate's;
+/// the entries within a replicate stay correlated as they are (a ray deposits in many zones,
+/// a row's medium share is what its attenuation removes). The table itself is the one
+/// estimate's: the replicates' few transmittance samples per pair bias a ratio estimator
+/// (O(1/samples)), which shifts their mean but not their spread. Where `surface` carries
+/// per-entry errors their aggregate is added: in full to the surfaces' entries (a bound:
+/// attenuation only shrinks them) and, summed over the surfaces, to the medium's row and
+/// column (the medium takes what attenuation removes).
+SurfaceFactors medium_surface_factors(const PatchMesh& mesh, const FormFactors& surface,
+                                      const FormFactors& extended, const Medium& medium,
+                                      const Zones& zones, const MediumFactorOptions& o,
+                                      const Bvh& bvh);
 
 /// View factors from a differential area at a point to every surface.
 struct PointFactors {
