@@ -224,7 +224,8 @@ FormFactors obtain_form_factors(const LoadedScene& scene, const FormFactorArgs& 
                   static_cast<long long>(ff.stats.pairs_tested), 100.0 * exchange);
     if (ff.options.estimator == "analytic")
       log_warn(pairs + share +
-               " did not reach --ff-tol within their budget of point factors: their entries "
+               " did not reach --ff-tol, neither within their budget of point factors nor by "
+               "sampling to 2^20 rays: their entries "
                "carry a larger error estimate (--stderr shows it); many blockers per pair or "
                "blockers standing on both patches are the likely cause (docs/form-factors.md "
                "\"The analytic estimator\": hybrid or gather suit such scenes)");

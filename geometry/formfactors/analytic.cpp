@@ -1410,12 +1410,23 @@ PairEstimate estimate_analytic(const PairContext& ctx, std::int32_t i, std::int3
   const bool contact_i = blocker_stands_on(pi, blockers),
              contact_j = blocker_stands_on(pj, blockers);
   const bool over_i = contact_i != contact_j ? contact_j : gi.area <= gj.area;
-  const AnalyticEstimate e = analytic_pair_G(over_i ? pi : pj, over_i ? pj : pi, blockers,
-                                             ctx.tol * std::min(gi.area, gj.area));
+  const double area = std::min(gi.area, gj.area);
+  const AnalyticEstimate e =
+      analytic_pair_G(over_i ? pi : pj, over_i ? pj : pi, blockers, ctx.tol * area,
+                      ctx.analytic_budget > 0 ? ctx.analytic_budget : kAnalyticMaxEvaluations);
   PairEstimate out;
   out.G = e.G;
   out.var = e.error * e.error;
   out.unverified = !e.converged;
+  if (e.converged) return out;
+  // The budget ran out (many blockers per pair, blockers standing on both patches): hybrid's
+  // rays until their standard error meets the same tolerance (issue 36), if that does better.
+  const PairEstimate h = estimate_to_target(ctx, estimate_hybrid, i, j, ctx.tol);
+  if (!h.short_of_target || h.var < out.var) {
+    out = h;
+    out.unverified = h.short_of_target;
+  }
+  out.rays = h.rays;  // traced either way
   return out;
 }
 

@@ -24,6 +24,9 @@ struct PairContext {
   std::uint64_t seed;
   double offset;  ///< ray ends are lifted this far off their patches (scene units)
   double tol = 0.0;  ///< estimator "analytic": absolute error target of F_ij and F_ji
+  /// Estimator "analytic": point factors per pair before it falls back to sampling
+  /// (estimate_analytic; 0: kAnalyticMaxEvaluations).
+  std::int64_t analytic_budget = 0;
 };
 
 /// One pair's estimate.
@@ -38,6 +41,12 @@ struct PairEstimate {
 /// Signature of a pair estimator.
 using PairEstimator = PairEstimate (*)(const PairContext&, std::int32_t i, std::int32_t j);
 
+/// `estimator` (mc, hybrid) on pair (i, j) with 4 x the samples at a time, from ctx.samples,
+/// until the larger standard error of F_ij and F_ji is at most `target`
+/// (--target-stderr; short_of_target when kMaxPairSamples did not reach it).
+PairEstimate estimate_to_target(const PairContext& ctx, PairEstimator estimator, std::int32_t i,
+                                std::int32_t j, double target);
+
 /// Estimator "mc": 4-D randomly shifted Kronecker points (x on i, y on j), one occlusion
 /// ray per sample with positive kernel. Unbiased; variance from replicates.
 PairEstimate estimate_mc(const PairContext& ctx, std::int32_t i, std::int32_t j);
@@ -49,8 +58,9 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
 
 /// Estimator "analytic" (analytic.hpp): exact point factors past the blockers the BVH
 /// finds in the pair's bounding ball, integrated over the smaller patch to an error
-/// estimate of ctx.tol on both factors; var is the estimate squared, unverified when the
-/// evaluation budget ran out first. Traces no rays.
+/// estimate of ctx.tol on both factors; var is the estimate squared. Where the budget of
+/// point factors runs out first, the pair is sampled instead (hybrid, estimate_to_target
+/// with target ctx.tol) and the better of the two kept; unverified when neither met ctx.tol.
 PairEstimate estimate_analytic(const PairContext& ctx, std::int32_t i, std::int32_t j);
 
 /// The exact point factor F_{dx->j, visible} at x (unit normal n) past the patches in the
