@@ -269,7 +269,8 @@ SurfaceFactors medium_surface_factors(const PatchMesh& mesh, const FormFactors& 
         mesh, extend_with_medium(mesh, medium, zones, surface, part, bvh), &zones.area));
   }
   SurfaceFactors out = surface_factors(mesh, extended, &zones.area);
-  const Eigen::Index s = out.F.rows(), m = s - 1;  // the medium's group is the last
+  // The medium's group is the last (none when no voxel extinguishes: m = s).
+  const Eigen::Index s = out.F.rows(), m = zones.size() > 0 ? s - 1 : s;
   Eigen::MatrixXd var = Eigen::MatrixXd::Zero(s, s);
   for (Eigen::Index g = 0; g < s; ++g)
     for (Eigen::Index h = 0; h < s; ++h) {
@@ -282,13 +283,13 @@ SurfaceFactors medium_surface_factors(const PatchMesh& mesh, const FormFactors& 
     const Eigen::MatrixXd vf = plain.stderr_F.cwiseAbs2();
     var.topLeftCorner(m, m) += vf;
     double into_medium = 0.0;
-    for (Eigen::Index g = 0; g < m; ++g) {
+    for (Eigen::Index g = 0; g < m && m < s; ++g) {
       var(g, m) += vf.row(g).sum();
       const double r = out.areas[g] / out.areas[m];
       var(m, g) += vf.row(g).sum() * r * r;
       into_medium += vf.row(g).sum() * r * r;
     }
-    var(m, m) += into_medium;
+    if (m < s) var(m, m) += into_medium;
   }
   out.stderr_F = var.cwiseSqrt();
   out.has_stderr = true;
