@@ -316,10 +316,15 @@ double integrate_unoccluded(const PatchGeom& a, const PatchGeom& b,
         continue;
       }
       // A sliver gets the order its width needs across it (sliver_frame), any other cell
-      // one order both ways.
+      // one order both ways. Along a sliver the order is that of twice its length: d is
+      // its axis's distance, the true one to within its width, where a square cell's is its
+      // centre's less its radius, so that a sliver cell kept at length / d <= 2 is up to
+      // twice as long against its true distance as any square one (50 mm from a strip 3 mm
+      // aside, order 6 left 2.2e-6 of G; order 8: 4e-8, HybridQuadrature.SliverStrips...).
       const double d = std::min(touching, hovering);
       const PatchGeom& q = sliver ? frame : g;
-      const GaussRule ru = gauss_legendre(cell_order(along, d, accuracy.extra));
+      const GaussRule ru =
+          gauss_legendre(cell_order(sliver ? 2.0 * along : along, d, accuracy.extra));
       const GaussRule rv = gauss_legendre(cell_order(across, d, accuracy.extra));
       QuadCell cell{g, 0.0};
       for (int u = 0; u < ru.n; ++u)
