@@ -32,8 +32,9 @@ struct QuadratureAccuracy {
 constexpr QuadratureAccuracy kEstimatorAccuracy{0.5, 10, 3, 0};
 /// Relative error bound of kEstimatorAccuracy, checked by tests/geometry/quadrature_test.cpp
 /// (measured worst 5.2e-8 over size ratios 1..100 and heights 0.01..10; 7e-11 for a
-/// shared edge; 5.6e-8 for 100 mm x 0.1 mm sliver strips 2 mm apart, whose cells are cut by
-/// their axis's distance); hybrid adds it to its standard error.
+/// shared edge; 3.5e-7 for 100 mm x 0.1 mm sliver strips 1 mm apart and 50 mm aside, as
+/// before sliver cells were cut by their axis's distance: HybridQuadrature.SliverStrips...);
+/// hybrid adds it to its standard error.
 constexpr double kQuadratureTolerance = 1e-6;
 /// For the reference of `lambert accuracy` and the tests (relative error < 1e-9).
 constexpr QuadratureAccuracy kReferenceAccuracy{2.0, 16, 10, 6};
