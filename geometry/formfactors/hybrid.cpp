@@ -67,20 +67,16 @@ constexpr double kMinJointAcceptance = 0.2;
 // K = (n_a · d)(-n_b · d) / r^4 for x in a's plane and y in b's: n_a · d is y's height above
 // a's plane (at most the largest over b's front corners) and -n_b · d is x's height above
 // b's plane (at most the largest over the cell's corners); r is at least the distance from
-// the cell's bounding sphere to b.
+// the cell to b (cell_distance_bound: along a sliver cell's axis, not from its bounding
+// sphere, which reaches to within half a sliver's length of b and made every sliver cell
+// "per point").
 // `ha` is the largest height of b's front part above a's plane (one per pair).
 CellMode cell_mode(const QuadCell& cell, const PatchGeom& b, double ha, double bfront_area) {
   CellMode m;
   m.ready = true;
   double hb = 0.0;
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (int k = 0; k < cell.g.n; ++k) {
-    hb = std::max(hb, b.normal.dot(cell.g.p[k] - b.p[0]));
-    centre += cell.g.p[k] / cell.g.n;
-  }
-  double radius = 0.0;
-  for (int k = 0; k < cell.g.n; ++k) radius = std::max(radius, (cell.g.p[k] - centre).norm());
-  const double rmin = distance_to_patch(centre, b) - radius;
+  for (int k = 0; k < cell.g.n; ++k) hb = std::max(hb, b.normal.dot(cell.g.p[k] - b.p[0]));
+  const double rmin = cell_distance_bound(cell.g, b);
   if (!(rmin > 0.0) || !(ha > 0.0) || !(hb > 0.0)) return m;
   m.kmax = ha * hb / (rmin * rmin * rmin * rmin);
   const double mean_k = M_PI * cell.G / (cell.g.area * bfront_area);

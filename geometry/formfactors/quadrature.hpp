@@ -31,8 +31,10 @@ struct QuadratureAccuracy {
 /// For the estimators (relative error < 1e-6 for any size ratio, ~1e-6 at shared edges).
 constexpr QuadratureAccuracy kEstimatorAccuracy{0.5, 10, 3, 0};
 /// Relative error bound of kEstimatorAccuracy, checked by tests/geometry/quadrature_test.cpp
-/// (measured worst 1.5e-8 over size ratios 1..100 and heights 0.01..10; 7e-11 for a
-/// shared edge); hybrid adds it to its standard error.
+/// (measured worst 5.2e-8 over size ratios 1..100 and heights 0.01..10; 7e-11 for a
+/// shared edge; 3.5e-7 for 100 mm x 0.1 mm sliver strips 1 mm apart and 50 mm aside, as
+/// before sliver cells were cut by their axis's distance: HybridQuadrature.SliverStrips...);
+/// hybrid adds it to its standard error.
 constexpr double kQuadratureTolerance = 1e-6;
 /// For the reference of `lambert accuracy` and the tests (relative error < 1e-9).
 constexpr QuadratureAccuracy kReferenceAccuracy{2.0, 16, 10, 6};
@@ -56,5 +58,11 @@ void front_part(const PatchGeom& a, const PatchGeom& b, std::vector<PatchGeom>& 
 
 /// Distance from x to the (planar, convex) patch g.
 double distance_to_patch(const Eigen::Vector3d& x, const PatchGeom& g);
+
+/// A lower bound on the distance from any point of `cell` (a planar convex triangle or quad)
+/// to patch b (<= 0 when they may touch): from the cell's bounding sphere, or for a sliver
+/// (long side > 4 x its width) from its long axis less its half width, which is the true
+/// distance to within that width where the sphere undercuts it by up to half the length.
+double cell_distance_bound(const PatchGeom& cell, const PatchGeom& b);
 
 }  // namespace lambert::ff

@@ -120,16 +120,18 @@ TEST(HybridQuadrature, SharedEdgeIsExact) {
 }
 
 // CAD slivers (issue 36): a round fin tip exported as facets 100 mm long and 0.1 mm wide
-// (aspect 1000), facing another such strip 2 or 20 mm away, straight above or offset. The
+// (aspect 1000), facing another such strip 1 to 200 mm away, straight above or offset. The
 // quadrature halves slivers across their length and gives them a low order across it; the
 // sum over the 2 x 2 triangle pairs must still be the rectangles' closed form to
 // kQuadratureTolerance (1e-6 relative per pair, so of the sum). The closed form loses ~16
-// ulps of its largest corner term (|g| <= L² = 0.01): 16 * 2.2e-16 * 0.01 / 2π < 1e-17
-// absolute, against G >= 1e-10 here.
+// ulps of its largest corner term (|g| <= L² + offset² = 0.0125): 16 * 2.2e-16 * 0.0125 / 2π
+// < 1e-17 absolute, against G >= 1e-10 here. Sliver cells, cut by their axis's distance d
+// (cell_distance_bound), run up to 2d long: the worst case, 50 mm up and 3 mm aside, was
+// 2.2e-6 off with the order 6 of cell_order's length / d <= 2 and is 4e-8 with order 8.
 TEST(HybridQuadrature, SliverStripsMatchTheClosedForm) {
   const double L = 0.1, w = 1e-4;
-  for (double h : {0.002, 0.02})
-    for (double offset : {0.0, 0.003}) {
+  for (double h : {0.001, 0.002, 0.005, 0.02, 0.05, 0.2})
+    for (double offset : {0.0, 0.003, 0.05}) {
       const auto lower = strip(L, 0.0, w, 0.0, true), upper = strip(L, offset, w, h, false);
       std::vector<ff::QuadCell> cells;
       double G = 0.0;
