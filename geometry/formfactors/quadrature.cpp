@@ -263,15 +263,7 @@ double integrate_unoccluded(const PatchGeom& a, const PatchGeom& b,
       for (int k = 0; k < t.n; ++k) {
         const Eigen::Vector3d& p = t.p[k];
         const Eigen::Vector3d& q = t.p[(k + 1) % t.n];
-        double dist;
-        if (to) {
-          dist = segment_distance(x, *to, p, q);
-        } else {
-          const Eigen::Vector3d e = q - p;
-          const double e2 = e.squaredNorm();
-          const double u = e2 > 0.0 ? std::clamp(e.dot(x - p) / e2, 0.0, 1.0) : 0.0;
-          dist = (p + u * e - x).norm();
-        }
+        const double dist = segment_distance(x, to ? *to : x, p, q);
         const bool flat = std::abs(a.normal.dot(p - a.p[0])) <= in_plane &&
                           std::abs(a.normal.dot(q - a.p[0])) <= in_plane;
         (flat ? touching : hovering) = std::min(flat ? touching : hovering, dist);
