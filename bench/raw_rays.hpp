@@ -3,6 +3,7 @@
 // rays are generated first, so only the traversal is timed.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -51,5 +52,26 @@ inline double raw_closest_hit_rate(const lambert::Bvh& bvh, const std::vector<Be
                           for (auto k = b; k < e; ++k)
                             hit[k] = bvh.intersect(rays[k].org, rays[k].dir).patch;
                         });
+  return static_cast<double>(rays.size()) / t.seconds();
+}
+
+/// Rays per second of bvh.intersect_packet over `rays` in packets of 16 consecutive rays
+/// (hemisphere_rays: one patch's rays together when per_patch is a multiple of 16).
+inline double raw_closest_hit_packet_rate(const lambert::Bvh& bvh,
+                                          const std::vector<BenchRay>& rays, int threads) {
+  std::vector<std::int32_t> hit(rays.size());
+  lambert::Timer t;
+  const auto packets = static_cast<std::int64_t>((rays.size() + 15) / 16);
+  lambert::parallel_for(packets, 256, threads, [&](std::int64_t b, std::int64_t e) {
+    Eigen::Vector3f o[16], d[16];
+    lambert::RayHit h[16];
+    for (auto p = b; p < e; ++p) {
+      const auto k0 = static_cast<size_t>(p) * 16;
+      const int n = static_cast<int>(std::min<size_t>(16, rays.size() - k0));
+      for (int k = 0; k < n; ++k) o[k] = rays[k0 + k].org, d[k] = rays[k0 + k].dir;
+      bvh.intersect_packet(o, d, n, h);
+      for (int k = 0; k < n; ++k) hit[k0 + k] = h[k].patch;
+    }
+  });
   return static_cast<double>(rays.size()) / t.seconds();
 }

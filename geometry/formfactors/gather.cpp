@@ -55,6 +55,23 @@ void trace_row(const std::vector<PatchGeom>& geom, const std::vector<Eigen::Vect
   Eigen::Vector3d t, b;
   orthonormal_frame(g.normal, t, b);
   hits.clear();
+  // The row's rays go Bvh::kPacket at a time (one patch's origins: Embree's packets trace
+  // them ~1.2x faster than one by one, with the same hits); hits are kept in ray order.
+  Eigen::Vector3f origin[Bvh::kPacket], direction[Bvh::kPacket];
+  Eigen::Vector3d dir[Bvh::kPacket];
+  int rep_of[Bvh::kPacket];
+  double weight[Bvh::kPacket];
+  RayHit hit[Bvh::kPacket];
+  int pending = 0;
+  auto flush = [&] {
+    bvh.intersect_packet(origin, direction, pending, hit);
+    for (int k = 0; k < pending; ++k) {
+      if (hit[k].patch < 0 || hit[k].patch == i) continue;
+      if (dir[k].dot(normals[hit[k].patch]) >= 0.0) continue;  // the back of j: absorbed
+      hits.push_back({hit[k].patch, rep_of[k], weight[k]});
+    }
+    pending = 0;
+  };
   const int R = replicate_count(K);
   for (int rep = 0; rep < R; ++rep) {
     const Kronecker4 seq(
@@ -63,14 +80,15 @@ void trace_row(const std::vector<PatchGeom>& geom, const std::vector<Eigen::Vect
     for (int s = 0; s < k; ++s) {
       double jac;
       const Eigen::Vector3d x = sample_patch(g, seq.get(s, 0), seq.get(s, 1), jac);
-      const Eigen::Vector3d dir = cosine_direction(g.normal, t, b, seq.get(s, 2), seq.get(s, 3));
-      const Eigen::Vector3d origin = x + end_lift(g, offset) * g.normal;
-      const RayHit hit = bvh.intersect(origin.cast<float>(), dir.cast<float>());
-      if (hit.patch < 0 || hit.patch == i) continue;
-      if (dir.dot(normals[hit.patch]) >= 0.0) continue;  // the back of j: absorbed
-      hits.push_back({hit.patch, rep, jac / g.area});
+      dir[pending] = cosine_direction(g.normal, t, b, seq.get(s, 2), seq.get(s, 3));
+      origin[pending] = (x + end_lift(g, offset) * g.normal).cast<float>();
+      direction[pending] = dir[pending].cast<float>();
+      rep_of[pending] = rep;
+      weight[pending] = jac / g.area;
+      if (++pending == Bvh::kPacket) flush();
     }
   }
+  flush();
 }
 
 // Row i's entries from its hits: F_ij = Σ w / K (summed in hit order), and with `with_err`

@@ -52,12 +52,21 @@ PairEstimate estimate_mc(const PairContext& ctx, std::int32_t i, std::int32_t j)
   PairEstimate est;
   const int R = replicate_count(ctx.samples);
   double replicate[kReplicates];
-  double total = 0.0;
+  // The segments go to the batch with their replicate and kernel; each replicate's sum
+  // adds its unblocked kernels in sample order.
+  struct Ray {
+    int rep;
+    double kernel;
+  };
+  thread_local SegmentBatch<Ray> batch;
+  double sum[kReplicates] = {};
+  auto each = [&](const Ray& ray, bool free) {
+    if (free) sum[ray.rep] += ray.kernel;
+  };
+  const double lift_a = end_lift(a, ctx.offset), lift_b = end_lift(b, ctx.offset);
   for (int rep = 0; rep < R; ++rep) {
     const Kronecker4 seq(hash_keys(key, static_cast<std::uint64_t>(rep)));
-    const int k = replicate_size(ctx.samples, rep);
-    double sum = 0.0;
-    for (int s = 0; s < k; ++s) {
+    for (int s = 0, k = replicate_size(ctx.samples, rep); s < k; ++s) {
       double ja, jb;
       const Eigen::Vector3d x = sample_patch(a, seq.get(s, 0), seq.get(s, 1), ja);
       const Eigen::Vector3d y = sample_patch(b, seq.get(s, 2), seq.get(s, 3), jb);
@@ -65,14 +74,16 @@ PairEstimate estimate_mc(const PairContext& ctx, std::int32_t i, std::int32_t j)
       const double r2 = d.squaredNorm();
       const double ci = a.normal.dot(d), cj = -b.normal.dot(d);
       if (ci <= 0.0 || cj <= 0.0 || r2 <= 0.0) continue;
-      ++est.rays;
-      if (!visible(ctx.bvh, x, a.normal, end_lift(a, ctx.offset), y, b.normal,
-                   end_lift(b, ctx.offset)))
-        continue;
-      sum += ci * cj / (M_PI * r2 * r2) * ja * jb;
+      batch.add(x, a.normal, lift_a, y, b.normal, lift_b,
+                Ray{rep, ci * cj / (M_PI * r2 * r2) * ja * jb});
+      if (batch.full()) est.rays += batch.flush(ctx.bvh, each);
     }
-    total += sum;
-    replicate[rep] = sum / k;
+  }
+  est.rays += batch.flush(ctx.bvh, each);
+  double total = 0.0;
+  for (int rep = 0; rep < R; ++rep) {
+    total += sum[rep];
+    replicate[rep] = sum[rep] / replicate_size(ctx.samples, rep);
   }
   est.G = total / ctx.samples;
   est.var = replicate_variance(replicate, R);

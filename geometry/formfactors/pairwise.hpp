@@ -7,6 +7,8 @@
 // by construction. Each pair's random stream is a hash of (seed, i, j): results do not
 // depend on the thread count or schedule.
 
+#include <Eigen/Core>
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -83,5 +85,50 @@ inline bool visible(const Bvh& bvh, const Eigen::Vector3d& x, const Eigen::Vecto
   const Eigen::Vector3d b = y + y_lift * ny;
   return !bvh.occluded(a.cast<float>(), (b - a).cast<float>(), 0.0f, 1.0f);
 }
+
+/// One pair's segments, each with a Payload (what its estimator needs back: replicate,
+/// kernel, weight), traced Bvh::kPacket at a time: a pair's rays run from one patch to
+/// another, coherent enough that Embree's packets trace them ~2.5 x faster than one by one
+/// (bench/formfactors_bench), with the same answers (Bvh::occluded_packet). add() segments as
+/// visible() takes them; flush() traces the pending ones and hands each payload back with
+/// its answer, in the order added. Callers flush when full() (memory stays bounded under
+/// --target-stderr's 2^20 samples) and once at the end.
+template <typename Payload>
+class SegmentBatch {
+ public:
+  static constexpr size_t kFlush = 256;
+
+  void add(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, double x_lift,
+           const Eigen::Vector3d& y, const Eigen::Vector3d& ny, double y_lift,
+           const Payload& payload) {
+    const Eigen::Vector3d a = x + x_lift * nx;
+    const Eigen::Vector3d b = y + y_lift * ny;
+    origin_.push_back(a.cast<float>());
+    direction_.push_back((b - a).cast<float>());
+    payload_.push_back(payload);
+  }
+  bool full() const { return origin_.size() >= kFlush; }
+
+  /// Traces the pending segments and calls each(payload, unblocked) for them in order;
+  /// returns how many were traced.
+  template <typename Each>
+  std::int64_t flush(const Bvh& bvh, Each&& each) {
+    bool hit[Bvh::kPacket];
+    for (size_t k0 = 0; k0 < origin_.size(); k0 += Bvh::kPacket) {
+      const int n = static_cast<int>(std::min<size_t>(Bvh::kPacket, origin_.size() - k0));
+      bvh.occluded_packet(&origin_[k0], &direction_[k0], n, hit);
+      for (int k = 0; k < n; ++k) each(payload_[k0 + k], !hit[k]);
+    }
+    const auto traced = static_cast<std::int64_t>(origin_.size());
+    origin_.clear();
+    direction_.clear();
+    payload_.clear();
+    return traced;
+  }
+
+ private:
+  std::vector<Eigen::Vector3f> origin_, direction_;
+  std::vector<Payload> payload_;
+};
 
 }  // namespace lambert::ff

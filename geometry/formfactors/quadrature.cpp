@@ -241,12 +241,33 @@ void sliver_axis(const PatchGeom& frame, Eigen::Vector3d& from, Eigen::Vector3d&
 
 }  // namespace
 
-double integrate_unoccluded(const PatchGeom& a, const PatchGeom& b,
-                            const QuadratureAccuracy& accuracy, std::vector<QuadCell>& cells) {
-  cells.clear();
-  thread_local std::vector<PatchGeom> pieces, bfront;
+namespace {
+
+// A cell's Gauss rule, its orders over `frame` (the cell in its rule's parameters):
+// Σ w_u w_v jac F(x(u, v) -> b) over its nodes.
+double cell_rule(const QuadCell& cell, const PatchGeom& frame, const PatchGeom& b,
+                 const Eigen::Vector3d& na) {
+  const GaussRule ru = gauss_legendre(cell.order_u), rv = gauss_legendre(cell.order_v);
+  double G = 0.0;
+  for (int u = 0; u < ru.n; ++u)
+    for (int v = 0; v < rv.n; ++v) {
+      double jac;
+      const Eigen::Vector3d x = quadrature_point(frame, ru.x[u], rv.x[v], jac);
+      G += ru.w[u] * rv.w[v] * jac * point_to_patch(x, na, b);
+    }
+  return G;
+}
+
+// Splits each root (a cell and its depth) by `accuracy`'s criterion, depth first, and
+// hands every leaf to leaf(cell, frame): a QuadCell with its Gauss orders (G unset) and the
+// cell in its rule's parameters (sliver_frame's, or itself), in a fixed order. A leaf of a coarser
+// criterion (smaller kappa and depths) split again by a finer one gives the finer one's leaves from
+// that root in the same order: the finer tree refines it.
+template <typename Leaf>
+void subdivide(const PatchGeom& a, const PatchGeom& b, const QuadratureAccuracy& accuracy,
+               const std::vector<std::pair<PatchGeom, int>>& roots, Leaf&& leaf) {
+  thread_local std::vector<PatchGeom> bfront;
   thread_local std::vector<std::pair<PatchGeom, int>> stack;
-  front_part(a, b, pieces);
   // F(x -> b) is analytic in x away from the lines of the edges of b's part in front of a
   // (the contour it is the integral over), so distances are taken to those edges. Edges in
   // a's plane (a shared edge, a contact line) touch the domain: F stays continuous there
@@ -269,9 +290,8 @@ double integrate_unoccluded(const PatchGeom& a, const PatchGeom& b,
         (flat ? touching : hovering) = std::min(flat ? touching : hovering, dist);
       }
   };
-  double total = 0.0;
-  for (const PatchGeom& piece : pieces) {
-    stack.assign(1, {piece, 0});
+  for (const auto& root : roots) {
+    stack.assign(1, root);
     while (!stack.empty()) {
       const auto [g, depth] = stack.back();
       stack.pop_back();
@@ -314,22 +334,75 @@ double integrate_unoccluded(const PatchGeom& a, const PatchGeom& b,
       // twice as long against its true distance as any square one (50 mm from a strip 3 mm
       // aside, order 6 left 2.2e-6 of G; order 8: 4e-8, HybridQuadrature.SliverStrips...).
       const double d = std::min(touching, hovering);
-      const PatchGeom& q = sliver ? frame : g;
-      const GaussRule ru =
-          gauss_legendre(cell_order(sliver ? 2.0 * along : along, d, accuracy.extra));
-      const GaussRule rv = gauss_legendre(cell_order(across, d, accuracy.extra));
-      QuadCell cell{g, 0.0};
-      for (int u = 0; u < ru.n; ++u)
-        for (int v = 0; v < rv.n; ++v) {
-          double jac;
-          const Eigen::Vector3d x = quadrature_point(q, ru.x[u], rv.x[v], jac);
-          cell.G += ru.w[u] * rv.w[v] * jac * point_to_patch(x, a.normal, b);
-        }
-      if (cell.G > 0.0 && g.area > 0.0) {
-        total += cell.G;
-        cells.push_back(cell);
-      }
+      leaf(QuadCell{g, 0.0, cell_order(sliver ? 2.0 * along : along, d, accuracy.extra),
+                    cell_order(across, d, accuracy.extra), sliver, depth},
+           sliver ? frame : g);
     }
+  }
+}
+
+// The roots of a's partition: the pieces of its front part (front_part), at depth 0.
+const std::vector<std::pair<PatchGeom, int>>& front_roots(const PatchGeom& a, const PatchGeom& b) {
+  thread_local std::vector<PatchGeom> pieces;
+  thread_local std::vector<std::pair<PatchGeom, int>> roots;
+  front_part(a, b, pieces);
+  roots.clear();
+  for (const PatchGeom& piece : pieces) roots.push_back({piece, 0});
+  return roots;
+}
+
+// The cells of integrate_unoccluded (G > 0 and positive area), valued by their rules.
+double partition(const PatchGeom& a, const PatchGeom& b, const QuadratureAccuracy& accuracy,
+                 std::vector<QuadCell>& cells) {
+  cells.clear();
+  const auto& roots = front_roots(a, b);
+  double total = 0.0;
+  subdivide(a, b, accuracy, roots, [&](QuadCell cell, const PatchGeom& frame) {
+    cell.G = cell_rule(cell, frame, b, a.normal);
+    if (cell.G > 0.0 && cell.g.area > 0.0) {
+      total += cell.G;
+      cells.push_back(cell);
+    }
+  });
+  return total;
+}
+
+}  // namespace
+
+double integrate_unoccluded(const PatchGeom& a, const PatchGeom& b,
+                            const QuadratureAccuracy& accuracy, std::vector<QuadCell>& cells) {
+  return partition(a, b, accuracy, cells);
+}
+
+double preview_unoccluded(const PatchGeom& a, const PatchGeom& b, std::vector<QuadCell>& cells) {
+  cells.clear();
+  const auto& roots = front_roots(a, b);
+  double total = 0.0;
+  subdivide(a, b, kPreviewAccuracy, roots, [&](QuadCell cell, const PatchGeom& frame) {
+    if (!(cell.g.area > 0.0)) return;
+    double jac;
+    const Eigen::Vector3d x = quadrature_point(frame, 0.5, 0.5, jac);
+    cell.G = jac * point_to_patch(x, a.normal, b);
+    total += cell.G;
+    cells.push_back(cell);
+  });
+  return total;
+}
+
+double integrate_cells(const PatchGeom& a, const PatchGeom& b, const std::vector<QuadCell>& cells,
+                       std::vector<double>& exact) {
+  exact.assign(cells.size(), 0.0);
+  double total = 0.0;
+  thread_local std::vector<std::pair<PatchGeom, int>> root(1);
+  for (size_t c = 0; c < cells.size(); ++c) {
+    root.assign(1, {cells[c].g, cells[c].depth});
+    subdivide(a, b, kEstimatorAccuracy, root, [&](const QuadCell& cell, const PatchGeom& frame) {
+      const double G = cell_rule(cell, frame, b, a.normal);
+      if (G > 0.0 && cell.g.area > 0.0) {
+        exact[c] += G;
+        total += G;
+      }
+    });
   }
   return total;
 }

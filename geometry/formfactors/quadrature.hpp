@@ -36,20 +36,39 @@ constexpr QuadratureAccuracy kEstimatorAccuracy{0.5, 10, 3, 0};
 /// before sliver cells were cut by their axis's distance: HybridQuadrature.SliverStrips...);
 /// hybrid adds it to its standard error.
 constexpr double kQuadratureTolerance = 1e-6;
+/// The coarser partition hybrid draws its rays from (preview_unoccluded): cells up to 16x
+/// their distance to b (kappa 1/16) instead of 2x. Its every split is also one of
+/// kEstimatorAccuracy's, so integrate_cells refines its cells into exactly kEstimatorAccuracy's.
+constexpr QuadratureAccuracy kPreviewAccuracy{0.0625, 10, 3, 0};
 /// For the reference of `lambert accuracy` and the tests (relative error < 1e-9).
 constexpr QuadratureAccuracy kReferenceAccuracy{2.0, 16, 10, 6};
 
 /// One cell of the partition (a planar triangle or quad with its area and normal) and its
-/// contribution G = ∫_cell F(x -> b) dA_x.
+/// contribution G = ∫_cell F(x -> b) dA_x, with the Gauss rule that integrates it.
 struct QuadCell {
   PatchGeom g;
   double G = 0.0;
+  int order_u = 0, order_v = 0;  ///< Gauss orders (along, across for a sliver)
+  bool sliver = false;           ///< the rule runs in sliver_frame's parameters
+  int depth = 0;                 ///< splits from the patch
 };
 
 /// Splits the part of `a` in front of `b`'s plane into cells and integrates F(x -> b) over
 /// each (cells with G > 0 only are kept, in a fixed order). Returns Σ G. Thread-safe.
 double integrate_unoccluded(const PatchGeom& a, const PatchGeom& b,
                             const QuadratureAccuracy& accuracy, std::vector<QuadCell>& cells);
+
+/// A coarser partition of the same part of a (kPreviewAccuracy), every cell of positive
+/// area valued by one point factor at its parameter midpoint instead of a Gauss rule (good
+/// to ~(h / 2d)^2; hybrid draws its rays from it and integrates only where some ray is
+/// unblocked). Returns Σ G.
+double preview_unoccluded(const PatchGeom& a, const PatchGeom& b, std::vector<QuadCell>& cells);
+
+/// exact[c] = ∫_cell F(x -> b) dA_x for each cell of preview_unoccluded: the cell split
+/// further into integrate_unoccluded's cells (kEstimatorAccuracy), each by its Gauss rule,
+/// those with G > 0 summed. Returns their total, bitwise integrate_unoccluded's.
+double integrate_cells(const PatchGeom& a, const PatchGeom& b, const std::vector<QuadCell>& cells,
+                       std::vector<double>& exact);
 
 /// The part of patch a in front of patch b's plane, as one or more pieces (a itself, or
 /// triangles of the clipped polygon). F(x -> b) is exactly 0 behind b's plane and jumps

@@ -220,6 +220,102 @@ bool Bvh::occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& directi
 }
 
 namespace {
+// Fills lanes [0, W) of an Embree packet (RTCRayW) with the first n rays in the BVH's frame
+// (tfar 1 or infinity, times the ray's 2^shift) and marks them valid; the rest invalid.
+template <int W, typename Packet>
+void fill_packet(double scale, const Eigen::Vector3f* origin, const Eigen::Vector3f* direction,
+                 int n, float tfar, Packet& rays, int* valid, int* shift) {
+  for (int k = 0; k < W; ++k) {
+    valid[k] = k < n ? -1 : 0;
+    const FrameRay f = k < n ? to_bvh_frame(origin[k], direction[k], scale)
+                             : FrameRay{Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitX(), 0};
+    shift[k] = f.shift;
+    rays.org_x[k] = f.o.x();
+    rays.org_y[k] = f.o.y();
+    rays.org_z[k] = f.o.z();
+    rays.dir_x[k] = f.d.x();
+    rays.dir_y[k] = f.d.y();
+    rays.dir_z[k] = f.d.z();
+    rays.tnear[k] = 0.0f;
+    rays.tfar[k] = f.shift == 0 ? tfar : std::ldexp(tfar, f.shift);
+    rays.time[k] = 0.0f;
+    rays.mask[k] = 0xFFFFFFFFu;
+    rays.id[k] = static_cast<unsigned>(k);
+    rays.flags[k] = 0;
+  }
+}
+
+template <int W, typename Packet, typename Trace>
+void occluded_lanes(RTCScene scene, double scale, const Eigen::Vector3f* origin,
+                    const Eigen::Vector3f* direction, int n, bool* hit, Trace trace) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  alignas(64) Packet rays;
+  alignas(64) int valid[W];
+  int shift[W];
+  fill_packet<W>(scale, origin, direction, n, 1.0f, rays, valid, shift);
+  trace(valid, scene, &context, &rays);
+  for (int k = 0; k < n; ++k) hit[k] = rays.tfar[k] < 0.0f;
+}
+
+template <int W, typename Packet, typename Trace>
+void intersect_lanes(RTCScene scene, double scale, const Eigen::Vector3f* origin,
+                     const Eigen::Vector3f* direction, int n, RayHit* hit, Trace trace) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  alignas(64) Packet rh;
+  alignas(64) int valid[W];
+  int shift[W];
+  fill_packet<W>(scale, origin, direction, n, std::numeric_limits<float>::infinity(), rh.ray, valid,
+                 shift);
+  for (int k = 0; k < W; ++k) {
+    rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+  }
+  trace(valid, scene, &context, &rh);
+  for (int k = 0; k < n; ++k) {
+    hit[k] = RayHit{};
+    if (rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID) {
+      hit[k].patch = static_cast<std::int32_t>(rh.hit.primID[k]);
+      hit[k].t = std::ldexp(rh.ray.tfar[k], -shift[k]);
+    }
+  }
+}
+}  // namespace
+
+void Bvh::intersect_packet(const Eigen::Vector3f* origin, const Eigen::Vector3f* direction, int n,
+                           RayHit* hit) const {
+  RTCScene scene = impl_->scene.get();
+  if (n <= 1) {
+    if (n == 1) hit[0] = intersect(origin[0], direction[0]);
+  } else if (n <= 4) {
+    intersect_lanes<4, RTCRayHit4>(scene, impl_->scale, origin, direction, n, hit, rtcIntersect4);
+  } else if (n <= 8) {
+    intersect_lanes<8, RTCRayHit8>(scene, impl_->scale, origin, direction, n, hit, rtcIntersect8);
+  } else {
+    intersect_lanes<16, RTCRayHit16>(scene, impl_->scale, origin, direction, n, hit,
+                                     rtcIntersect16);
+  }
+}
+
+void Bvh::occluded_packet(const Eigen::Vector3f* origin, const Eigen::Vector3f* direction, int n,
+                          bool* hit) const {
+  // The narrowest packet that holds the n rays (a wide packet's empty lanes cost as much as
+  // full ones); a lone ray goes alone.
+  RTCScene scene = impl_->scene.get();
+  if (n <= 1) {
+    if (n == 1) hit[0] = occluded(origin[0], direction[0], 0.0f, 1.0f);
+  } else if (n <= 4) {
+    occluded_lanes<4, RTCRay4>(scene, impl_->scale, origin, direction, n, hit, rtcOccluded4);
+  } else if (n <= 8) {
+    occluded_lanes<8, RTCRay8>(scene, impl_->scale, origin, direction, n, hit, rtcOccluded8);
+  } else {
+    occluded_lanes<16, RTCRay16>(scene, impl_->scale, origin, direction, n, hit, rtcOccluded16);
+  }
+}
+
+namespace {
 // Point-query callback: collects the primitive (= patch) ids Embree hands over.
 bool collect_patch(RTCPointQueryFunctionArguments* args) {
   static_cast<std::vector<std::int32_t>*>(args->userPtr)

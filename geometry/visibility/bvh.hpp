@@ -35,6 +35,22 @@ class Bvh {
   bool occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, float tnear,
                 float tfar) const;
 
+  /// The most segments occluded_packet takes at once.
+  static constexpr int kPacket = 16;
+
+  /// occluded(origin[k], direction[k], 0, 1) for k < n <= kPacket, traced together as one
+  /// Embree packet (pays for coherent rays: one pair's, from one patch to another). Each
+  /// answer is the single query's (the same watertight test per lane; checked in
+  /// tests/geometry/bvh_test.cpp), whatever the other lanes hold.
+  void occluded_packet(const Eigen::Vector3f* origin, const Eigen::Vector3f* direction, int n,
+                       bool* hit) const;
+
+  /// intersect(origin[k], direction[k]) for k < n <= kPacket (tnear 0, tfar infinity),
+  /// traced together as one Embree packet (gather's rays from one patch). Each answer is the
+  /// single query's (tests/geometry/bvh_test.cpp).
+  void intersect_packet(const Eigen::Vector3f* origin, const Eigen::Vector3f* direction, int n,
+                        RayHit* hit) const;
+
   /// Closest hit on origin + t * direction for t in (tnear, tfar).
   RayHit intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
                    float tnear = 0.0f, float tfar = std::numeric_limits<float>::infinity()) const;

@@ -161,4 +161,38 @@ TEST(HybridQuadrature, SliverCellCountGrowsWithLengthOnly) {
     }
 }
 
+// hybrid draws its rays from preview_unoccluded's coarser cells and integrates them only when
+// a ray is unblocked (issue 36: a heat sink's fully blocked pairs skip the Gauss rules). Its
+// cells split by kEstimatorAccuracy must be exactly integrate_unoccluded's, so an unoccluded
+// pair's G is bitwise what it was: sliver strips over and beside each other, a small square
+// close above a large one, squares sharing an edge, a far pair.
+TEST(HybridQuadrature, PreviewCellsRefineIntoTheRulesCellsBitwise) {
+  std::vector<std::pair<ff::PatchGeom, ff::PatchGeom>> pairs;
+  for (double offset : {0.0, 0.003})
+    for (const ff::PatchGeom& a : strip(0.1, 0.0, 1e-4, 0.0, true))
+      for (const ff::PatchGeom& b : strip(0.1, offset, 1e-4, 0.002, false)) pairs.push_back({a, b});
+  for (const Pair& p : {Pair{2.0, 0.05, 0.1, 0.0, 0.0}, Pair{2.0, 0.2, 5.0, 1.0, 0.3}}) {
+    const auto geom = ff::patch_geometry(mesh_scene(make_scene(p), {}));
+    pairs.push_back({geom[1], geom[0]});
+  }
+  const auto edge = ff::patch_geometry(mesh_scene(perpendicular_squares(), {}));
+  pairs.push_back({edge[0], edge[1]});
+  for (const auto& [a, b] : pairs) {
+    std::vector<ff::QuadCell> fine, preview;
+    std::vector<double> exact;
+    const double G = ff::integrate_unoccluded(a, b, ff::kEstimatorAccuracy, fine);
+    ff::preview_unoccluded(a, b, preview);
+    ASSERT_FALSE(preview.empty());
+    EXPECT_LE(preview.size(), fine.size());
+    EXPECT_EQ(ff::integrate_cells(a, b, preview, exact), G);
+    double by_cell = 0.0;
+    for (size_t c = 0; c < preview.size(); ++c) {
+      EXPECT_GT(preview[c].G, 0.0);
+      by_cell += exact[c];
+    }
+    // The cells' integrals sum to G in another order: a few roundings of G.
+    EXPECT_NEAR(by_cell, G, 1e-14 * G);
+  }
+}
+
 }  // namespace lambert
