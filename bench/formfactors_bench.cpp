@@ -1,18 +1,21 @@
 // Form-factor engine benchmark (issue 3). Prints, in one run:
 //  1. raw Embree occlusion-ray throughput of the scene's BVH on the same rays the "mc"
 //     estimator traces (pre-generated for a random subset of pairs, so only the traversal
-//     is timed), with the same thread count;
+//     is timed), with the same thread count, one ray at a time (rtcOccluded1) and as one
+//     packet per pair (rtcOccluded4/8/16, what mc and hybrid trace);
 //  2. end-to-end throughput of the full "mc" and "hybrid" fills (sampling, kernels, culling,
 //     matrix assembly included) and the ratio end-to-end / raw; the same for "gather"
 //     against raw Embree closest-hit rays from the patches in cosine-distributed directions
 //     (the rays gather traces);
 //  2b. the same end-to-end fills on CAD slivers: the generated heat sink of data/heat_sink
 //     (3,852 facets up to 100 mm x 0.05 mm, issue 36), rays/s and the ratio to the Cornell
-//     box's per-ray rate of the same estimator in the same run;
+//     box's per-ray rate of the same estimator in the same run, and raw Embree on its rays;
 //  3. time and peak memory of the Cornell box fill at ~2,000, ~10,000 and ~30,000 patches,
 //     each in a forked child so that its peak RSS is its own.
-// Usage: formfactors_bench [--quick] [--sizes 2000,10000,30000] [--samples K] [--rays K] [-j N]
-// Medians over repeats are quoted; the machine is shared, so compare ratios.
+// Usage: formfactors_bench [--quick] [--repeats N] [--sizes 2000,10000,30000] [--samples K]
+//                          [--rays K] [-j N]
+// Medians over repeats (default 3, 1 with --quick) are quoted; the machine is shared, so
+// compare ratios.
 
 #include <algorithm>
 #include <cmath>
@@ -152,11 +155,14 @@ int main(int argc, char** argv) {
   int threads = resolve_threads(0);
   int samples = 16;
   int gather_k = 1024;
+  int repeats = 0;  // 0: 1 with --quick, else 3
   std::vector<std::int64_t> sizes = {2000, 10000, 30000};
   for (int a = 1; a < argc; ++a) {
     if (!std::strcmp(argv[a], "--quick")) quick = true;
     else if (!std::strcmp(argv[a], "-j") && a + 1 < argc) threads = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--samples") && a + 1 < argc) samples = std::atoi(argv[++a]);
+    else if (!std::strcmp(argv[a], "--repeats") && a + 1 < argc)
+      repeats = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--rays") && a + 1 < argc) gather_k = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--sizes") && a + 1 < argc) {
       sizes.clear();
@@ -173,7 +179,7 @@ int main(int argc, char** argv) {
   const std::vector<Ray> rays = mc_rays(mesh, samples, quick ? 50000 : 300000, &starts);
   std::printf("Cornell box, %d patches, %d threads, %d samples per pair\n", mesh.size(), threads, samples);
   std::vector<double> raw, raw_packet, e2e_mc, e2e_hybrid;
-  const int repeats = quick ? 1 : 3;
+  if (repeats < 1) repeats = quick ? 1 : 3;
   for (int r = 0; r < repeats; ++r) {
     raw.push_back(raw_throughput(bvh, rays, threads));
     raw_packet.push_back(raw_packet_throughput(bvh, rays, starts, threads));
