@@ -59,8 +59,10 @@ void validate_medium(const Medium& m, const std::string& what) {
   // can hold (1 - 1e-100 == 1) while its albedo and emission divide by sigma_t (1e-320 gave
   // NaN energies); above 1e100 every transmittance underflows. 0 means no medium there.
   const double diagonal = (m.hi - m.lo).norm();
+  bool extinguishes = false;
   for (std::int32_t v = 0; v < n; ++v) {
     const Eigen::Vector3d t = (m.sigma_a.row(v) + m.sigma_s.row(v)).transpose();
+    extinguishes = extinguishes || t.maxCoeff() > 0.0;
     const double depth = t.maxCoeff() * diagonal;
     if (depth != 0.0 && !(depth >= 1e-100 && depth <= 1e100)) {
       std::ostringstream msg;
@@ -79,6 +81,12 @@ void validate_medium(const Medium& m, const std::string& what) {
       throw UsageError(what + ": voxel " + std::to_string(v) +
                        " emits but has sigma_a + sigma_s = 0 (emission needs extinction)");
   }
+  // A medium of no extinction anywhere changes no result: the option would be ignored.
+  if (!extinguishes)
+    throw UsageError(what +
+                     ": the medium extinguishes nothing (sigma_a + sigma_s = 0 in every voxel), "
+                     "so it would change no result; give a positive --sigma-a or --sigma-s "
+                     "(or a grid with extinction), or leave the medium out");
 }
 
 std::uint64_t extinction_hash(const Medium& m) {

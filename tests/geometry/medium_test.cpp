@@ -103,6 +103,13 @@ TEST(MediumModel, ValidationNamesTheProblem) {
   Medium e = homogeneous_medium({0, 0, 0}, {1, 1, 1}, {1, 1, 1}, Eigen::Vector3d::Zero(),
                                 Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones());
   EXPECT_THROW(validate_medium(e, "x"), UsageError);  // emission without extinction
+  // A medium that extinguishes nothing anywhere would change no result: refused, not ignored
+  // (--medium-box without --sigma-a/--sigma-s was accepted and did nothing).
+  Medium clear = homogeneous_medium({0, 0, 0}, {1, 1, 1}, {2, 2, 2}, Eigen::Vector3d::Zero(),
+                                    Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  EXPECT_THROW(validate_medium(clear, "x"), UsageError);
+  clear.sigma_s.row(5).setConstant(0.5);  // one voxel that scatters: a medium
+  EXPECT_NO_THROW(validate_medium(clear, "x"));
   Medium inverted = homogeneous_medium({0, 0, 0}, {1, -1, 1}, {1, 1, 1}, Eigen::Vector3d::Ones(),
                                        Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
   EXPECT_THROW(validate_medium(inverted, "x"), UsageError);
