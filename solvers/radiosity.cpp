@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 #include "core/timer.hpp"
 #include "solvers/system.hpp"
 
@@ -14,6 +15,9 @@ struct SolverEntry {
   const char* name;
   const char* description;
   ChannelSolver solve;
+  /// The method runs on one thread (a sweep in row order): its three channels are solved
+  /// side by side instead (the others spread each product over the threads).
+  bool serial = false;
 };
 
 // The registry: a table of functions chosen by name.
@@ -21,11 +25,11 @@ const SolverEntry kSolvers[] = {
     {"jacobi", "Jacobi: B <- B + (E - K B) / diag(K), all rows from the previous iterate",
      solve_jacobi},
     {"gauss-seidel", "Gauss-Seidel gathering, one row at a time with the newest values",
-     solve_gauss_seidel},
-    {"sor", "successive over-relaxation of Gauss-Seidel (--omega)", solve_sor},
+     solve_gauss_seidel, true},
+    {"sor", "successive over-relaxation of Gauss-Seidel (--omega)", solve_sor, true},
     {"southwell",
      "Southwell / progressive refinement: shoot from the largest unshot power (Cohen 1988)",
-     solve_southwell},
+     solve_southwell, true},
     {"bicgstab", "BiCGSTAB through the transport operator, --preconditioner none|diagonal|ilut",
      solve_bicgstab},
     {"gmres", "restarted GMRES(m), right-preconditioned, --restart m, --preconditioner",
@@ -219,8 +223,10 @@ RadiositySolution solve_radiosity(const RadiosityProblem& problem, const SolveOp
   const Eigen::Index n = problem.area.size();
   RadiositySolution sol;
   sol.B = Eigen::MatrixX3d::Zero(n, 3);
-  for (int c = 0; c < 3; ++c) {
-    const ChannelSystem system = make_channel_system(problem, c, options.threads, options.initial_guess);
+  // One channel: its own system, report and column (independent of the others, so the
+  // channels of a serial method run side by side with the same results).
+  auto solve_channel = [&](int c, int threads) {
+    const ChannelSystem system = make_channel_system(problem, c, threads, options.initial_guess);
     ChannelReport& report = sol.channels[c];
     Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
     if (system.e_norm == 0.0) {
@@ -231,8 +237,17 @@ RadiositySolution solve_radiosity(const RadiosityProblem& problem, const SolveOp
       report.matvecs = system.matvecs;
     }
     sol.B.col(c) = b * system.e_scale;
-    if (severity(report.status) > severity(sol.status)) sol.status = report.status;
+  };
+  if (entry.serial) {
+    parallel_for(3, 1, options.threads, [&](std::int64_t begin, std::int64_t end) {
+      for (auto c = begin; c < end; ++c) solve_channel(static_cast<int>(c), 1);
+    });
+  } else {
+    for (int c = 0; c < 3; ++c) solve_channel(c, options.threads);
   }
+  for (int c = 0; c < 3; ++c)
+    if (severity(sol.channels[c].status) > severity(sol.status))
+      sol.status = sol.channels[c].status;
   sol.seconds = timer.seconds();
   // After the solve: B is finite, and for E >= 0 (an M-matrix K, check_form_factors) B >= 0
   // up to the solve's own error, tol ||E||_2 / (1 - rho_max) per entry (STYLE.md's bound,
