@@ -79,7 +79,7 @@ void render_and_write(const RenderOptions& opts, const LoadedScene& loaded,
   paths.ply = opts.ply;
   const std::string settings =
       render_settings(opts, method_settings, shaded.interpolation, camera, stats.direct_rays);
-  auto written = write_outputs(paths, loaded.mesh, shaded, image, ev, settings);
+  auto written = write_outputs(paths, loaded.mesh, shaded, image, ev, settings, opts.run.threads);
   if (!opts.glb.empty()) {
     static const std::vector<EmitterBasis> kNone;
     const std::vector<EmitterBasis>& bases = relight.bases ? *relight.bases : kNone;

@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/memory.hpp"
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "core/timer.hpp"
 #include "geometry/formfactors/formfactors.hpp"
@@ -287,9 +288,19 @@ int finish_run(const RunOptions& opts, const RunPaths& paths, const MethodOutcom
   const Timer timer;
   const std::string settings =
       m.settings + shade_settings(opts, shaded.interpolation, camera, rs.direct_rays);
-  std::vector<std::string> files =
-      write_outputs(paths.files, m.loaded.mesh, shaded, image, ev, settings);
-  const Json viewer = write_run_viewer(paths, m, shaded, camera, ev, settings, files);
+  // The files and the viewer side by side (independent, each written atomically).
+  std::vector<std::string> files, viewer_files;
+  Json viewer;
+  parallel_for(2, 1, opts.run.threads, [&](std::int64_t begin, std::int64_t end) {
+    for (auto k = begin; k < end; ++k) {
+      if (k == 0)
+        files = write_outputs(paths.files, m.loaded.mesh, shaded, image, ev, settings,
+                              opts.run.threads);
+      else
+        viewer = write_run_viewer(paths, m, shaded, camera, ev, settings, viewer_files);
+    }
+  });
+  files.insert(files.end(), viewer_files.begin(), viewer_files.end());
   files.push_back(paths.report);
   const Tail tail{shaded, rs, camera, ev, timer.seconds(), files, settings, viewer};
   Json report = report_json(opts, m, tail);

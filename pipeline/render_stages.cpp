@@ -3,11 +3,13 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <memory>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "core/timer.hpp"
 #include "geometry/formfactors/constants.hpp"
@@ -399,32 +401,41 @@ double choose_exposure(const ShadeArgs& args, const Image& image, bool sky) {
 
 std::vector<std::string> write_outputs(const OutputPaths& paths, const PatchMesh& mesh,
                                        const ShadedField& shaded, const Image& image, double ev,
-                                       const std::string& settings) {
+                                       const std::string& settings, int threads) {
   std::vector<std::string> written;
+  std::vector<std::function<void()>> jobs;
   if (!paths.image_exr.empty()) {
-    write_image_exr(paths.image_exr, image,
-                    {"R,G,B: radiance L = B/pi (W m^-2 sr^-1, scene emission units per sr); "
-                     "A: fraction of pixel samples that hit a surface",
-                     settings,
-                     {}});
+    jobs.push_back([&] {
+      write_image_exr(paths.image_exr, image,
+                      {"R,G,B: radiance L = B/pi (W m^-2 sr^-1, scene emission units per sr); "
+                       "A: fraction of pixel samples that hit a surface",
+                       settings,
+                       {}});
+    });
     written.push_back(paths.image_exr);
   }
   if (!paths.png.empty()) {
-    write_png_preview(paths.png, image, ev);
+    jobs.push_back([&] { write_png_preview(paths.png, image, ev); });
     written.push_back(paths.png);
   }
   if (!paths.vertex_exr.empty()) {
-    write_vertex_exr(paths.vertex_exr, shaded.field,
-                     {"R,G,B: radiosity B (W/m^2, the units of the scene's emission Ke); "
-                      "P: position (scene length units); N: unit normal; surface: index into "
-                      "surfaceNames",
-                      settings, mesh.surface_names});
+    jobs.push_back([&] {
+      write_vertex_exr(paths.vertex_exr, shaded.field,
+                       {"R,G,B: radiosity B (W/m^2, the units of the scene's emission Ke); "
+                        "P: position (scene length units); N: unit normal; surface: index into "
+                        "surfaceNames",
+                        settings, mesh.surface_names});
+    });
     written.push_back(paths.vertex_exr);
   }
   if (!paths.ply.empty()) {
-    write_ply(paths.ply, mesh, shaded.field, ev, settings);
+    jobs.push_back([&] { write_ply(paths.ply, mesh, shaded.field, ev, settings); });
     written.push_back(paths.ply);
   }
+  parallel_for(static_cast<std::int64_t>(jobs.size()), 1, threads,
+               [&](std::int64_t begin, std::int64_t end) {
+                 for (auto k = begin; k < end; ++k) jobs[static_cast<size_t>(k)]();
+               });
   return written;
 }
 

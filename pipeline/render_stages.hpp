@@ -180,10 +180,11 @@ struct OutputPaths {
   std::string image_exr, png, vertex_exr, ply;
 };
 
-/// Writes the requested files atomically and returns the paths written, in order.
+/// Writes the requested files atomically, side by side on up to `threads` threads (they
+/// are independent), and returns the paths written, in a fixed order.
 std::vector<std::string> write_outputs(const OutputPaths& paths, const PatchMesh& mesh,
                                        const ShadedField& shaded, const Image& image, double ev,
-                                       const std::string& settings);
+                                       const std::string& settings, int threads);
 
 /// Largest relative power error over surfaces (after --vertex-interp) and before any rescale.
 std::pair<double, double> worst_power_error(const std::vector<SurfacePower>& power);
