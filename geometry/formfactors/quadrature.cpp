@@ -351,13 +351,13 @@ const std::vector<std::pair<PatchGeom, int>>& front_roots(const PatchGeom& a, co
   return roots;
 }
 
-// The cells of integrate_unoccluded (G > 0 and positive area), valued by their rules.
-double partition(const PatchGeom& a, const PatchGeom& b, const QuadratureAccuracy& accuracy,
-                 std::vector<QuadCell>& cells) {
+}  // namespace
+
+double integrate_unoccluded(const PatchGeom& a, const PatchGeom& b,
+                            const QuadratureAccuracy& accuracy, std::vector<QuadCell>& cells) {
   cells.clear();
-  const auto& roots = front_roots(a, b);
   double total = 0.0;
-  subdivide(a, b, accuracy, roots, [&](QuadCell cell, const PatchGeom& frame) {
+  subdivide(a, b, accuracy, front_roots(a, b), [&](QuadCell cell, const PatchGeom& frame) {
     cell.G = cell_rule(cell, frame, b, a.normal);
     if (cell.G > 0.0 && cell.g.area > 0.0) {
       total += cell.G;
@@ -367,18 +367,10 @@ double partition(const PatchGeom& a, const PatchGeom& b, const QuadratureAccurac
   return total;
 }
 
-}  // namespace
-
-double integrate_unoccluded(const PatchGeom& a, const PatchGeom& b,
-                            const QuadratureAccuracy& accuracy, std::vector<QuadCell>& cells) {
-  return partition(a, b, accuracy, cells);
-}
-
 double preview_unoccluded(const PatchGeom& a, const PatchGeom& b, std::vector<QuadCell>& cells) {
   cells.clear();
-  const auto& roots = front_roots(a, b);
   double total = 0.0;
-  subdivide(a, b, kPreviewAccuracy, roots, [&](QuadCell cell, const PatchGeom& frame) {
+  subdivide(a, b, kPreviewAccuracy, front_roots(a, b), [&](QuadCell cell, const PatchGeom& frame) {
     if (!(cell.g.area > 0.0)) return;
     double jac;
     const Eigen::Vector3d x = quadrature_point(frame, 0.5, 0.5, jac);
