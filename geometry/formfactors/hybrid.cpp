@@ -160,6 +160,7 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
     double w;
   };
   thread_local SegmentBatch<Ray> batch;
+  batch.clear();
   thread_local std::vector<std::int64_t> joint_all, joint_free;
   joint_all.assign(nc * R, 0);
   joint_free.assign(nc * R, 0);

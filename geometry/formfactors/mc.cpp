@@ -59,6 +59,7 @@ PairEstimate estimate_mc(const PairContext& ctx, std::int32_t i, std::int32_t j)
     double kernel;
   };
   thread_local SegmentBatch<Ray> batch;
+  batch.clear();
   double sum[kReplicates] = {};
   auto each = [&](const Ray& ray, bool free) {
     if (free) sum[ray.rep] += ray.kernel;

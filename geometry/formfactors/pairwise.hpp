@@ -108,6 +108,13 @@ class SegmentBatch {
     payload_.push_back(payload);
   }
   bool full() const { return origin_.size() >= kFlush; }
+  /// Drops pending segments (a thread's batch is reused: an estimate that threw mid-pair
+  /// must not hand its segments to the next).
+  void clear() {
+    origin_.clear();
+    direction_.clear();
+    payload_.clear();
+  }
 
   /// Traces the pending segments and calls each(payload, unblocked) for them in order;
   /// returns how many were traced.
@@ -120,9 +127,7 @@ class SegmentBatch {
       for (int k = 0; k < n; ++k) each(payload_[k0 + k], !hit[k]);
     }
     const auto traced = static_cast<std::int64_t>(origin_.size());
-    origin_.clear();
-    direction_.clear();
-    payload_.clear();
+    clear();
     return traced;
   }
 

@@ -286,6 +286,7 @@ void intersect_lanes(RTCScene scene, double scale, const Eigen::Vector3f* origin
 
 void Bvh::intersect_packet(const Eigen::Vector3f* origin, const Eigen::Vector3f* direction, int n,
                            RayHit* hit) const {
+  LAMBERT_CHECK(n <= kPacket, "intersect_packet: more rays than a packet holds");
   RTCScene scene = impl_->scene.get();
   if (n <= 1) {
     if (n == 1) hit[0] = intersect(origin[0], direction[0]);
@@ -303,6 +304,7 @@ void Bvh::occluded_packet(const Eigen::Vector3f* origin, const Eigen::Vector3f* 
                           bool* hit) const {
   // The narrowest packet that holds the n rays (a wide packet's empty lanes cost as much as
   // full ones); a lone ray goes alone.
+  LAMBERT_CHECK(n <= kPacket, "occluded_packet: more rays than a packet holds");
   RTCScene scene = impl_->scene.get();
   if (n <= 1) {
     if (n == 1) hit[0] = occluded(origin[0], direction[0], 0.0f, 1.0f);
