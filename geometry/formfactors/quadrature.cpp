@@ -259,8 +259,9 @@ double cell_rule(const QuadCell& cell, const PatchGeom& frame, const PatchGeom& 
 }
 
 // Splits each root (a cell and its depth) by `accuracy`'s criterion, depth first, and
-// hands every leaf to leaf(cell, frame): a QuadCell with its Gauss orders (G unset) and the
-// cell in its rule's parameters (sliver_frame's, or itself), in a fixed order. A leaf of a coarser
+// hands every leaf to leaf(root, cell, frame): the index of its root, a QuadCell with its
+// Gauss orders (G unset) and the cell in its rule's parameters (sliver_frame's, or itself),
+// in a fixed order. A leaf of a coarser
 // criterion (smaller kappa and depths) split again by a finer one gives the finer one's leaves from
 // that root in the same order: the finer tree refines it.
 template <typename Leaf>
@@ -290,8 +291,8 @@ void subdivide(const PatchGeom& a, const PatchGeom& b, const QuadratureAccuracy&
         (flat ? touching : hovering) = std::min(flat ? touching : hovering, dist);
       }
   };
-  for (const auto& root : roots) {
-    stack.assign(1, root);
+  for (size_t r = 0; r < roots.size(); ++r) {
+    stack.assign(1, roots[r]);
     while (!stack.empty()) {
       const auto [g, depth] = stack.back();
       stack.pop_back();
@@ -334,7 +335,8 @@ void subdivide(const PatchGeom& a, const PatchGeom& b, const QuadratureAccuracy&
       // twice as long against its true distance as any square one (50 mm from a strip 3 mm
       // aside, order 6 left 2.2e-6 of G; order 8: 4e-8, HybridQuadrature.SliverStrips...).
       const double d = std::min(touching, hovering);
-      leaf(QuadCell{g, 0.0, cell_order(sliver ? 2.0 * along : along, d, accuracy.extra),
+      leaf(r,
+           QuadCell{g, 0.0, cell_order(sliver ? 2.0 * along : along, d, accuracy.extra),
                     cell_order(across, d, accuracy.extra), sliver, depth},
            sliver ? frame : g);
     }
@@ -357,7 +359,7 @@ double integrate_unoccluded(const PatchGeom& a, const PatchGeom& b,
                             const QuadratureAccuracy& accuracy, std::vector<QuadCell>& cells) {
   cells.clear();
   double total = 0.0;
-  subdivide(a, b, accuracy, front_roots(a, b), [&](QuadCell cell, const PatchGeom& frame) {
+  subdivide(a, b, accuracy, front_roots(a, b), [&](size_t, QuadCell cell, const PatchGeom& frame) {
     cell.G = cell_rule(cell, frame, b, a.normal);
     if (cell.G > 0.0 && cell.g.area > 0.0) {
       total += cell.G;
@@ -370,14 +372,15 @@ double integrate_unoccluded(const PatchGeom& a, const PatchGeom& b,
 double preview_unoccluded(const PatchGeom& a, const PatchGeom& b, std::vector<QuadCell>& cells) {
   cells.clear();
   double total = 0.0;
-  subdivide(a, b, kPreviewAccuracy, front_roots(a, b), [&](QuadCell cell, const PatchGeom& frame) {
-    if (!(cell.g.area > 0.0)) return;
-    double jac;
-    const Eigen::Vector3d x = quadrature_point(frame, 0.5, 0.5, jac);
-    cell.G = jac * point_to_patch(x, a.normal, b);
-    total += cell.G;
-    cells.push_back(cell);
-  });
+  subdivide(a, b, kPreviewAccuracy, front_roots(a, b),
+            [&](size_t, QuadCell cell, const PatchGeom& frame) {
+              if (!(cell.g.area > 0.0)) return;
+              double jac;
+              const Eigen::Vector3d x = quadrature_point(frame, 0.5, 0.5, jac);
+              cell.G = jac * point_to_patch(x, a.normal, b);
+              total += cell.G;
+              cells.push_back(cell);
+            });
   return total;
 }
 
@@ -385,17 +388,18 @@ double integrate_cells(const PatchGeom& a, const PatchGeom& b, const std::vector
                        std::vector<double>& exact) {
   exact.assign(cells.size(), 0.0);
   double total = 0.0;
-  thread_local std::vector<std::pair<PatchGeom, int>> root(1);
-  for (size_t c = 0; c < cells.size(); ++c) {
-    root.assign(1, {cells[c].g, cells[c].depth});
-    subdivide(a, b, kEstimatorAccuracy, root, [&](const QuadCell& cell, const PatchGeom& frame) {
-      const double G = cell_rule(cell, frame, b, a.normal);
-      if (G > 0.0 && cell.g.area > 0.0) {
-        exact[c] += G;
-        total += G;
-      }
-    });
-  }
+  // Every preview cell is a root (b's front part and the criterion set up once per pair).
+  thread_local std::vector<std::pair<PatchGeom, int>> roots;
+  roots.clear();
+  for (const QuadCell& cell : cells) roots.push_back({cell.g, cell.depth});
+  subdivide(a, b, kEstimatorAccuracy, roots,
+            [&](size_t c, const QuadCell& cell, const PatchGeom& frame) {
+              const double G = cell_rule(cell, frame, b, a.normal);
+              if (G > 0.0 && cell.g.area > 0.0) {
+                exact[c] += G;
+                total += G;
+              }
+            });
   return total;
 }
 
