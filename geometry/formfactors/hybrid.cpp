@@ -153,29 +153,48 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
   const size_t nc = cells.size();
   // Per replicate: the per-point rays' weight sums (all, unblocked), and per cell the joint
   // rays drawn and unblocked; a joint ray's weight, exact_c / preview_c, is known once the
-  // cells are integrated (below).
+  // cells are integrated (below). A per-point ray's weight F(x -> b) A_c / preview_c (a
+  // contour sum) is computed only once some ray of the pair is unblocked: until then the
+  // blocked rays wait in `pending` (in order, so the sums are those of weighing each as it
+  // comes), and a pair all of whose rays are blocked is 0 whatever its weights.
   struct Ray {
     int rep;
-    int cell;  // -1: a per-point ray of weight w
-    double w;
+    int cell;
+    bool joint;
+    Eigen::Vector3d x;  // a per-point ray's start
   };
   thread_local SegmentBatch<Ray> batch;
   batch.clear();
   thread_local std::vector<std::int64_t> joint_all, joint_free;
+  thread_local std::vector<Ray> pending;
+  pending.clear();
   joint_all.assign(nc * R, 0);
   joint_free.assign(nc * R, 0);
   double point_all[kReplicates] = {}, point_free[kReplicates] = {};
+  int traced[kReplicates] = {};
   bool any_free = false;
+  auto weigh = [&](const Ray& ray, bool free) {
+    const double w =
+        clipped_factor(ray.x, a.normal, b) * cells[ray.cell].g.area / cells[ray.cell].G;
+    if (!(w > 0.0)) return;  // only by rounding at a horizon: the ray carries nothing
+    point_all[ray.rep] += w;
+    if (free) point_free[ray.rep] += w;
+  };
+  constexpr size_t kMaxPending = 1024;  // bounds the memory under --target-stderr's rays
   auto each = [&](const Ray& ray, bool free) {
-    any_free = any_free || free;
-    if (ray.cell >= 0) {
+    ++traced[ray.rep];
+    if (ray.joint) {
       const size_t at = static_cast<size_t>(ray.rep) * nc + static_cast<size_t>(ray.cell);
       ++joint_all[at];
       joint_free[at] += free;
+    } else if (any_free || free || pending.size() >= kMaxPending) {
+      for (const Ray& p : pending) weigh(p, false);
+      pending.clear();
+      weigh(ray, free);
     } else {
-      point_all[ray.rep] += ray.w;
-      point_free[ray.rep] += free ? ray.w : 0.0;
+      pending.push_back(ray);
     }
+    any_free = any_free || free;
   };
   const double lift_a = end_lift(a, ctx.offset), lift_b = end_lift(b, ctx.offset);
   bool unverified = false;
@@ -190,7 +209,7 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
       const double within = std::clamp((pick - lo) / cells[c].G, 0.0, 1.0);
       if (!modes[c].ready) modes[c] = cell_mode(cells[c], b, ha, bcdf.back());
       Eigen::Vector3d x, y;
-      Ray ray{rep, static_cast<int>(c), 1.0};
+      Ray ray{rep, static_cast<int>(c), true, Eigen::Vector3d::Zero()};
       bool exhausted = true;
       if (modes[c].joint) {
         double u[5] = {within, seq.get(r, 1), seq.get(r, 2), seq.get(r, 3), rng.uniform()};
@@ -207,10 +226,10 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
         }
       } else {
         x = uniform_in_cell(cells[c].g, cell_first[c], within, seq.get(r, 1), seq.get(r, 2));
-        const KernelSampler sampler(x, a.normal, b);
-        ray.cell = -1;
-        ray.w = sampler.factor() * cells[c].g.area / cells[c].G;
-        if (!(ray.w > 0.0) || sampler.empty()) continue;
+        const KernelSampler sampler(x, a.normal, b, /*with_factor=*/false);
+        if (sampler.empty()) continue;
+        ray.joint = false;
+        ray.x = x;
         y = sampler.sample(seq.get(r, 3), rng.uniform(), rng.uniform(), rng, exhausted);
       }
       unverified = unverified || exhausted;
@@ -223,8 +242,21 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
   // probability preview_c / Σ preview, so their importance weight is exact_c / preview_c
   // (per-point rays carry theirs, F(x -> b) A_c / preview_c); while every ray is blocked the
   // weights do not matter (any positive one gives num = 0).
-  if (any_free) integrate();
   double replicate[kReplicates];
+  if (!any_free) {
+    // Every ray blocked: 0 in every replicate that traced one.
+    int used = 0;
+    for (int rep = 0; rep < R; ++rep) used += traced[rep] > 0;
+    if (used > 0) {
+      std::fill(replicate, replicate + used, 0.0);
+      const double quad = kQuadratureTolerance * G0;
+      est.G = 0.0;
+      est.var = replicate_variance(replicate, used) + quad * quad;
+      est.unverified = unverified || used < R;
+      return est;
+    }
+  }
+  integrate();
   double num = 0.0, den = 0.0;
   int used = 0;
   for (int rep = 0; rep < R; ++rep) {
@@ -232,7 +264,7 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
     for (size_t c = 0; c < nc; ++c) {
       const size_t at = static_cast<size_t>(rep) * nc + c;
       if (!joint_all[at]) continue;
-      const double w = integrated ? std::max(0.0, exact[c]) / cells[c].G : 1.0;
+      const double w = std::max(0.0, exact[c]) / cells[c].G;
       rnum += w * static_cast<double>(joint_free[at]);
       rden += w * static_cast<double>(joint_all[at]);
     }
@@ -244,7 +276,6 @@ PairEstimate estimate_hybrid(const PairContext& ctx, std::int32_t i, std::int32_
   }
   if (!(den > 0.0)) {
     // No ray could be traced: report the unoccluded value, flagged (the driver warns).
-    integrate();
     est.G = G0;
     est.unverified = true;
     return est;

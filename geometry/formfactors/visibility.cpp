@@ -1,6 +1,7 @@
 #include "geometry/formfactors/visibility.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include "geometry/formfactors/pairwise.hpp"
 #include "geometry/formfactors/quadrature.hpp"
@@ -62,16 +63,27 @@ Eigen::Vector3d arvo(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const E
 
 }  // namespace
 
+double clipped_factor(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& b) {
+  ClippedCorners r;
+  const int m = clip_to_horizon(x, nx, b, r);
+  return m < 3 ? 0.0 : contour_factor(nx, r.data(), m);
+}
+
 KernelSampler::KernelSampler(const Eigen::Vector3d& x, const Eigen::Vector3d& nx,
-                             const PatchGeom& b)
+                             const PatchGeom& b, bool with_factor)
     : x_(x), nx_(nx), nb_(b.normal), plane_(b.normal.dot(b.p[0])) {
   const double height = nb_.dot(x) - plane_;  // x's height above b's plane
   if (!(height > 0.0)) return;                // b's back faces x: nothing to receive
   ClippedCorners r;
   const int m = clip_to_horizon(x, nx, b, r);
   if (m < 3) return;
-  factor_ = contour_factor(nx, r.data(), m);
-  if (!(factor_ > 0.0)) return;
+  // The contour sum costs about what the rest of the set-up does; hybrid's near pairs need
+  // it only for the few pairs one of whose rays turns out unblocked.
+  factor_ = std::numeric_limits<double>::quiet_NaN();
+  if (with_factor) {
+    factor_ = contour_factor(nx, r.data(), m);
+    if (!(factor_ > 0.0)) return;
+  }
   ClippedCorners w;
   for (int k = 0; k < m; ++k) w[k] = r[k].normalized();
   const double cos_max = max_cosine(nx, w.data(), m);
@@ -94,6 +106,10 @@ KernelSampler::KernelSampler(const Eigen::Vector3d& x, const Eigen::Vector3d& nx
     // many times as far, and K falls like 1/r³ along it: acceptance ~1e-4, 4096 tries per
     // ray and a give-up (issue 36). Below kMinAreaAcceptance its solid angle is sampled.
     rmin = std::max(distance_to_patch(x, b), height);
+    if (!with_factor) {
+      factor_ = contour_factor(nx, r.data(), m);
+      if (!(factor_ > 0.0)) return;
+    }
     double area = 0.0;
     for (int k = 0; k + 2 < m; ++k) area += measure[k];
     const double mean_k = M_PI * factor_ / area, bound = cos_max * height / (rmin * rmin * rmin);

@@ -24,10 +24,15 @@ namespace lambert::ff {
 /// kept with probability K / (bound of K over b). Both are rejection samplers of the same density.
 class KernelSampler {
  public:
-  KernelSampler(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& b);
-  /// True when no part of b is in front of x (nothing to sample).
+  /// With `with_factor` false the unoccluded factor is computed only where the choice of
+  /// method needs it (a small solid angle), and factor() is NaN otherwise: a caller that
+  /// weights rays by it can compute it later (clipped_factor), only where it matters.
+  KernelSampler(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& b,
+                bool with_factor = true);
+  /// True when no part of b is in front of x (nothing to sample); with `with_factor`, also
+  /// when F(x -> b) is not positive.
   bool empty() const { return triangles_ == 0; }
-  /// The unoccluded factor F(x -> b) (point_to_patch, from the same clipped polygon).
+  /// The unoccluded factor F(x -> b) (clipped_factor, from the same clipped polygon).
   double factor() const { return factor_; }
   /// A point of b. (u0, u1, u2) uniform in [0,1)^3 drive the first try (stratification);
   /// further tries draw from rng. After kMaxTries rejections the last try is returned and
@@ -55,6 +60,10 @@ class KernelSampler {
   double bound_ = 1.0;  // upper bound of the acceptance numerator
   double factor_ = 0.0;
 };
+
+/// F(x -> b) for x with normal nx in front of b: b clipped to x's horizon, then the contour
+/// formula; bitwise the factor KernelSampler computes. 0 where nothing of b is in front.
+double clipped_factor(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, const PatchGeom& b);
 
 /// Number of `rays` visibility rays from x (normal nx, on a patch) to points of b drawn by
 /// KernelSampler that reach b unblocked. `stream` seeds the lattice; `exhausted` counts
