@@ -239,6 +239,45 @@ void sliver_axis(const PatchGeom& frame, Eigen::Vector3d& from, Eigen::Vector3d&
     across_radius = std::max(across_radius, segment_distance(frame.p[k], frame.p[k], from, to));
 }
 
+// How far, along a sliver cell's length, F(x -> b) stays analytic near the edge [p, q] of
+// b: the distance from the cell's u-lines (sliver_frame's parameter lines along its length,
+// taken at v = 0, 1/2, 1 from `frame`) to the nearest complex singularity of the edge's
+// contour term as x runs along them. With x = o + s e_u (e_u a unit direction) the term is
+// analytic in s except where |x - p|² |x - q|² = 0, at s = s_p ± i ρ_p (s_p the projection
+// of p, ρ_p its distance from the line: within the 3D distance of p from the axis; likewise
+// q), and where |(x - p) × (q - p)|² = 0, a quadratic A s² + B s + C positive on the real
+// line with roots σ ± iτ, A = |e_u × e|², σ = -(w × e)·(e_u × e) / A, τ = |(w × e) × (e_u ×
+// e)| / A (w = o - p, e = q - p; Lagrange's identity, no cancellation). An edge parallel
+// to the cell (A = 0) has no such root: the term varies along the cell only near the
+// edge's ends, however close the edge runs beside it. So a sliver beside a long parallel
+// edge (a CAD fin's tip facet and the next fin's face) is a smooth integrand along its
+// length, where the edge's distance (segment_distance) would cut it into pieces a few
+// times that distance long (78 % of a heat sink's quadrature nodes). Gauss-Legendre's
+// error depends on the distance to the nearest singularity, which is this one.
+double along_singularity_distance(const PatchGeom& frame, const Eigen::Vector3d& from,
+                                  const Eigen::Vector3d& to, const Eigen::Vector3d& p,
+                                  const Eigen::Vector3d& q) {
+  double dist = std::min(segment_distance(from, to, p, p), segment_distance(from, to, q, q));
+  const Eigen::Vector3d e = q - p;
+  const Eigen::Vector3d o0 = frame.p[0], e0 = frame.p[1], e1 = frame.p[2];
+  const Eigen::Vector3d o1 = frame.n == 3 ? o0 : frame.p[3];
+  const Eigen::Vector3d starts[3] = {o0, 0.5 * (o0 + o1), o1}, ends[3] = {e0, 0.5 * (e0 + e1), e1};
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d& o = starts[k];
+    const Eigen::Vector3d& end = ends[k];
+    const double length = (end - o).norm();
+    if (!(length > 0.0)) continue;
+    const Eigen::Vector3d eu = (end - o) / length, w = o - p;
+    const Eigen::Vector3d ue = eu.cross(e), we = w.cross(e);
+    const double A = ue.squaredNorm();
+    if (!(A > 0.0)) continue;
+    const double sigma = -we.dot(ue) / A, tau = we.cross(ue).norm() / A;
+    const double beyond = std::max({0.0, -sigma, sigma - length});
+    dist = std::min(dist, std::sqrt(beyond * beyond + tau * tau));
+  }
+  return dist;
+}
+
 }  // namespace
 
 namespace {
@@ -277,10 +316,13 @@ void subdivide(const PatchGeom& a, const PatchGeom& b, const QuadratureAccuracy&
   // height, and cells near them are split until small against their distance.
   front_part(b, a, bfront);
   const double in_plane = 1e-9 * (a.diameter + b.diameter);
-  // Distances from the point x (to == nullptr) or the segment [x, *to] to the edges.
-  auto edge_distances = [&](const Eigen::Vector3d& x, const Eigen::Vector3d* to, double& touching,
-                            double& hovering) {
-    touching = hovering = std::numeric_limits<double>::infinity();
+  // Distances from the point x (to == nullptr) or the segment [x, *to] to the edges; for a
+  // sliver's axis also the distance along it to the edges' singularities
+  // (along_singularity_distance, of the hovering edges).
+  auto edge_distances = [&](const Eigen::Vector3d& x, const Eigen::Vector3d* to,
+                            const PatchGeom* frame, double& touching, double& hovering,
+                            double& along) {
+    touching = hovering = along = std::numeric_limits<double>::infinity();
     for (const PatchGeom& t : bfront)
       for (int k = 0; k < t.n; ++k) {
         const Eigen::Vector3d& p = t.p[k];
@@ -289,6 +331,8 @@ void subdivide(const PatchGeom& a, const PatchGeom& b, const QuadratureAccuracy&
         const bool flat = std::abs(a.normal.dot(p - a.p[0])) <= in_plane &&
                           std::abs(a.normal.dot(q - a.p[0])) <= in_plane;
         (flat ? touching : hovering) = std::min(flat ? touching : hovering, dist);
+        if (!flat && frame)
+          along = std::min(along, along_singularity_distance(*frame, x, *to, p, q));
       }
   };
   for (size_t r = 0; r < roots.size(); ++r) {
@@ -308,20 +352,28 @@ void subdivide(const PatchGeom& a, const PatchGeom& b, const QuadratureAccuracy&
       PatchGeom frame;
       double along = h, across = h;
       const bool sliver = sliver_frame(g, frame, along, across);
-      double touching, hovering;
+      double touching, hovering, hover_along;
       if (sliver) {
         Eigen::Vector3d from, to;
         double across_radius;
         sliver_axis(frame, from, to, across_radius);
-        edge_distances(from, &to, touching, hovering);
+        edge_distances(from, &to, &frame, touching, hovering, hover_along);
         touching -= across_radius;
         hovering -= across_radius;
+        hover_along -= across_radius;
       } else {
-        edge_distances(centre, nullptr, touching, hovering);
+        edge_distances(centre, nullptr, nullptr, touching, hovering, hover_along);
         touching -= radius;
         hovering -= radius;
+        hover_along = hovering;
       }
-      if ((hovering < accuracy.kappa * h && depth < accuracy.max_depth) ||
+      // A sliver is split when its length is long against the distance to the singularities
+      // along it (hover_along) or its width against the hovering edges' distance; any
+      // other cell when its diameter is long against that distance.
+      const bool hover_split =
+          sliver ? hover_along < accuracy.kappa * h || hovering < accuracy.kappa * across
+                 : hovering < accuracy.kappa * h;
+      if ((hover_split && depth < accuracy.max_depth) ||
           (touching < accuracy.kappa * h && depth < accuracy.touch_depth)) {
         PatchGeom children[4];
         const int count = split(g, children);
@@ -334,9 +386,9 @@ void subdivide(const PatchGeom& a, const PatchGeom& b, const QuadratureAccuracy&
       // centre's less its radius, so that a sliver cell kept at length / d <= 2 is up to
       // twice as long against its true distance as any square one (50 mm from a strip 3 mm
       // aside, order 6 left 2.2e-6 of G; order 8: 4e-8, HybridQuadrature.SliverStrips...).
-      const double d = std::min(touching, hovering);
+      const double d = std::min(touching, hovering), d_along = std::min(touching, hover_along);
       leaf(r,
-           QuadCell{g, 0.0, cell_order(sliver ? 2.0 * along : along, d, accuracy.extra),
+           QuadCell{g, 0.0, cell_order(sliver ? 2.0 * along : along, d_along, accuracy.extra),
                     cell_order(across, d, accuracy.extra), sliver, depth},
            sliver ? frame : g);
     }
