@@ -437,8 +437,8 @@ double preview_unoccluded(const PatchGeom& a, const PatchGeom& b, std::vector<Qu
 }
 
 double integrate_cells(const PatchGeom& a, const PatchGeom& b, const std::vector<QuadCell>& cells,
-                       std::vector<double>& exact) {
-  exact.assign(cells.size(), 0.0);
+                       std::vector<double>* exact) {
+  if (exact) exact->assign(cells.size(), 0.0);
   double total = 0.0;
   // Every preview cell is a root (b's front part and the criterion set up once per pair).
   thread_local std::vector<std::pair<PatchGeom, int>> roots;
@@ -448,7 +448,7 @@ double integrate_cells(const PatchGeom& a, const PatchGeom& b, const std::vector
             [&](size_t c, const QuadCell& cell, const PatchGeom& frame) {
               const double G = cell_rule(cell, frame, b, a.normal);
               if (G > 0.0 && cell.g.area > 0.0) {
-                exact[c] += G;
+                if (exact) (*exact)[c] += G;
                 total += G;
               }
             });

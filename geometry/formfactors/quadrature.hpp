@@ -64,11 +64,12 @@ double integrate_unoccluded(const PatchGeom& a, const PatchGeom& b,
 /// unblocked). Returns Σ G.
 double preview_unoccluded(const PatchGeom& a, const PatchGeom& b, std::vector<QuadCell>& cells);
 
-/// exact[c] = ∫_cell F(x -> b) dA_x for each cell of preview_unoccluded: the cell split
-/// further into integrate_unoccluded's cells (kEstimatorAccuracy), each by its Gauss rule,
-/// those with G > 0 summed. Returns their total, bitwise integrate_unoccluded's.
+/// ∫_a F(x -> b) dA_x from the cells of preview_unoccluded: each split further into
+/// integrate_unoccluded's cells (kEstimatorAccuracy), each by its Gauss rule, those with
+/// G > 0 summed. Returns their total, bitwise integrate_unoccluded's; with `exact`, also
+/// (*exact)[c] = ∫_cell F(x -> b) dA_x for each preview cell.
 double integrate_cells(const PatchGeom& a, const PatchGeom& b, const std::vector<QuadCell>& cells,
-                       std::vector<double>& exact);
+                       std::vector<double>* exact = nullptr);
 
 /// The part of patch a in front of patch b's plane, as one or more pieces (a itself, or
 /// triangles of the clipped polygon). F(x -> b) is exactly 0 behind b's plane and jumps

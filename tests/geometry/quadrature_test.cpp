@@ -268,7 +268,7 @@ TEST(HybridQuadrature, PreviewCellsRefineIntoTheRulesCellsBitwise) {
     ff::preview_unoccluded(a, b, preview);
     ASSERT_FALSE(preview.empty());
     EXPECT_LE(preview.size(), fine.size());
-    EXPECT_EQ(ff::integrate_cells(a, b, preview, exact), G);
+    EXPECT_EQ(ff::integrate_cells(a, b, preview, &exact), G);
     double by_cell = 0.0;
     for (size_t c = 0; c < preview.size(); ++c) {
       EXPECT_GT(preview[c].G, 0.0);
