@@ -44,7 +44,7 @@ class KernelSampler {
   static constexpr double kSmallSolidAngle = 1e-4;
   /// Area sampling only where its expected acceptance is at least this (else solid-angle
   /// sampling): the break-even of a cheap area try against an Arvo try (trigonometry, ~5x
-  /// the cost) accepted with probability >= cos of b's elevation; as kMinJointAcceptance.
+  /// the cost) accepted with probability >= cos of b's elevation.
   static constexpr double kMinAreaAcceptance = 0.2;
   /// Tries before giving up on the rejection.
   static constexpr int kMaxTries = 4096;
