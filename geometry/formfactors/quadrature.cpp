@@ -240,8 +240,9 @@ void sliver_axis(const PatchGeom& frame, Eigen::Vector3d& from, Eigen::Vector3d&
 }
 
 // How far, along a sliver cell's length, F(x -> b) stays analytic near the edge [p, q] of
-// b: the distance from the cell's u-lines (sliver_frame's parameter lines along its length,
-// taken at v = 0, 1/2, 1 from `frame`) to the nearest complex singularity of the edge's
+// b (along_lines and line_root_distance, with the ends' distances from the cell's axis):
+// the distance from the cell's u-lines (sliver_frame's parameter lines along its length,
+// taken at v = 0, 1/2, 1) to the nearest complex singularity of the edge's
 // contour term as x runs along them. With x = o + s e_u (e_u a unit direction) the term is
 // analytic in s except where |x - p|² |x - q|² = 0, at s = s_p ± i ρ_p (s_p the projection
 // of p, ρ_p its distance from the line: within the 3D distance of p from the axis; likewise
@@ -254,25 +255,40 @@ void sliver_axis(const PatchGeom& frame, Eigen::Vector3d& from, Eigen::Vector3d&
 // length, where the edge's distance (segment_distance) would cut it into pieces a few
 // times that distance long (78 % of a heat sink's quadrature nodes). Gauss-Legendre's
 // error depends on the distance to the nearest singularity, which is this one.
-double along_singularity_distance(const PatchGeom& frame, const Eigen::Vector3d& from,
-                                  const Eigen::Vector3d& to, const Eigen::Vector3d& p,
-                                  const Eigen::Vector3d& q) {
-  double dist = std::min(segment_distance(from, to, p, p), segment_distance(from, to, q, q));
-  const Eigen::Vector3d e = q - p;
+//
+// A sliver cell's u-lines at v = 0, 1/2, 1 (those of positive length): start, unit
+// direction, length; set up once per cell.
+struct AlongLines {
+  Eigen::Vector3d o[3], eu[3];
+  double length[3];
+  int n = 0;
+};
+AlongLines along_lines(const PatchGeom& frame) {
+  AlongLines lines;
   const Eigen::Vector3d o0 = frame.p[0], e0 = frame.p[1], e1 = frame.p[2];
   const Eigen::Vector3d o1 = frame.n == 3 ? o0 : frame.p[3];
   const Eigen::Vector3d starts[3] = {o0, 0.5 * (o0 + o1), o1}, ends[3] = {e0, 0.5 * (e0 + e1), e1};
   for (int k = 0; k < 3; ++k) {
-    const Eigen::Vector3d& o = starts[k];
-    const Eigen::Vector3d& end = ends[k];
-    const double length = (end - o).norm();
+    const double length = (ends[k] - starts[k]).norm();
     if (!(length > 0.0)) continue;
-    const Eigen::Vector3d eu = (end - o) / length, w = o - p;
-    const Eigen::Vector3d ue = eu.cross(e), we = w.cross(e);
+    lines.o[lines.n] = starts[k];
+    lines.eu[lines.n] = (ends[k] - starts[k]) / length;
+    lines.length[lines.n++] = length;
+  }
+  return lines;
+}
+// The distance to the line roots of the edge [p, q] (the ends' distances are the caller's).
+double line_root_distance(const AlongLines& lines, const Eigen::Vector3d& p,
+                          const Eigen::Vector3d& q) {
+  double dist = std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d e = q - p;
+  for (int k = 0; k < lines.n; ++k) {
+    const Eigen::Vector3d w = lines.o[k] - p;
+    const Eigen::Vector3d ue = lines.eu[k].cross(e), we = w.cross(e);
     const double A = ue.squaredNorm();
     if (!(A > 0.0)) continue;
     const double sigma = -we.dot(ue) / A, tau = we.cross(ue).norm() / A;
-    const double beyond = std::max({0.0, -sigma, sigma - length});
+    const double beyond = std::max({0.0, -sigma, sigma - lines.length[k]});
     dist = std::min(dist, std::sqrt(beyond * beyond + tau * tau));
   }
   return dist;
@@ -318,12 +334,17 @@ void subdivide(const PatchGeom& a, const PatchGeom& b, const QuadratureAccuracy&
   const double in_plane = 1e-9 * (a.diameter + b.diameter);
   // Distances from the point x (to == nullptr) or the segment [x, *to] to the edges; for a
   // sliver's axis also the distance along it to the edges' singularities
-  // (along_singularity_distance, of the hovering edges).
+  // (along_lines, line_root_distance: of the hovering edges).
   auto edge_distances = [&](const Eigen::Vector3d& x, const Eigen::Vector3d* to,
                             const PatchGeom* frame, double& touching, double& hovering,
                             double& along) {
     touching = hovering = along = std::numeric_limits<double>::infinity();
-    for (const PatchGeom& t : bfront)
+    AlongLines lines;
+    if (frame) lines = along_lines(*frame);
+    for (const PatchGeom& t : bfront) {
+      double ends[4];  // the corners' distances from the axis (each shared by two edges)
+      if (frame)
+        for (int k = 0; k < t.n; ++k) ends[k] = segment_distance(x, *to, t.p[k], t.p[k]);
       for (int k = 0; k < t.n; ++k) {
         const Eigen::Vector3d& p = t.p[k];
         const Eigen::Vector3d& q = t.p[(k + 1) % t.n];
@@ -332,8 +353,9 @@ void subdivide(const PatchGeom& a, const PatchGeom& b, const QuadratureAccuracy&
                           std::abs(a.normal.dot(q - a.p[0])) <= in_plane;
         (flat ? touching : hovering) = std::min(flat ? touching : hovering, dist);
         if (!flat && frame)
-          along = std::min(along, along_singularity_distance(*frame, x, *to, p, q));
+          along = std::min({along, ends[k], ends[(k + 1) % t.n], line_root_distance(lines, p, q)});
       }
+    }
   };
   for (size_t r = 0; r < roots.size(); ++r) {
     stack.assign(1, roots[r]);

@@ -180,9 +180,9 @@ TEST(HybridQuadrature, SliverCellCountGrowsWithLengthOnly) {
 }
 
 // A sliver cell is cut by the distance along it to the singularities of F(x -> b)
-// (along_singularity_distance), not by its distance to b's edges: an edge running beside it
-// makes F steep across the sliver but varies it along only near the edge's ends, and a
-// slanted edge only near where it crosses over. CAD's case: a fin's tip facets (needle
+// (quadrature.cpp: along_lines, line_root_distance), not by its distance to b's edges: an edge
+// running beside it makes F steep across the sliver but varies it along only near the edge's ends,
+// and a slanted edge only near where it crosses over. CAD's case: a fin's tip facets (needle
 // triangles 100 mm x 0.1 mm) under the next fin's face, a large triangle with a long
 // edge, a short one and a diagonal, parallel to the strip, turned against it (0.5 deg:
 // nearly parallel; 10 deg; 90 deg), or tilted 60 deg, 1..10 mm away, the strip under its
