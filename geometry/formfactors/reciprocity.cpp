@@ -188,13 +188,19 @@ void weighted_row_sums(const SparseF& H, const std::vector<double>& d, const cha
 
 // The symmetric balancing of reciprocity.hpp: d with Σ_j d_i d_j H_ij + K_i = A_i t_i for
 // the rows with a target, K_i the sum of the row's kept pairs (a pair with a `kept` patch is
-// not scaled), by the damped symmetric Sinkhorn-Knopp update (Knight 2008)
-// d_i ← sqrt(d_i (A_i t_i - K_i) / Σ_j H_ij d_j), d_i clamped to [1/kMaxScale, kMaxScale].
+// not scaled), by the symmetric Sinkhorn-Knopp update (Knight 2008), over-relaxed:
+// d_i ← d_i (w_i / (d_i Σ_j H_ij d_j))^ω, w_i = A_i t_i - K_i, d_i clamped to [1/kMaxScale,
+// kMaxScale]. Near the fixed point the error in log d falls per sweep by 1 - ω (1 + λ) for
+// each eigenvalue λ in [-1, 1] of the normalised H: Knight's damped ω = 1/2 is slowest where
+// λ is most negative (0.84 per sweep on the Cornell box: 119 sweeps to 1e-12), any ω < 1
+// converges, and ω = 0.8 took 70 (71 instead of 121 at 10,000 patches; the same d to 1e-14
+// in F). Should the residual ever grow, the sweeps go on with ω = 1/2.
 std::vector<double> balance(const SparseF& H, const Eigen::VectorXd& a,
                             const std::vector<double>& target, const char* kept, int threads,
                             int& iterations) {
   const auto n = static_cast<std::int64_t>(target.size());
   std::vector<double> d(n, 1.0), c(n, 0.0), fixed(n, 0.0);
+  double omega = kBalanceOverRelaxation, last = std::numeric_limits<double>::infinity();
   for (iterations = 0; iterations < kBalanceIterations; ++iterations) {
     weighted_row_sums(H, d, kept, threads, c, fixed);
     double worst = 0.0;
@@ -204,10 +210,14 @@ std::vector<double> balance(const SparseF& H, const Eigen::VectorXd& a,
       worst = std::max(worst, std::abs(d[i] * c[i] - want) / want);
     }
     if (worst <= kBalanceTolerance) break;
+    if (worst > last) omega = 0.5;
+    last = worst;
     for (std::int64_t i = 0; i < n; ++i) {
       const double want = a[i] * target[i] - fixed[i];
       if (target[i] <= 0.0 || c[i] <= 0.0 || want <= 0.0) continue;
-      d[i] = std::clamp(std::sqrt(d[i] * want / c[i]), 1.0 / kMaxScale, kMaxScale);
+      const double step = want / (d[i] * c[i]);
+      d[i] = std::clamp(d[i] * (omega == 0.5 ? std::sqrt(step) : std::pow(step, omega)),
+                        1.0 / kMaxScale, kMaxScale);
     }
   }
   return d;

@@ -22,7 +22,8 @@ struct Reference {
 };
 
 // reciprocity.hpp step by step on dense matrices: G = (A F + (A F)^T) / 2, the damped
-// symmetric Sinkhorn-Knopp balancing with the same constants, the cap by min(s_i, s_j).
+// symmetric Sinkhorn-Knopp balancing with the same constants (over-relaxed, falling back to
+// the damped update should the residual grow), the cap by min(s_i, s_j).
 // Sums run over j in increasing order like the CSR rows (absent entries add an exact 0).
 Reference dense_reference(const Dense& F0, const Dense& S0, const std::vector<double>& a) {
   const auto n = F0.rows();
@@ -44,6 +45,7 @@ Reference dense_reference(const Dense& F0, const Dense& S0, const std::vector<do
   }
   r.mean_change = changed / total;
   std::vector<double> d(n, 1.0), c(n);
+  double omega = ff::kBalanceOverRelaxation, last = std::numeric_limits<double>::infinity();
   for (int it = 0; it < ff::kBalanceIterations; ++it) {
     double worst = 0.0;
     for (Eigen::Index i = 0; i < n; ++i) {
@@ -55,10 +57,14 @@ Reference dense_reference(const Dense& F0, const Dense& S0, const std::vector<do
       if (target[i] > 0.0 && c[i] > 0.0)
         worst = std::max(worst, std::abs(d[i] * c[i] - a[i] * target[i]) / (a[i] * target[i]));
     if (worst <= ff::kBalanceTolerance) break;
+    if (worst > last) omega = 0.5;
+    last = worst;
     for (Eigen::Index i = 0; i < n; ++i)
-      if (target[i] > 0.0 && c[i] > 0.0)
-        d[i] = std::clamp(std::sqrt(d[i] * a[i] * target[i] / c[i]), 1.0 / ff::kMaxScale,
-                          ff::kMaxScale);
+      if (target[i] > 0.0 && c[i] > 0.0) {
+        const double step = a[i] * target[i] / (d[i] * c[i]);
+        d[i] = std::clamp(d[i] * (omega == 0.5 ? std::sqrt(step) : std::pow(step, omega)),
+                          1.0 / ff::kMaxScale, ff::kMaxScale);
+      }
   }
   for (Eigen::Index i = 0; i < n; ++i)
     for (Eigen::Index j = 0; j < n; ++j) {
