@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 
 namespace lambert::ff {
 
@@ -43,6 +44,40 @@ void CsrAppender::append_row(const std::vector<RowEntry>& row) {
   ++row_;
   F_.outerIndexPtr()[row_] = size_;
   if (with_err_) err_.outerIndexPtr()[row_] = size_;
+}
+
+void CsrAppender::append_rows(const std::vector<RowEntry>* rows, std::int32_t count, int threads) {
+  LAMBERT_CHECK(count >= 0 && row_ + count <= n_, "CsrAppender: more rows than the matrix has");
+  auto* outer = F_.outerIndexPtr();
+  for (std::int32_t r = 0; r < count; ++r) {
+    const auto size = static_cast<std::int64_t>(rows[r].size());
+    LAMBERT_CHECK(outer[row_ + r] + size <= capacity_, "CsrAppender: more entries than reserved");
+    outer[row_ + r + 1] = outer[row_ + r] + size;
+  }
+  if (with_err_)
+    std::copy(outer + row_ + 1, outer + row_ + count + 1, err_.outerIndexPtr() + row_ + 1);
+  auto* inner = F_.innerIndexPtr();
+  double* value = F_.valuePtr();
+  auto* err_inner = with_err_ ? err_.innerIndexPtr() : nullptr;
+  double* err_value = with_err_ ? err_.valuePtr() : nullptr;
+  const std::int32_t first = row_;
+  parallel_for(count, 64, threads, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t r = begin; r < end; ++r) {
+      const std::vector<RowEntry>& row = rows[r];
+      const std::int64_t at = outer[first + r];
+      for (size_t k = 0; k < row.size(); ++k) {
+        inner[at + k] = row[k].col;
+        value[at + k] = row[k].value;
+      }
+      if (err_inner)
+        for (size_t k = 0; k < row.size(); ++k) {
+          err_inner[at + k] = row[k].col;
+          err_value[at + k] = row[k].err;
+        }
+    }
+  });
+  row_ += count;
+  size_ = outer[row_];
 }
 
 void CsrAppender::finish(SparseF& F, SparseF& err) {

@@ -31,6 +31,9 @@ class CsrAppender {
 
   /// Appends the next row (columns strictly increasing). Throws Error past max_entries.
   void append_row(const std::vector<RowEntry>& row);
+  /// Appends rows[0..count) in order, exactly as append_row one by one would, with the
+  /// copies (and the first touch of their pages) on `threads` threads.
+  void append_rows(const std::vector<RowEntry>* rows, std::int32_t count, int threads);
   /// Entries appended so far.
   std::int64_t size() const { return size_; }
   /// Rows appended so far.

@@ -138,10 +138,9 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
       }
       rays[i] = row_rays;
     }
-    for (std::int32_t i = block_begin; i < block_end; ++i) {
-      upper.append_row(rows[i]);
+    upper.append_rows(rows.data() + block_begin, block_end - block_begin, options.run.threads);
+    for (std::int32_t i = block_begin; i < block_end; ++i)
       std::vector<RowEntry>().swap(rows[i]);  // release the staging as we go
-    }
     block_begin = block_end;
   }
   for (std::int32_t i = last; i < n; ++i) upper.append_row({});

@@ -310,7 +310,7 @@ FormFactors compute_gather(const PatchMesh& mesh, const FormFactorOptions& optio
         progress.advance(1, is_emitter[i] ? 0 : K);
       }
     });
-    for (std::int32_t r = 0; r < count; ++r) csr.append_row(rows[r]);
+    csr.append_rows(rows.data(), count, options.run.threads);
   }
   progress.finish();
 
