@@ -14,8 +14,8 @@
 // For distant cells (x, y) is drawn jointly instead, uniform on cell x b's front part, and
 // weighted by K (CellMode below): w_r = K(x_r, y_r) A_c A_b / (π P_c), the same importance
 // weight relative to the target density ∝ K on a x b, without a contour evaluation per ray
-// (they were kept with probability K / K_max before, 1.9 tries per ray on the Cornell box:
-// the same variance per ray, a quarter of the fill time more). The rays are traced (in
+// (and without the tries of drawing ∝ K by rejection: 1.9 per ray on the Cornell box, for
+// the same variance per ray). The rays are traced (in
 // packets); only if one is unblocked is G0 integrated (integrate_cells: the preview's cells
 // split further into the quadrature's, so G0 is bitwise integrate_unoccluded's): a fully
 // blocked pair is 0 whatever G0 is, and most of a CAD part's tested pairs are (92 % of a
@@ -69,7 +69,6 @@ Eigen::Vector3d uniform_in_cell(const PatchGeom& g, double first, double u, doub
 // strongly over b; a per-point ray costs ~5x a joint one).
 struct CellMode {
   bool ready = false, joint = false;
-  double kmax = 0.0;
   double scale = 0.0;  // a joint ray's weight per unit K: A_c A_b / (π P_c)
 };
 // The bound is loose (heights and distance bounded separately), so the worst case, 20x the
@@ -95,9 +94,9 @@ CellMode cell_mode(const QuadCell& cell, const PatchGeom& b, double ha, double b
   for (int k = 0; k < cell.g.n; ++k) hb = std::max(hb, b.normal.dot(cell.g.p[k] - b.p[0]));
   const double rmin = cell_distance_bound(cell.g, b);
   if (!(rmin > 0.0) || !(ha > 0.0) || !(hb > 0.0)) return m;
-  m.kmax = ha * hb / (rmin * rmin * rmin * rmin);
+  const double kmax = ha * hb / (rmin * rmin * rmin * rmin);
   const double mean_k = M_PI * cell.G / (cell.g.area * bfront_area);
-  m.joint = mean_k >= kMinJointMeanToBound * m.kmax;
+  m.joint = mean_k >= kMinJointMeanToBound * kmax;
   m.scale = cell.g.area * bfront_area / (M_PI * cell.G);
   return m;
 }

@@ -78,12 +78,21 @@ FormFactors compute_pairwise(const PatchMesh& mesh, const FormFactorOptions& opt
 /// True when the segment between x (on a patch with normal nx) and y (normal ny) is free,
 /// with the ends lifted by `x_lift` and `y_lift` along their normals so the end patches never
 /// occlude (end_lift: the rays' offset plus the patch's warp).
+/// The segment visible() traces, as Embree's origin and direction (t in [0, 1]).
+inline void lifted_segment(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, double x_lift,
+                           const Eigen::Vector3d& y, const Eigen::Vector3d& ny, double y_lift,
+                           Eigen::Vector3f& origin, Eigen::Vector3f& direction) {
+  const Eigen::Vector3d a = x + x_lift * nx;
+  const Eigen::Vector3d b = y + y_lift * ny;
+  origin = a.cast<float>();
+  direction = (b - a).cast<float>();
+}
 inline bool visible(const Bvh& bvh, const Eigen::Vector3d& x, const Eigen::Vector3d& nx,
                     double x_lift, const Eigen::Vector3d& y, const Eigen::Vector3d& ny,
                     double y_lift) {
-  const Eigen::Vector3d a = x + x_lift * nx;
-  const Eigen::Vector3d b = y + y_lift * ny;
-  return !bvh.occluded(a.cast<float>(), (b - a).cast<float>(), 0.0f, 1.0f);
+  Eigen::Vector3f origin, direction;
+  lifted_segment(x, nx, x_lift, y, ny, y_lift, origin, direction);
+  return !bvh.occluded(origin, direction, 0.0f, 1.0f);
 }
 
 /// One pair's segments, each with a Payload (what its estimator needs back: replicate,
@@ -101,10 +110,9 @@ class SegmentBatch {
   void add(const Eigen::Vector3d& x, const Eigen::Vector3d& nx, double x_lift,
            const Eigen::Vector3d& y, const Eigen::Vector3d& ny, double y_lift,
            const Payload& payload) {
-    const Eigen::Vector3d a = x + x_lift * nx;
-    const Eigen::Vector3d b = y + y_lift * ny;
-    origin_.push_back(a.cast<float>());
-    direction_.push_back((b - a).cast<float>());
+    origin_.emplace_back();
+    direction_.emplace_back();
+    lifted_segment(x, nx, x_lift, y, ny, y_lift, origin_.back(), direction_.back());
     payload_.push_back(payload);
   }
   bool full() const { return origin_.size() >= kFlush; }

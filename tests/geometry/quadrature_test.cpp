@@ -57,24 +57,6 @@ double exact_G(const Pair& p) {
                                p.cy + p.s / 2, p.h);
 }
 
-// A planar polygon (3 or 4 corners) as a PatchGeom, its normal from the corners' winding.
-ff::PatchGeom polygon(std::initializer_list<Eigen::Vector3d> corners) {
-  ff::PatchGeom g;
-  g.n = static_cast<int>(corners.size());
-  int k = 0;
-  for (const Eigen::Vector3d& c : corners) g.p[k++] = c;
-  if (g.n == 3) g.p[3] = g.p[2];
-  const Eigen::Vector3d twice = g.n == 3 ? (g.p[1] - g.p[0]).cross(g.p[2] - g.p[0])
-                                         : (g.p[2] - g.p[0]).cross(g.p[3] - g.p[1]);
-  g.normal = twice.normalized();
-  g.area = 0.5 * twice.norm();
-  g.centroid = Eigen::Vector3d::Zero();
-  for (k = 0; k < g.n; ++k) g.centroid += g.p[k] / g.n;
-  for (int i = 0; i < g.n; ++i)
-    for (int j = i + 1; j < g.n; ++j) g.diameter = std::max(g.diameter, (g.p[i] - g.p[j]).norm());
-  return g;
-}
-
 }  // namespace
 
 TEST(HybridQuadrature, UnoccludedPairsOfAnySizeRatioMatchTheClosedForm) {
@@ -209,19 +191,26 @@ TEST(HybridQuadrature, SliversBesideSlantedEdgesMatchAFineReference) {
             const double ly = ry - (y - 0.005);  // distance from the long edge's line
             return Eigen::Vector3d(rx, (y - 0.005) + ct * ly, h + st * ly);
           };
-          const ff::PatchGeom b =
-              polygon({place(-0.01, y - 0.005), place(0.11, y + 0.035), place(0.11, y - 0.005)});
+          // One scene, one patch per polygon: b, then the reference's 1,000 pieces of the strip.
+          Scene scene;
+          const Material m{"m", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
+          add_polygon(scene, "b", m,
+                      {place(-0.01, y - 0.005), place(0.11, y + 0.035), place(0.11, y - 0.005)});
+          for (int k = 0; k < 1000; ++k) {
+            const double x0 = k * L / 1000, x1 = (k + 1) * L / 1000;
+            add_polygon(scene, "piece", m,
+                        {{x0, y, 0}, {x1, y, 0}, {x1, y + w, 0}, {x0, y + w, 0}});
+          }
+          const auto geom = ff::patch_geometry(mesh_scene(scene, {0.0, 0}));
+          ASSERT_EQ(geom.size(), 1001u);
+          const ff::PatchGeom& b = geom[0];
           ASSERT_LT(b.normal.z(), 0.0);
           double G = 0.0, reference = 0.0;
           std::vector<ff::QuadCell> cells;
           for (const ff::PatchGeom& a : strip(L, y, w, 0.0, true))
             G += ff::integrate_unoccluded(a, b, ff::kEstimatorAccuracy, cells);
-          for (int k = 0; k < 1000; ++k) {
-            const double x0 = k * L / 1000, x1 = (k + 1) * L / 1000;
-            const ff::PatchGeom piece =
-                polygon({{x0, y, 0}, {x1, y, 0}, {x1, y + w, 0}, {x0, y + w, 0}});
-            reference += ff::integrate_unoccluded(piece, b, ff::kReferenceAccuracy, cells);
-          }
+          for (size_t k = 1; k < geom.size(); ++k)
+            reference += ff::integrate_unoccluded(geom[k], b, ff::kReferenceAccuracy, cells);
           ASSERT_GT(reference, 0.0);
           EXPECT_NEAR(G, reference, ff::kQuadratureTolerance * reference)
               << "h " << h << " turn " << turn << " tilt " << tilt << " y " << y;

@@ -21,9 +21,9 @@ struct Reference {
   std::int64_t rows_scaled = 0;
 };
 
-// reciprocity.hpp step by step on dense matrices: G = (A F + (A F)^T) / 2, the damped
-// symmetric Sinkhorn-Knopp balancing with the same constants (over-relaxed, falling back to
-// the damped update should the residual grow), the cap by min(s_i, s_j).
+// reciprocity.hpp step by step on dense matrices: G = (A F + (A F)^T) / 2, the symmetric
+// Sinkhorn-Knopp balancing with the same constants (over-relaxed, falling back to the damped
+// update should the residual grow), the cap by min(s_i, s_j).
 // Sums run over j in increasing order like the CSR rows (absent entries add an exact 0).
 Reference dense_reference(const Dense& F0, const Dense& S0, const std::vector<double>& a) {
   const auto n = F0.rows();
