@@ -205,7 +205,7 @@ void write_formfactors_outputs(const FormFactorsOptions& opts, const LoadedScene
   check_closed_lossless(scene.mesh, ff, false);
   // Diagnostics of the patches' F; with a medium they describe the surfaces' exchange before
   // the medium attenuates it, and the zones are appended to F after them.
-  const FormFactorDiagnostics d = diagnose(scene.mesh, ff.F);
+  const FormFactorDiagnostics d = diagnose(scene.mesh, ff.F, 5, opts.run.threads);
   print_diagnostics(scene, ff, d);
   Json j = diagnostics_json(scene, ff, d, "");
   Eigen::VectorXd zone_area;

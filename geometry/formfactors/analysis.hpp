@@ -27,8 +27,10 @@ struct FormFactorDiagnostics {
   static constexpr double kHistogramMax = 1.1;  ///< row sums above 1 show over-estimation
 };
 
-/// Computes the diagnostics; `worst` rows are reported. O(nnz log) time.
-FormFactorDiagnostics diagnose(const PatchMesh& mesh, const SparseF& F, int worst = 5);
+/// Computes the diagnostics; `worst` rows are reported. O(nnz log) time, rows on `threads`
+/// (the same result for any count).
+FormFactorDiagnostics diagnose(const PatchMesh& mesh, const SparseF& F, int worst = 5,
+                               int threads = 1);
 
 /// Why a scene would silently come out as B = E (or all zero), found from the mesh's
 /// emission and F alone, so it holds for any estimator and for an F loaded from a file.
