@@ -1,7 +1,9 @@
 #include "solvers/radiosity.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
@@ -18,6 +20,9 @@ struct SolverEntry {
   /// The method runs on one thread (a sweep in row order): its three channels are solved
   /// side by side instead (the others spread each product over the threads).
   bool serial = false;
+  /// A serial method that also solves a group of channels in one pass over F: the channels
+  /// are split into min(threads, 3) groups, each swept together on its own thread.
+  ChannelGroupSolver group = nullptr;
 };
 
 // The registry: a table of functions chosen by name.
@@ -25,8 +30,9 @@ const SolverEntry kSolvers[] = {
     {"jacobi", "Jacobi: B <- B + (E - K B) / diag(K), all rows from the previous iterate",
      solve_jacobi},
     {"gauss-seidel", "Gauss-Seidel gathering, one row at a time with the newest values",
-     solve_gauss_seidel, true},
-    {"sor", "successive over-relaxation of Gauss-Seidel (--omega)", solve_sor, true},
+     solve_gauss_seidel, true, solve_gauss_seidel_channels},
+    {"sor", "successive over-relaxation of Gauss-Seidel (--omega)", solve_sor, true,
+     solve_sor_channels},
     {"southwell",
      "Southwell / progressive refinement: shoot from the largest unshot power (Cohen 1988)",
      solve_southwell, true},
@@ -88,27 +94,39 @@ void check_applicable(const RadiosityProblem& p, const SolveOptions& o) {
 // what no estimate of a form-factor matrix gives (row sums of 2.4 or 10, which solved to
 // negative B and negative absorbed power). Below it, whether the solve is physical is
 // checked on its result (solve_radiosity: B >= 0).
-void check_form_factors(const RadiosityProblem& p) {
+void check_form_factors(const RadiosityProblem& p, int threads) {
   constexpr double kEntrySlack = 1e-12, kRowSlack = 0.25;
   const TransportOperator& F = *p.F;
   const bool has_continued = p.continued.size() == p.area.size();
-  for (std::int32_t i = 0; i < F.size(); ++i) {
+  // Rows are checked in parallel, each marking its first impossible entry (or -2 for an
+  // impossible sum); the first marked row is reported, as a row-by-row scan would.
+  std::vector<std::int64_t> bad(F.size(), -1);
+  auto check_row = [&](std::int32_t i) -> std::int64_t {
     const TransportOperator::RowSpan r = F.row(i);
     double sum = 0.0;
     for (std::int64_t k = 0; k < r.count; ++k) {
       const double f = r.values[k];
-      if (!(f >= 0.0 && f <= 1.0 + kEntrySlack))
-        throw SceneError("form factor F(" + std::to_string(i) + ", " + std::to_string(r.cols[k]) +
-                         ") = " + std::to_string(f) +
-                         " is impossible (a form factor lies in [0, 1])");
+      if (!(f >= 0.0 && f <= 1.0 + kEntrySlack)) return k;
       sum += f;
     }
-    const double leaving = sum - (has_continued ? p.continued[i] : 0.0);
-    if (leaving > 1.0 + kRowSlack)
-      throw SceneError("form factors of patch " + std::to_string(i) + " sum to " +
-                       std::to_string(leaving) +
-                       ": impossible (a row sums to at most 1, Monte Carlo noise aside; "
-                       "more samples, or the hybrid estimator)");
+    return sum - (has_continued ? p.continued[i] : 0.0) > 1.0 + kRowSlack ? -2 : -1;
+  };
+  parallel_for(F.size(), 1024, threads, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) bad[i] = check_row(static_cast<std::int32_t>(i));
+  });
+  for (std::int32_t i = 0; i < F.size(); ++i) {
+    if (bad[i] == -1) continue;
+    const TransportOperator::RowSpan r = F.row(i);
+    if (bad[i] >= 0)
+      throw SceneError("form factor F(" + std::to_string(i) + ", " +
+                       std::to_string(r.cols[bad[i]]) + ") = " + std::to_string(r.values[bad[i]]) +
+                       " is impossible (a form factor lies in [0, 1])");
+    double sum = 0.0;
+    for (std::int64_t k = 0; k < r.count; ++k) sum += r.values[k];
+    throw SceneError("form factors of patch " + std::to_string(i) + " sum to " +
+                     std::to_string(sum - (has_continued ? p.continued[i] : 0.0)) +
+                     ": impossible (a row sums to at most 1, Monte Carlo noise aside; "
+                     "more samples, or the hybrid estimator)");
   }
 }
 
@@ -142,7 +160,7 @@ std::vector<std::string> solver_names() {
   return out;
 }
 
-void validate_problem(const RadiosityProblem& p) {
+void validate_problem(const RadiosityProblem& p, int threads) {
   if (p.F == nullptr) throw UsageError("radiosity problem without a form-factor operator");
   const Eigen::Index n = p.area.size();
   if (p.F->size() != n || p.rho.rows() != n || p.emission.rows() != n)
@@ -165,7 +183,7 @@ void validate_problem(const RadiosityProblem& p) {
                                                        : ": emission must be finite and >= 0"));
     }
   }
-  check_form_factors(p);
+  check_form_factors(p, threads);
 }
 
 double relative_residual(const RadiosityProblem& problem, const Eigen::MatrixX3d& B, int channel) {
@@ -189,12 +207,13 @@ double relative_residual(const RadiosityProblem& problem, const Eigen::MatrixX3d
 // that escapes is A_i B_i (1 − rowsum_i + c_i) and the absorbed part of H loses Σ A B c, so
 // the two parts of the imbalance above are unchanged.
 EnergyBalance energy_balance(const RadiosityProblem& problem, const Eigen::MatrixX3d& B,
-                             int channel) {
+                             int channel, int threads) {
   const TransportOperator& F = *problem.F;
   const Eigen::VectorXd b = B.col(channel);
-  Eigen::VectorXd h;
-  F.apply(b, h, 1);
-  const Eigen::VectorXd row_sum = F.row_sums();
+  Eigen::VectorXd h, row_sum;
+  F.apply(b, h, threads);
+  // F 1: each row summed in storage order (x 1.0 is exact), bitwise row_sums().
+  F.apply(Eigen::VectorXd::Ones(b.size()), row_sum, threads);
   const Eigen::VectorXd& a = problem.area;
   const Eigen::VectorXd rho = problem.rho.col(channel);
   const Eigen::VectorXd e_col = problem.emission.col(channel);
@@ -214,7 +233,7 @@ EnergyBalance energy_balance(const RadiosityProblem& problem, const Eigen::Matri
 RadiositySolution solve_radiosity(const RadiosityProblem& problem, const SolveOptions& options) {
   const SolverEntry& entry = find_solver(options.solver);
   validate_options(options);
-  validate_problem(problem);
+  validate_problem(problem, options.threads);
   check_applicable(problem, options);
   if (options.initial_guess.size() > 0 && options.initial_guess.rows() != problem.area.size())
     throw UsageError("initial guess has " + std::to_string(options.initial_guess.rows()) +
@@ -238,7 +257,43 @@ RadiositySolution solve_radiosity(const RadiosityProblem& problem, const SolveOp
     }
     sol.B.col(c) = b * system.e_scale;
   };
-  if (entry.serial) {
+  if (entry.group) {
+    // Channels grouped over the threads (1 thread: all three in one pass over F per sweep;
+    // 2: one alone and two together; 3 or more: one each). Every channel is bitwise the
+    // same in any grouping.
+    std::vector<ChannelSystem> systems;
+    for (int c = 0; c < 3; ++c)
+      systems.push_back(make_channel_system(problem, c, 1, options.initial_guess));
+    std::vector<Eigen::VectorXd> b(3, Eigen::VectorXd::Zero(n));
+    std::vector<int> emitting;
+    for (int c = 0; c < 3; ++c) {
+      if (systems[c].e_norm > 0.0)
+        emitting.push_back(c);
+      else
+        record(sol.channels[c], 0, 0.0, 0.0);  // nothing emitted: B = 0 solves K B = 0 exactly
+    }
+    const int groups =
+        std::min<int>(resolve_threads(options.threads), static_cast<int>(emitting.size()));
+    parallel_for(groups, 1, groups, [&](std::int64_t begin, std::int64_t end) {
+      for (auto g = begin; g < end; ++g) {
+        // Group g takes the emitting channels g, g + groups, ... (2 threads: {0, 2} and {1}).
+        std::vector<const ChannelSystem*> s;
+        std::vector<Eigen::VectorXd*> x;
+        std::vector<ChannelReport*> r;
+        for (size_t q = static_cast<size_t>(g); q < emitting.size();
+             q += static_cast<size_t>(groups)) {
+          s.push_back(&systems[emitting[q]]);
+          x.push_back(&b[emitting[q]]);
+          r.push_back(&sol.channels[emitting[q]]);
+        }
+        entry.group(s, options, x, r);
+      }
+    });
+    for (int c = 0; c < 3; ++c) {
+      sol.channels[c].matvecs = systems[c].matvecs;
+      sol.B.col(c) = b[c] * systems[c].e_scale;
+    }
+  } else if (entry.serial) {
     parallel_for(3, 1, options.threads, [&](std::int64_t begin, std::int64_t end) {
       for (auto c = begin; c < end; ++c) solve_channel(static_cast<int>(c), 1);
     });
@@ -269,7 +324,7 @@ RadiositySolution solve_radiosity(const RadiosityProblem& problem, const SolveOp
       if (sol.B.col(c).minCoeff() < -bound) sol.status = SolveStatus::NumericalIssue;
     }
   }
-  for (int c = 0; c < 3; ++c) sol.energy[c] = energy_balance(problem, sol.B, c);
+  for (int c = 0; c < 3; ++c) sol.energy[c] = energy_balance(problem, sol.B, c, options.threads);
   return sol;
 }
 

@@ -114,12 +114,13 @@ double relative_residual(const RadiosityProblem& problem, const Eigen::MatrixX3d
 /// emitted - absorbed - escaped = residual_part + non_reciprocity_part: sum_i A_i r_i with
 /// r = E - K B the residual (0 for an exact solution), plus
 /// sum_i A_i B_i sum_j F_ij - sum_i A_i H_i (0 for a reciprocal F, A_i F_ij = A_j F_ji).
+/// Its two products with F run on `threads` (bitwise the same for any count).
 EnergyBalance energy_balance(const RadiosityProblem& problem, const Eigen::MatrixX3d& B,
-                             int channel);
+                             int channel, int threads = 1);
 
 /// Checks sizes and ranges of a problem (N x N F, rho in [0, 1], E >= 0, A > 0); throws
-/// UsageError naming what is wrong.
-void validate_problem(const RadiosityProblem& problem);
+/// UsageError naming what is wrong. F's rows are checked on `threads`.
+void validate_problem(const RadiosityProblem& problem, int threads = 1);
 
 /// Peak bytes of `direct` on an N-patch F with `nnz` entries: the assembled K plus a dense
 /// LU (8 N^2) above 10% fill, else the SparseLU estimate (see direct.cpp).

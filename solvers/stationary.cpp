@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/error.hpp"
 #include "solvers/system.hpp"
 
 namespace lambert {
@@ -59,54 +60,110 @@ ChannelReport solve_jacobi(const ChannelSystem& system, const SolveOptions& opti
 
 namespace {
 
-// One in-place SOR sweep (omega = 1: Gauss-Seidel); returns the sweep residual norm.
-double sor_sweep(const ChannelSystem& s, double omega, Eigen::VectorXd& B) {
-  double sq = 0.0;
-  for (std::int32_t i = 0; i < s.size(); ++i) {
-    const TransportOperator::RowSpan row = s.F->row(i);
-    double gather = 0.0;
-    for (std::int64_t k = 0; k < row.count; ++k) gather += row.values[k] * B[row.cols[k]];
-    const double d = 1.0 - s.rho[i] * s.f_diag[i];
-    const double r = s.E[i] + s.rho[i] * gather - B[i];  // row i of E - K B, newest values
-    sq += r * r;
-    B[i] += omega * r / d;
+// One in-place SOR sweep (omega = 1: Gauss-Seidel) of C channels over F's rows together:
+// each row is read once and gathered into C sums, each summed in storage order exactly as
+// a one-channel sweep sums it (so every channel is bitwise what it is alone). sq[c]
+// receives channel c's squared sweep residual.
+template <int C>
+void sor_sweep(const ChannelSystem* const* s, double omega, Eigen::VectorXd* const* B, double* sq) {
+  const TransportOperator& F = *s[0]->F;
+  const std::int32_t n = s[0]->size();
+  double* b[C];
+  for (int c = 0; c < C; ++c) {
+    b[c] = B[c]->data();
+    sq[c] = 0.0;
   }
-  ++s.matvecs;
-  return std::sqrt(sq);
+  for (std::int32_t i = 0; i < n; ++i) {
+    const TransportOperator::RowSpan row = F.row(i);
+    double gather[C] = {};
+    for (std::int64_t k = 0; k < row.count; ++k) {
+      const double v = row.values[k];
+      const auto j = row.cols[k];
+      for (int c = 0; c < C; ++c) gather[c] += v * b[c][j];
+    }
+    for (int c = 0; c < C; ++c) {
+      const double d = 1.0 - s[c]->rho[i] * s[c]->f_diag[i];
+      const double r = s[c]->E[i] + s[c]->rho[i] * gather[c] - b[c][i];  // row i of E - K B
+      sq[c] += r * r;
+      b[c][i] += omega * r / d;
+    }
+  }
+  for (int c = 0; c < C; ++c) ++s[c]->matvecs;
+}
+
+// One channel's state in a fused run.
+struct SorChannel {
+  const ChannelSystem* system;
+  Eigen::VectorXd* B;
+  ChannelReport* report;
+  double check_below;  // sweep residual that triggers a true-residual check
+  bool done = false;
+};
+
+void sor_channels(const std::vector<const ChannelSystem*>& systems, const SolveOptions& options,
+                  double omega, const std::vector<Eigen::VectorXd*>& B,
+                  const std::vector<ChannelReport*>& reports) {
+  constexpr int kMaxChannels = 3;
+  LAMBERT_CHECK(systems.size() == B.size() && systems.size() == reports.size() &&
+                    systems.size() <= kMaxChannels,
+                "solve_sor_channels: one system, solution and report per channel, at most 3");
+  std::vector<SorChannel> ch;
+  for (size_t c = 0; c < systems.size(); ++c) {
+    *reports[c] = ChannelReport();
+    *B[c] = systems[c]->guess;
+    record(*reports[c], 0, systems[c]->relative_residual_uncounted(*B[c]), 0.0);
+    reports[c]->status = SolveStatus::MaxIterations;
+    ch.push_back({systems[c], B[c], reports[c], options.tol});
+  }
+  const Timer timer;
+  for (int k = 1; k <= options.max_iterations; ++k) {
+    const ChannelSystem* s[kMaxChannels];
+    Eigen::VectorXd* b[kMaxChannels];
+    SorChannel* live[kMaxChannels];
+    int count = 0;
+    for (SorChannel& c : ch)
+      if (!c.done) {
+        s[count] = c.system;
+        b[count] = c.B;
+        live[count++] = &c;
+      }
+    if (count == 0) break;
+    double sq[kMaxChannels];
+    if (count == 1) sor_sweep<1>(s, omega, b, sq);
+    if (count == 2) sor_sweep<2>(s, omega, b, sq);
+    if (count == 3) sor_sweep<3>(s, omega, b, sq);
+    for (int q = 0; q < count; ++q) {
+      SorChannel& c = *live[q];
+      ChannelReport& report = *c.report;
+      const double sweep = std::sqrt(sq[q]) / c.system->e_norm;
+      report.iterations = k;
+      report.residual = sweep;
+      if (!std::isfinite(sweep)) {
+        report.status = SolveStatus::NumericalIssue;
+        record(report, k, sweep, timer.seconds());
+        c.done = true;
+      } else if (sweep <= c.check_below || k == options.max_iterations) {
+        const double truth = c.system->relative_residual(*c.B);
+        report.residual = truth;
+        record(report, k, truth, timer.seconds());
+        if (truth <= options.tol) {
+          report.status = SolveStatus::Converged;
+          c.done = true;
+        }
+        // Expect the true residual to fall in proportion to the sweep residual.
+        c.check_below = sweep * options.tol / truth;
+      } else {
+        record(report, k, sweep, timer.seconds());
+      }
+      if (c.done || k == options.max_iterations) report.seconds = timer.seconds();
+    }
+  }
 }
 
 ChannelReport sor_iterate(const ChannelSystem& system, const SolveOptions& options, double omega,
                           Eigen::VectorXd& B) {
   ChannelReport report;
-  B = system.guess;
-  record(report, 0, system.relative_residual_uncounted(B), 0.0);
-  const Timer timer;
-  double check_below = options.tol;  // sweep residual that triggers a true-residual check
-  report.status = SolveStatus::MaxIterations;
-  for (int k = 1; k <= options.max_iterations; ++k) {
-    const double sweep = sor_sweep(system, omega, B) / system.e_norm;
-    report.iterations = k;
-    report.residual = sweep;
-    if (!std::isfinite(sweep)) {
-      report.status = SolveStatus::NumericalIssue;
-      record(report, k, sweep, timer.seconds());
-      break;
-    }
-    if (sweep <= check_below || k == options.max_iterations) {
-      const double truth = system.relative_residual(B);
-      report.residual = truth;
-      record(report, k, truth, timer.seconds());
-      if (truth <= options.tol) {
-        report.status = SolveStatus::Converged;
-        break;
-      }
-      // Expect the true residual to fall in proportion to the sweep residual.
-      check_below = sweep * options.tol / truth;
-    } else {
-      record(report, k, sweep, timer.seconds());
-    }
-  }
-  report.seconds = timer.seconds();
+  sor_channels({&system}, options, omega, {&B}, {&report});
   return report;
 }
 
@@ -120,6 +177,19 @@ ChannelReport solve_gauss_seidel(const ChannelSystem& system, const SolveOptions
 ChannelReport solve_sor(const ChannelSystem& system, const SolveOptions& options,
                         Eigen::VectorXd& B) {
   return sor_iterate(system, options, options.omega, B);
+}
+
+void solve_gauss_seidel_channels(const std::vector<const ChannelSystem*>& systems,
+                                 const SolveOptions& options,
+                                 const std::vector<Eigen::VectorXd*>& B,
+                                 const std::vector<ChannelReport*>& reports) {
+  sor_channels(systems, options, 1.0, B, reports);
+}
+
+void solve_sor_channels(const std::vector<const ChannelSystem*>& systems,
+                        const SolveOptions& options, const std::vector<Eigen::VectorXd*>& B,
+                        const std::vector<ChannelReport*>& reports) {
+  sor_channels(systems, options, options.omega, B, reports);
 }
 
 }  // namespace lambert

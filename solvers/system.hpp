@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/sparse.hpp"
 #include "core/timer.hpp"
@@ -64,6 +65,22 @@ ChannelReport solve_gauss_seidel(const ChannelSystem& system, const SolveOptions
                                  Eigen::VectorXd& B);  ///< gauss-seidel (omega 1)
 ChannelReport solve_sor(const ChannelSystem& system, const SolveOptions& options,
                         Eigen::VectorXd& B);  ///< sor (options.omega)
+/// A solver of several channels of one problem at once (they share F): systems[c] solves
+/// into *B[c] and reports into *reports[c] (at most 3 channels).
+using ChannelGroupSolver = void (*)(const std::vector<const ChannelSystem*>& systems,
+                                    const SolveOptions& options,
+                                    const std::vector<Eigen::VectorXd*>& B,
+                                    const std::vector<ChannelReport*>& reports);
+/// Gauss-Seidel and SOR on a group of channels: one pass over F's rows per sweep updates
+/// every channel still iterating, each with its own stopping rule and report, and each
+/// bitwise what it is when solved alone (solve_gauss_seidel, solve_sor).
+void solve_gauss_seidel_channels(const std::vector<const ChannelSystem*>& systems,
+                                 const SolveOptions& options,
+                                 const std::vector<Eigen::VectorXd*>& B,
+                                 const std::vector<ChannelReport*>& reports);
+void solve_sor_channels(const std::vector<const ChannelSystem*>& systems,
+                        const SolveOptions& options, const std::vector<Eigen::VectorXd*>& B,
+                        const std::vector<ChannelReport*>& reports);
 ChannelReport solve_southwell(const ChannelSystem& system, const SolveOptions& options,
                               Eigen::VectorXd& B);  ///< southwell / progressive refinement
 ChannelReport solve_bicgstab(const ChannelSystem& system, const SolveOptions& options,
