@@ -2,8 +2,11 @@
 // The memory a job may use: what the machine has available, sizes as users write them.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
+#include <utility>
 
 namespace lambert {
 
@@ -17,5 +20,29 @@ std::optional<double> parse_size(const std::string& text);
 
 /// Formats bytes with a binary suffix, e.g. "11.2 GiB".
 std::string format_bytes(double bytes);
+
+/// An allocator whose resize() leaves new elements as the memory was (no zeroing pass):
+/// for arrays of plain data that parallel loops fill, so that nothing touches a page of a
+/// large array before the thread that writes it (serial zeroing faults every page in on
+/// one thread). Elements constructed with arguments are constructed as usual.
+template <class T>
+struct UninitializedAllocator : std::allocator<T> {
+  using value_type = T;
+  template <class U>
+  struct rebind {
+    using other = UninitializedAllocator<U>;
+  };
+  UninitializedAllocator() = default;
+  template <class U>
+  UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U*) noexcept {
+    static_assert(std::is_trivially_copyable<U>::value, "plain data only");
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
 
 }  // namespace lambert

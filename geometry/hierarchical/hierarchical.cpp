@@ -161,56 +161,61 @@ Eigen::Vector3d facing_irradiance(const Field& E, const Eigen::Vector3d& n) {
 /// Push-pull: irradiance down (a cluster hands the directional field it and its ancestors
 /// gathered to its children, which take what their faces' orientation lets them; an element
 /// adds its own gathered corner field to the inherited one and hands each child the
-/// interpolated field), B = E + rho mean(H) at the leaves, area-averaged B up. Returns the
-/// largest change of a leaf's B and the largest leaf B (any channel).
+/// interpolated field), B = E + rho mean(H) at the leaves, area-averaged B up. A sweep
+/// returns the largest change of a leaf's B and the largest leaf B (any channel).
 struct Sweep {
   double change = 0.0, max_b = 0.0;
-};
-Sweep push_pull(const Hierarchy& h, std::int32_t i, const Field& down, State& s) {
-  const hr::Node& n = h.node(i);
-  Field H;
-  for (int k = 0; k < 6; ++k) H[k] = down[k] + s.gathered[i][k];
-  const int corners = n.cluster ? 0 : h.geom(i).n;
-  if (n.child_count == 0) {
-    const Patch& face = h.faces().patches[n.face];
-    const std::array<double, 4> mu = hr::corner_masses(h.geom(i));
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int k = 0; k < corners; ++k) mean += mu[k] * H[k];
-    const Eigen::Vector3d b = face.emission + face.rho.cwiseProduct(mean);
-    const double change = (b - s.B[i]).cwiseAbs().maxCoeff();
-    s.B[i] = b;
-    // The spread of B over the leaf: its irradiance varies between the corner values.
-    s.lo[i] = b;
-    s.hi[i] = b;
-    Eigen::Vector3d bk[4];
-    for (int k = 0; k < corners; ++k) {
-      bk[k] = face.emission + face.rho.cwiseProduct(H[k]);
-      s.lo[i] = s.lo[i].cwiseMin(bk[k]);
-      s.hi[i] = s.hi[i].cwiseMax(bk[k]);
-    }
-    const ff::PatchGeom& g = h.geom(i);
-    s.grad[i] = plane_gradient(g.normal, g.p.data(), bk, mu.data(), corners);
-    s.H[i] = mean;
-    return {change, b.maxCoeff()};
+  void add(const Sweep& o) {
+    change = std::max(change, o.change);
+    max_b = std::max(max_b, o.max_b);
   }
-  Sweep sweep;
+};
+
+/// The field child k of node i (whose total field is H) inherits.
+Field child_down(const Hierarchy& h, std::int32_t i, const Field& H, int k) {
+  const hr::Node& n = h.node(i);
+  const std::int32_t c = h.child(i, k);
+  if (!n.cluster) return child_corners(H, h.geom(i).n, k);
+  if (h.node(c).cluster) return H;
+  const Eigen::Vector3d e = facing_irradiance(H, h.geom(c).normal);
+  Field down = kNoField;
+  for (int j = 0; j < 4; ++j) down[j] = e;
+  return down;
+}
+
+/// A leaf's B (and its spread and gradient) from its total field H.
+Sweep update_leaf(const Hierarchy& h, std::int32_t i, const Field& H, State& s) {
+  const int corners = h.geom(i).n;
+  const Patch& face = h.faces().patches[h.node(i).face];
+  const std::array<double, 4> mu = hr::corner_masses(h.geom(i));
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int k = 0; k < corners; ++k) mean += mu[k] * H[k];
+  const Eigen::Vector3d b = face.emission + face.rho.cwiseProduct(mean);
+  const double change = (b - s.B[i]).cwiseAbs().maxCoeff();
+  s.B[i] = b;
+  // The spread of B over the leaf: its irradiance varies between the corner values.
+  s.lo[i] = b;
+  s.hi[i] = b;
+  Eigen::Vector3d bk[4];
+  for (int k = 0; k < corners; ++k) {
+    bk[k] = face.emission + face.rho.cwiseProduct(H[k]);
+    s.lo[i] = s.lo[i].cwiseMin(bk[k]);
+    s.hi[i] = s.hi[i].cwiseMax(bk[k]);
+  }
+  const ff::PatchGeom& g = h.geom(i);
+  s.grad[i] = plane_gradient(g.normal, g.p.data(), bk, mu.data(), corners);
+  s.H[i] = mean;
+  return {change, b.maxCoeff()};
+}
+
+/// An inner node's B (area average), spread and gradient from its children's.
+void pull(const Hierarchy& h, std::int32_t i, State& s) {
+  const hr::Node& n = h.node(i);
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = Eigen::Vector3d::Zero();
   for (int k = 0; k < n.child_count; ++k) {
     const std::int32_t c = h.child(i, k);
-    Field down_c = kNoField;
-    if (!n.cluster) {
-      down_c = child_corners(H, corners, k);
-    } else if (h.node(c).cluster) {
-      down_c = H;
-    } else {
-      const Eigen::Vector3d e = facing_irradiance(H, h.geom(c).normal);
-      for (int j = 0; j < 4; ++j) down_c[j] = e;
-    }
-    const Sweep child = push_pull(h, c, down_c, s);
-    sweep.change = std::max(sweep.change, child.change);
-    sweep.max_b = std::max(sweep.max_b, child.max_b);
     sum += h.node(c).area * s.B[c];
     lo = lo.cwiseMin(s.lo[c]);
     hi = hi.cwiseMax(s.hi[c]);
@@ -229,17 +234,139 @@ Sweep push_pull(const Hierarchy& h, std::int32_t i, const Field& down, State& s)
     }
     s.grad[i] = plane_gradient(h.geom(i).normal, x, v, w, n.child_count);
   }
+}
+
+/// The total field of node i: what it inherits plus what it gathered over its own links.
+Field total_field(std::int32_t i, const Field& down, const State& s) {
+  Field H;
+  for (int k = 0; k < 6; ++k) H[k] = down[k] + s.gathered[i][k];
+  return H;
+}
+
+/// Push-pull of the subtree below node i, which inherits `down`.
+Sweep push_pull(const Hierarchy& h, std::int32_t i, const Field& down, State& s) {
+  const Field H = total_field(i, down, s);
+  if (h.is_leaf(i)) return update_leaf(h, i, H, s);
+  Sweep sweep;
+  for (int k = 0; k < h.node(i).child_count; ++k)
+    sweep.add(push_pull(h, h.child(i, k), child_down(h, i, H, k), s));
+  pull(h, i, s);
   return sweep;
 }
 
-/// Links sorted by receiver, with the start of each receiver's run.
+/// The push-pull of the whole tree on several threads: the nodes whose subtrees exceed
+/// `grain` nodes (the top) push their fields down serially, the subtrees below them run
+/// push_pull in parallel, then the top pulls B up. Each node's arithmetic is push_pull's,
+/// so B is bitwise the serial sweep's for any thread count.
+class ParallelPushPull {
+ public:
+  ParallelPushPull(const Hierarchy& h, int threads) : h_(h), threads_(threads) {
+    // Subtree sizes, children after parents in node order except below clusters: an
+    // explicit post-order.
+    size_.assign(h.nodes().size(), 1);
+    std::vector<std::pair<std::int32_t, bool>> stack{{h.root(), false}};
+    while (!stack.empty()) {
+      const auto [i, done] = stack.back();
+      stack.pop_back();
+      const int children = h.node(i).child_count;
+      if (done) {
+        for (int k = 0; k < children; ++k) size_[i] += size_[h.child(i, k)];
+        continue;
+      }
+      stack.emplace_back(i, true);
+      for (int k = 0; k < children; ++k) stack.emplace_back(h.child(i, k), false);
+    }
+    // Subtrees of ~1/16 of a thread's share: enough pieces to balance uneven ones.
+    grain_ = std::max<std::int64_t>(4096, static_cast<std::int64_t>(h.nodes().size()) /
+                                              (16 * static_cast<std::int64_t>(threads)));
+  }
+
+  Sweep operator()(State& s) {
+    if (threads_ <= 1 || size_[h_.root()] <= grain_) return push_pull(h_, h_.root(), kNoField, s);
+    tasks_.clear();
+    descend(h_.root(), kNoField, s);
+    std::vector<Sweep> swept(tasks_.size());
+    parallel_for(static_cast<std::int64_t>(tasks_.size()), 1, threads_,
+                 [&](std::int64_t begin, std::int64_t end) {
+                   for (std::int64_t t = begin; t < end; ++t)
+                     swept[t] = push_pull(h_, tasks_[t].first, tasks_[t].second, s);
+                 });
+    ascend(h_.root(), s);
+    Sweep sweep;
+    for (const Sweep& x : swept) sweep.add(x);
+    return sweep;
+  }
+
+ private:
+  bool top(std::int32_t i) const { return size_[i] > grain_; }
+  void descend(std::int32_t i, const Field& down, const State& s) {
+    if (!top(i)) {
+      tasks_.emplace_back(i, down);
+      return;
+    }
+    const Field H = total_field(i, down, s);
+    for (int k = 0; k < h_.node(i).child_count; ++k)
+      descend(h_.child(i, k), child_down(h_, i, H, k), s);
+  }
+  void ascend(std::int32_t i, State& s) {
+    if (!top(i)) return;
+    for (int k = 0; k < h_.node(i).child_count; ++k) ascend(h_.child(i, k), s);
+    pull(h_, i, s);
+  }
+
+  const Hierarchy& h_;
+  int threads_;
+  std::vector<std::int64_t> size_;
+  std::int64_t grain_ = 0;
+  std::vector<std::pair<std::int32_t, Field>> tasks_;
+};
+
+/// Links in arrays that parallel loops fill (no zeroing pass before them).
+using LinkArray = std::vector<Link, UninitializedAllocator<Link>>;
+
+/// Links sorted by receiver (and source: every (p, q) pair is one link), with the start of
+/// each receiver's run, and the links accepted since they were sorted.
 struct LinkTable {
-  std::vector<Link> links;
+  LinkArray links;                   ///< sorted by (p, q)
   std::vector<std::int64_t> starts;  ///< run k is links[starts[k], starts[k+1])
-  void index() {
-    std::sort(links.begin(), links.end(), [](const Link& a, const Link& b) {
+  std::vector<LinkArray> fresh;      ///< accepted since the last index, one array per wave
+
+  std::size_t fresh_links() const {
+    std::size_t m = 0;
+    for (const LinkArray& wave : fresh) m += wave.size();
+    return m;
+  }
+  /// Bytes the index needs beside what is held: the fresh links side by side and the
+  /// merged table.
+  double index_bytes() const {
+    return static_cast<double>(fresh_links() + links.size() + fresh_links()) * sizeof(Link);
+  }
+  /// Sorts the fresh links and merges them into the table on `threads` threads (the order
+  /// is the one std::sort gives, (p, q) pairs being unique).
+  void index(int threads) {
+    const auto less = [](const Link& a, const Link& b) {
       return a.p < b.p || (a.p == b.p && a.q < b.q);
-    });
+    };
+    const std::int64_t m = static_cast<std::int64_t>(fresh_links());
+    if (m > 0) {
+      const std::int64_t head = static_cast<std::int64_t>(links.size()), n = head + m;
+      LinkArray tail(static_cast<std::size_t>(m));
+      std::vector<std::int64_t> at(fresh.size() + 1, 0);
+      for (std::size_t w = 0; w < fresh.size(); ++w)
+        at[w + 1] = at[w] + static_cast<std::int64_t>(fresh[w].size());
+      parallel_for(static_cast<std::int64_t>(fresh.size()), 1, threads,
+                   [&](std::int64_t begin, std::int64_t end) {
+                     for (std::int64_t w = begin; w < end; ++w) {
+                       std::copy(fresh[w].begin(), fresh[w].end(), tail.begin() + at[w]);
+                       LinkArray().swap(fresh[w]);
+                     }
+                   });
+      fresh.clear();
+      LinkArray merged(static_cast<std::size_t>(n));  // the sort's buffer, then the result
+      parallel_sort(tail.data(), m, less, threads, merged.data());
+      parallel_merge(links.data(), head, tail.data(), m, merged.data(), less, threads);
+      links.swap(merged);
+    }
     starts.clear();
     for (std::size_t k = 0; k < links.size(); ++k)
       if (k == 0 || links[k].p != links[k - 1].p) starts.push_back(static_cast<std::int64_t>(k));
@@ -335,7 +462,9 @@ struct Budget {
 
   /// Bytes held now: nodes with geometry and state, links and their index, the face BVH.
   double held() const {
-    return h.bytes() + s.bytes() + static_cast<double>(t.links.capacity()) * sizeof(Link) +
+    double fresh = 0.0;
+    for (const LinkArray& wave : t.fresh) fresh += static_cast<double>(wave.capacity());
+    return h.bytes() + s.bytes() + static_cast<double>(t.links.capacity() + fresh) * sizeof(Link) +
            static_cast<double>(t.starts.capacity()) * sizeof(std::int64_t) +
            static_cast<double>(h.faces().size()) * 256.0;  // the face BVH, ~2 nodes per face
   }
@@ -444,9 +573,18 @@ void export_leaves(const Hierarchy& h, const State& s, const std::vector<double>
 /// Per node, the transfer error (W/m^2, max channel) gathered over its own links and, at the
 /// leaves, over their ancestors' too (pushed down uniformly).
 std::vector<double> leaf_irradiance_error(const Hierarchy& h, const LinkTable& t,
-                                          const hr::LinkContext& ctx, const State& s) {
+                                          const hr::LinkContext& ctx, const State& s, int threads) {
   std::vector<double> e(h.nodes().size(), 0.0);
-  for (const Link& l : t.links) e[l.p] += hr::link_error(ctx, l, s.source(l.q)) / h.node(l.p).area;
+  const std::int64_t runs = static_cast<std::int64_t>(t.starts.size()) - 1;
+  parallel_for(runs, kGatherChunk, threads, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t r = begin; r < end; ++r) {  // receiver p's links, in link order
+      const std::int32_t p = t.links[t.starts[r]].p;
+      for (std::int64_t k = t.starts[r]; k < t.starts[r + 1]; ++k) {
+        const Link& l = t.links[k];
+        e[p] += hr::link_error(ctx, l, s.source(l.q)) / h.node(p).area;
+      }
+    }
+  });
   std::vector<std::pair<std::int32_t, double>> stack{{h.root(), 0.0}};
   while (!stack.empty()) {
     const auto [i, down] = stack.back();
@@ -578,9 +716,8 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
          // (pending, evaluated, actions, at worst all refined again), the table's growth
         std::size_t new_nodes = 0;
         std::tie(new_nodes, new_links) = wave_size(h, refine, to_split);
-        const std::size_t nodes = h.nodes().size(), links = table.links.size();
+        const std::size_t nodes = h.nodes().size();
         const std::size_t node_cap = Budget::grown(nodes, h.nodes().capacity(), new_nodes);
-        const std::size_t link_cap = Budget::grown(links, table.links.capacity(), new_links);
         const std::size_t wave = pending.size() + new_links;
         double extra = static_cast<double>(to_split.capacity()) * sizeof(std::int32_t) +
                        static_cast<double>(wave) * (2 * sizeof(pending[0]) + sizeof(Link) +
@@ -588,14 +725,11 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
         if (node_cap > h.nodes().capacity())
           extra += static_cast<double>(node_cap) *
                    (sizeof(hr::Node) + sizeof(ff::PatchGeom) + State::kBytesPerNode);
-        if (link_cap > table.links.capacity())
-          extra += static_cast<double>(link_cap) * sizeof(Link);
         budget.check(extra, "next refinement wave");
         if (node_cap > h.nodes().capacity()) {
           h.reserve(node_cap);
           s.reserve(node_cap);
         }
-        if (link_cap > table.links.capacity()) table.links.reserve(link_cap);
       }
       split_nodes(h, to_split, s);
       auto children = expand(h, refine, new_links);
@@ -605,7 +739,7 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
         pending.insert(pending.end(), children.begin(), children.end());
       std::vector<std::pair<std::int32_t, std::int32_t>>().swap(children);
       refine.clear();
-      std::vector<Link> evaluated(pending.size());
+      LinkArray evaluated(pending.size());
       std::vector<Action> action(pending.size());
       std::vector<std::int64_t> chunk_rays((pending.size() + kEvalChunk - 1) / kEvalChunk, 0);
       parallel_for(static_cast<std::int64_t>(pending.size()), kEvalChunk, threads,
@@ -613,7 +747,9 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
                      std::int64_t r = 0;
                      for (std::int64_t k = b; k < e; ++k) {
                        const auto [p, q] = pending[k];
-                       action[k] = hr::evaluate_link(ctx, p, q, s.source(q), evaluated[k], r);
+                       Link link;
+                       action[k] = hr::evaluate_link(ctx, p, q, s.source(q), link, r);
+                       evaluated[k] = link;
                      }
                      chunk_rays[b / kEvalChunk] += r;
                    });
@@ -622,23 +758,28 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
           static_cast<std::size_t>(std::count_if(action.begin(), action.end(), [](Action a) {
             return a != Action::Accept && a != Action::Drop;
           })));
+      std::size_t accepted = 0;  // moved to the front of `evaluated`, in order
       for (std::size_t k = 0; k < pending.size(); ++k) {
         if (action[k] == Action::Accept)
-          table.links.push_back(evaluated[k]);
+          evaluated[accepted++] = evaluated[k];
         else if (action[k] != Action::Drop)
           refine.push_back({pending[k].first, pending[k].second, action[k]});
       }
+      evaluated.resize(accepted);
+      if (accepted > 0) table.fresh.push_back(std::move(evaluated));
       std::vector<std::pair<std::int32_t, std::int32_t>>().swap(pending);
     }
-    table.index();
+    budget.check(table.index_bytes(), "link index");
+    table.index(threads);
     st.refine_seconds += refine_timer.seconds();
 
     Timer solve_timer;
     s.resize(h.nodes().size());
+    ParallelPushPull sweep_tree(h, threads);
     st.converged = false;
     for (int it = 1; it <= o.max_iterations; ++it) {
       gather(h, table, s, threads);
-      const Sweep sweep = push_pull(h, h.root(), kNoField, s);
+      const Sweep sweep = sweep_tree(s);
       ++st.iterations;
       st.change = sweep.max_b > 0 ? sweep.change / sweep.max_b : 0.0;
       if (st.change <= o.tol) {
@@ -659,7 +800,7 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
   st.rays = rays;
   st.memory_bytes = budget.held();
   energy_balance(h, s, st);
-  export_leaves(h, s, leaf_irradiance_error(h, table, ctx, s), result);
+  export_leaves(h, s, leaf_irradiance_error(h, table, ctx, s, threads), result);
   st.leaves = result.mesh.size();
   return result;
 }

@@ -97,6 +97,13 @@ Hierarchy::Hierarchy(PatchMesh faces) : faces_(std::move(faces)) {
   std::vector<std::int32_t> elements(n);
   std::iota(elements.begin(), elements.end(), 0);
   root_ = build_clusters(elements, 0, elements.size());
+  // The clusters are nodes [n, n + clusters_): their descent steps side by side.
+  steps_.reserve(static_cast<std::size_t>(clusters_));
+  for (std::int64_t c = 0; c < clusters_; ++c) {
+    const Node& node = nodes_[static_cast<std::size_t>(n + c)];
+    steps_.push_back(
+        {node.first_child, node.second_child, nodes_[node.first_child].area / node.area});
+  }
 }
 
 std::int32_t Hierarchy::build_clusters(std::vector<std::int32_t>& elements, std::size_t begin,
@@ -184,15 +191,16 @@ Eigen::Vector3d Hierarchy::sample_point(std::int32_t i, double u, double v, doub
   // Descend by area: u in [0,1) picks a child with probability A_child / A_node and is
   // rescaled to [0,1) within that child's share, so one number serves every level (its
   // precision, 53 bits, covers any depth lambert builds).
-  while (nodes_[i].cluster) {
-    const std::int32_t a = nodes_[i].first_child, b = nodes_[i].second_child;
-    const double pa = nodes_[a].area / nodes_[i].area;
+  const std::int32_t first_cluster = faces_.size();
+  while (i >= first_cluster && i - first_cluster < clusters_) {
+    const ClusterStep& step = steps_[static_cast<std::size_t>(i - first_cluster)];
+    const double pa = step.first_share;
     if (u < pa) {
       u = u / pa;
-      i = a;
+      i = step.first;
     } else {
       u = pa < 1.0 ? (u - pa) / (1.0 - pa) : 0.0;
-      i = b;
+      i = step.second;
     }
     u = std::min(u, 1.0 - 0x1.0p-53);
   }
@@ -224,7 +232,8 @@ void Hierarchy::reserve(std::size_t n) {
 
 double Hierarchy::bytes() const {
   return static_cast<double>(nodes_.capacity()) * sizeof(Node) +
-         static_cast<double>(geom_.capacity()) * sizeof(ff::PatchGeom);
+         static_cast<double>(geom_.capacity()) * sizeof(ff::PatchGeom) +
+         static_cast<double>(steps_.capacity()) * sizeof(ClusterStep);
 }
 
 }  // namespace lambert::hr

@@ -62,6 +62,39 @@ TEST(ParallelFor, ACancelRequestSkipsTheRestAndThrowsCancelled) {
   }
 }
 
+TEST(ParallelSort, IsStdSortWhateverTheThreadCount) {
+  // Distinct keys in scrambled order, above the 2^15 elements where pieces start: every
+  // thread count (including ones that are not powers of two) gives std::sort's order.
+  std::vector<std::uint64_t> keys(300007);
+  for (std::size_t k = 0; k < keys.size(); ++k) keys[k] = mix64(k);
+  std::vector<std::uint64_t> expected = keys;
+  std::sort(expected.begin(), expected.end());
+  for (int threads : {1, 2, 3, 8}) {
+    std::vector<std::uint64_t> v = keys, buffer(v.size());
+    parallel_sort(v.data(), static_cast<std::int64_t>(v.size()), std::less<>(), threads,
+                  buffer.data());
+    EXPECT_EQ(v, expected) << "threads=" << threads;
+  }
+}
+
+TEST(ParallelMerge, IsStdMergeWithTiesAndUnequalLengths) {
+  // Keys with many ties (k / 7) and a payload telling the inputs apart: std::merge takes
+  // a's elements first on ties, and so must every piece boundary of the merge path.
+  using Item = std::pair<int, int>;  // (key, payload)
+  const auto by_key = [](const Item& x, const Item& y) { return x.first < y.first; };
+  std::vector<Item> a, b;
+  for (int k = 0; k < 250000; ++k) a.emplace_back(k / 7, k);
+  for (int k = 0; k < 70001; ++k) b.emplace_back(3 * k / 7 + 5, -k);
+  std::vector<Item> expected(a.size() + b.size());
+  std::merge(a.begin(), a.end(), b.begin(), b.end(), expected.begin(), by_key);
+  for (int threads : {1, 2, 5}) {
+    std::vector<Item> out(expected.size());
+    parallel_merge(a.data(), static_cast<std::int64_t>(a.size()), b.data(),
+                   static_cast<std::int64_t>(b.size()), out.data(), by_key, threads);
+    EXPECT_EQ(out, expected) << "threads=" << threads;
+  }
+}
+
 TEST(Sampling, KroneckerPointsAreEquidistributed) {
   // A shifted Kronecker lattice has star discrepancy O(log n / n); the count of n = 4096
   // points in any axis-aligned box of volume 1/16 must be within a few percent of n/16,
