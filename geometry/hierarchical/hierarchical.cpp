@@ -330,6 +330,9 @@ struct LinkTable {
   LinkArray links;                   ///< sorted by (p, q)
   std::vector<std::int64_t> starts;  ///< run k is links[starts[k], starts[k+1])
   std::vector<LinkArray> fresh;      ///< accepted since the last index, one array per wave
+  /// The table before the last index: the next index merges into it (its pages are already
+  /// the process's: a fresh array of every link each pass faulted them in again).
+  LinkArray spare;
 
   std::size_t fresh_links() const {
     std::size_t m = 0;
@@ -337,9 +340,11 @@ struct LinkTable {
     return m;
   }
   /// Bytes the index needs beside what is held: the fresh links side by side and the
-  /// merged table.
+  /// merged table (where the spare is too small for it).
   double index_bytes() const {
-    return static_cast<double>(fresh_links() + links.size() + fresh_links()) * sizeof(Link);
+    const std::size_t n = links.size() + fresh_links();
+    return static_cast<double>(fresh_links() + (spare.capacity() < n ? n + n / 4 : 0)) *
+           sizeof(Link);
   }
   /// Sorts the fresh links and merges them into the table on `threads` threads (the order
   /// is the one std::sort gives, (p, q) pairs being unique).
@@ -362,10 +367,19 @@ struct LinkTable {
                      }
                    });
       fresh.clear();
-      LinkArray merged(static_cast<std::size_t>(n));  // the sort's buffer, then the result
+      LinkArray merged;  // the sort's buffer, then the result
+      merged.swap(spare);
+      if (merged.capacity() < static_cast<std::size_t>(n)) {
+        // A quarter more: the table grows from pass to pass, and the spare is reused only
+        // while it holds the next table.
+        LinkArray().swap(merged);
+        merged.reserve(static_cast<std::size_t>(n + n / 4));
+      }
+      merged.resize(static_cast<std::size_t>(n));
       parallel_sort(tail.data(), m, less, threads, merged.data());
       parallel_merge(links.data(), head, tail.data(), m, merged.data(), less, threads);
       links.swap(merged);
+      spare.swap(merged);
     }
     starts.clear();
     for (std::size_t k = 0; k < links.size(); ++k)
@@ -464,7 +478,8 @@ struct Budget {
   double held() const {
     double fresh = 0.0;
     for (const LinkArray& wave : t.fresh) fresh += static_cast<double>(wave.capacity());
-    return h.bytes() + s.bytes() + static_cast<double>(t.links.capacity() + fresh) * sizeof(Link) +
+    return h.bytes() + s.bytes() +
+           static_cast<double>(t.links.capacity() + t.spare.capacity() + fresh) * sizeof(Link) +
            static_cast<double>(t.starts.capacity()) * sizeof(std::int64_t) +
            static_cast<double>(h.faces().size()) * 256.0;  // the face BVH, ~2 nodes per face
   }
@@ -791,6 +806,7 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
     progress.advance(1, static_cast<std::int64_t>(table.links.size()));
   }
   progress.finish();
+  LinkArray().swap(table.spare);
   if (emitted.maxCoeff() <= 0.0) st.converged = true;  // B = E = 0 is exact
 
   st.elements = h.size() - h.clusters();

@@ -186,27 +186,45 @@ void Hierarchy::split_element(std::int32_t i) {
   nodes_[i].child_count = 4;
 }
 
-Eigen::Vector3d Hierarchy::sample_point(std::int32_t i, double u, double v, double w,
-                                        Eigen::Vector3d& normal, double& warp) const {
+void Hierarchy::descend(std::int32_t i, int n, std::int32_t* element, double* u) const {
   // Descend by area: u in [0,1) picks a child with probability A_child / A_node and is
   // rescaled to [0,1) within that child's share, so one number serves every level (its
-  // precision, 53 bits, covers any depth lambert builds).
+  // precision, 53 bits, covers any depth lambert builds). Both outcomes are computed and
+  // one selected (no branch to mispredict), all n descents a level at a time (their chains
+  // of divisions overlap).
   const std::int32_t first_cluster = faces_.size();
-  while (i >= first_cluster && i - first_cluster < clusters_) {
-    const ClusterStep& step = steps_[static_cast<std::size_t>(i - first_cluster)];
-    const double pa = step.first_share;
-    if (u < pa) {
-      u = u / pa;
-      i = step.first;
-    } else {
-      u = pa < 1.0 ? (u - pa) / (1.0 - pa) : 0.0;
-      i = step.second;
+  const auto is_cluster = [&](std::int32_t k) {
+    return k >= first_cluster && k - first_cluster < clusters_;
+  };
+  for (int k = 0; k < n; ++k) element[k] = i;
+  for (bool active = is_cluster(i); active;) {
+    active = false;
+    for (int k = 0; k < n; ++k) {
+      if (!is_cluster(element[k])) continue;
+      const ClusterStep& step = steps_[static_cast<std::size_t>(element[k] - first_cluster)];
+      const double pa = step.first_share;
+      const bool first = u[k] < pa;
+      const double in_first = u[k] / pa;
+      const double in_second = pa < 1.0 ? (u[k] - pa) / (1.0 - pa) : 0.0;
+      u[k] = std::min(first ? in_first : in_second, 1.0 - 0x1.0p-53);
+      element[k] = first ? step.first : step.second;
+      active = active || is_cluster(element[k]);
     }
-    u = std::min(u, 1.0 - 0x1.0p-53);
   }
-  // Within an element: uniform in area. A quad is two triangles (0,1,2), (0,2,3) chosen by
-  // area with u's remainder; a triangle is sampled by the folded parallelogram (exact).
-  const ff::PatchGeom& g = geom_[i];
+  // The elements' geometry is what element_point reads next: ask for it now, all at once.
+  for (int k = 0; k < n; ++k) {
+    const char* g = reinterpret_cast<const char*>(&geom_[static_cast<std::size_t>(element[k])]);
+    for (std::size_t line = 0; line < sizeof(ff::PatchGeom); line += 64)
+      __builtin_prefetch(g + line);
+    __builtin_prefetch(g + sizeof(ff::PatchGeom) - 1);
+  }
+}
+
+Eigen::Vector3d Hierarchy::element_point(std::int32_t e, double u, double v, double w,
+                                         Eigen::Vector3d& normal, double& warp) const {
+  // Uniform in area. A quad is two triangles (0,1,2), (0,2,3) chosen by area with u; a
+  // triangle is sampled by the folded parallelogram (exact).
+  const ff::PatchGeom& g = geom_[e];
   normal = g.normal;
   warp = g.warp;
   Eigen::Vector3d a = g.p[0], b = g.p[1], c = g.p[2];
@@ -223,6 +241,13 @@ Eigen::Vector3d Hierarchy::sample_point(std::int32_t i, double u, double v, doub
     w = 1.0 - w;
   }
   return a + v * (b - a) + w * (c - a);
+}
+
+Eigen::Vector3d Hierarchy::sample_point(std::int32_t i, double u, double v, double w,
+                                        Eigen::Vector3d& normal, double& warp) const {
+  std::int32_t e = i;
+  descend(i, 1, &e, &u);
+  return element_point(e, u, v, w, normal, warp);
 }
 
 void Hierarchy::reserve(std::size_t n) {

@@ -72,6 +72,12 @@ class Hierarchy {
   /// the face it lies on: the surface the BVH traces).
   Eigen::Vector3d sample_point(std::int32_t i, double u, double v, double w,
                                Eigen::Vector3d& normal, double& warp) const;
+  /// sample_point's descent for n numbers u at once: element[k] is where u[k] leads below
+  /// node i, and u[k] becomes its remainder (what sample_point passes to element_point).
+  void descend(std::int32_t i, int n, std::int32_t* element, double* u) const;
+  /// The point of element e at (u, v, w) (sample_point below the descent).
+  Eigen::Vector3d element_point(std::int32_t e, double u, double v, double w,
+                                Eigen::Vector3d& normal, double& warp) const;
 
   /// Bytes held by nodes and element geometry.
   double bytes() const;

@@ -237,13 +237,25 @@ double cluster_transfer(const LinkContext& ctx, std::int32_t p, std::int32_t q,
   const Kronecker4 sx(hash_keys(ctx.seed, link_key(p, q), 1));
   const Kronecker4 sy(hash_keys(ctx.seed, link_key(p, q), 2));
   double sum = 0.0, share[6] = {0, 0, 0, 0, 0, 0};
+  // The pairs' descents in blocks, a block's descents interleaved (Hierarchy::descend).
+  constexpr int kBlock = 32;
+  std::int32_t ex[kBlock], ey[kBlock];
+  double ux[kBlock], uy[kBlock];
   for (int s = 0; s < ctx.rays; ++s) {
+    const int j = s % kBlock;
+    if (j == 0) {
+      const int n = std::min(kBlock, ctx.rays - s);
+      for (int k = 0; k < n; ++k) {
+        ux[k] = sx.get(s + k, 0);
+        uy[k] = sy.get(s + k, 0);
+      }
+      ctx.h.descend(p, n, ex, ux);
+      ctx.h.descend(q, n, ey, uy);
+    }
     Eigen::Vector3d nx, ny;
     double wx = 0.0, wy = 0.0;
-    const Eigen::Vector3d x =
-        ctx.h.sample_point(p, sx.get(s, 0), sx.get(s, 1), sx.get(s, 2), nx, wx);
-    const Eigen::Vector3d y =
-        ctx.h.sample_point(q, sy.get(s, 0), sy.get(s, 1), sy.get(s, 2), ny, wy);
+    const Eigen::Vector3d x = ctx.h.element_point(ex[j], ux[j], sx.get(s, 1), sx.get(s, 2), nx, wx);
+    const Eigen::Vector3d y = ctx.h.element_point(ey[j], uy[j], sy.get(s, 1), sy.get(s, 2), ny, wy);
     const Eigen::Vector3d r = y - x;
     const double r2 = r.squaredNorm();
     if (r2 <= 0.0) continue;
