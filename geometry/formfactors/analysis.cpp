@@ -11,6 +11,7 @@
 #include "core/parallel.hpp"
 #include "core/sampling.hpp"
 #include "geometry/formfactors/constants.hpp"
+#include "geometry/formfactors/mirror.hpp"
 #include "geometry/formfactors/pairwise.hpp"
 #include "geometry/formfactors/replicates.hpp"
 #include "geometry/formfactors/visibility.hpp"
@@ -44,16 +45,31 @@ FormFactorDiagnostics diagnose(const PatchMesh& mesh, const SparseF& F, int wors
   };
   std::vector<double> sums(d.n, 0.0);
   std::vector<RowFacts> facts(d.n);
+  const auto* outer = F.outerIndexPtr();
+  const auto* col = F.innerIndexPtr();
+  const std::uint64_t call = ff::MirrorCursor::next_call();
+  const bool compressed = F.isCompressed();  // (outer[j + 1] ends row j)
   parallel_for(d.n, 256, threads, [&](std::int64_t begin, std::int64_t end) {
+    thread_local ff::MirrorCursor mirror;
+    mirror.rows(d.n);
     for (std::int64_t i = begin; i < end; ++i) {
       RowFacts& r = facts[i];
       for (SparseF::InnerIterator it(F, i); it; ++it) {
         sums[i] += it.value();
         r.negative += it.value() < 0.0;
         r.above_one += it.value() > 1.0;
-        // F is row-major: F_ji by binary search in row j.
+        // F is row-major: F_ji from row j (0 where it is not stored).
+        const auto j = static_cast<SparseF::StorageIndex>(it.col());
+        double fji = 0.0;
+        if (compressed) {
+          const std::int64_t q =
+              mirror.find(col, outer, j, static_cast<SparseF::StorageIndex>(i), call);
+          if (q >= 0) fji = F.valuePtr()[q];
+        } else {
+          fji = F.coeff(j, i);
+        }
         const double aij = mesh.patches[i].area * it.value();
-        const double aji = mesh.patches[it.col()].area * F.coeff(it.col(), i);
+        const double aji = mesh.patches[j].area * fji;
         const double diff = std::abs(aij - aji);
         r.reciprocity_max = std::max(r.reciprocity_max, diff);
         r.reciprocity_max_relative =

@@ -11,17 +11,12 @@
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
+#include "geometry/formfactors/mirror.hpp"
 
 namespace lambert::ff {
 namespace {
 
 using Index = SparseF::StorageIndex;
-
-// Position of column j in the sorted run col[begin, end), or -1.
-std::int64_t find_col(const Index* col, std::int64_t begin, std::int64_t end, Index j) {
-  const Index* p = std::lower_bound(col + begin, col + end, j);
-  return p != col + end && *p == j ? p - col : -1;
-}
 
 // Per-row sums of the averaging step's change (stats), reduced in row order afterwards so
 // that they do not depend on the thread count.
@@ -42,7 +37,10 @@ void average_pairs(SparseF& F, SparseF* S, const Eigen::VectorXd& a, int threads
   const Index* col = F.innerIndexPtr();
   double* val = F.valuePtr();
   double* err = S ? S->valuePtr() : nullptr;
+  const std::uint64_t call = MirrorCursor::next_call();
   parallel_for(F.rows(), 256, threads, [&](std::int64_t begin, std::int64_t end) {
+    thread_local MirrorCursor mirror;
+    mirror.rows(F.rows());
     for (std::int64_t i = begin; i < end; ++i) {
       RowChange rc;
       for (std::int64_t k = outer[i]; k < outer[i + 1]; ++k) {
@@ -55,7 +53,7 @@ void average_pairs(SparseF& F, SparseF* S, const Eigen::VectorXd& a, int threads
           ++rc.matched;
           continue;
         }
-        const std::int64_t q = find_col(col, outer[j], outer[j + 1], static_cast<Index>(i));
+        const std::int64_t q = mirror.find(col, outer, j, static_cast<Index>(i), call);
         if (q < 0) {
           const double g = gij / 2;
           val[k] = -g;

@@ -10,8 +10,52 @@
 #include <limits>
 #include <random>
 
+#include "geometry/formfactors/mirror.hpp"
+
 namespace lambert {
 namespace {
+
+TEST(MirrorCursor, FindsWhatABinarySearchFindsWhateverTheCursorHeld) {
+  // A random CSR pattern (rows of 0-60 sorted distinct columns of 200), long rows beyond the
+  // cursor's linear steps included. The cursor is exact for rows visited in increasing
+  // order, after a pass that visited them in another order (stale cursors of an earlier
+  // call), and in a new call whose rows skip about (a thread's chunks).
+  const int n = 200;
+  std::mt19937 rng(7);
+  std::vector<int> outer{0}, col;
+  for (int r = 0; r < n; ++r) {
+    std::vector<int> row;
+    const int len = static_cast<int>(rng() % 61);
+    for (int k = 0; k < len; ++k) row.push_back(static_cast<int>(rng() % n));
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+    col.insert(col.end(), row.begin(), row.end());
+    outer.push_back(static_cast<int>(col.size()));
+  }
+  const auto expected = [&](int j, int i) -> std::int64_t {
+    const int* p = std::lower_bound(col.data() + outer[j], col.data() + outer[j + 1], i);
+    return p != col.data() + outer[j + 1] && *p == i ? p - col.data() : -1;
+  };
+  ff::MirrorCursor mirror;
+  mirror.rows(n);
+  std::vector<int> order(n);
+  for (int k = 0; k < n; ++k) order[k] = n - 1 - k;  // decreasing: not the cursor's order
+  std::uint64_t call = ff::MirrorCursor::next_call();
+  for (const int i : order)
+    for (int j = 0; j < n; ++j) mirror.find(col.data(), outer.data(), j, i, call);
+  std::int64_t found = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    call = ff::MirrorCursor::next_call();
+    for (int i = pass; i < n; i += 1 + pass * static_cast<int>(rng() % 5))
+      for (int k = outer[i]; k < outer[i + 1]; ++k) {
+        const int j = col[k];
+        const std::int64_t q = mirror.find(col.data(), outer.data(), j, i, call);
+        ASSERT_EQ(q, expected(j, i)) << "row " << j << " column " << i;
+        found += q >= 0;
+      }
+  }
+  EXPECT_GT(found, 100);  // the pattern has mirrors to find, not only misses
+}
 
 using Dense = Eigen::MatrixXd;
 
