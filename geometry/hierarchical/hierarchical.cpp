@@ -339,16 +339,21 @@ struct LinkTable {
     for (const LinkArray& wave : fresh) m += wave.size();
     return m;
   }
+  /// The array a merged table of n links gets where the spare is too small: a quarter more
+  /// (the table grows from pass to pass; the spare is reused while it holds the next one)
+  /// unless `tight`.
+  static std::size_t merged_capacity(std::size_t n, bool tight) { return tight ? n : n + n / 4; }
   /// Bytes the index needs beside what is held: the fresh links side by side and the
   /// merged table (where the spare is too small for it).
-  double index_bytes() const {
+  double index_bytes(bool tight) const {
     const std::size_t n = links.size() + fresh_links();
-    return static_cast<double>(fresh_links() + (spare.capacity() < n ? n + n / 4 : 0)) *
+    return static_cast<double>(fresh_links() +
+                               (spare.capacity() < n ? merged_capacity(n, tight) : 0)) *
            sizeof(Link);
   }
   /// Sorts the fresh links and merges them into the table on `threads` threads (the order
   /// is the one std::sort gives, (p, q) pairs being unique).
-  void index(int threads) {
+  void index(int threads, bool tight) {
     const auto less = [](const Link& a, const Link& b) {
       return a.p < b.p || (a.p == b.p && a.q < b.q);
     };
@@ -370,10 +375,8 @@ struct LinkTable {
       LinkArray merged;  // the sort's buffer, then the result
       merged.swap(spare);
       if (merged.capacity() < static_cast<std::size_t>(n)) {
-        // A quarter more: the table grows from pass to pass, and the spare is reused only
-        // while it holds the next table.
         LinkArray().swap(merged);
-        merged.reserve(static_cast<std::size_t>(n + n / 4));
+        merged.reserve(merged_capacity(static_cast<std::size_t>(n), tight));
       }
       merged.resize(static_cast<std::size_t>(n));
       parallel_sort(tail.data(), m, less, threads, merged.data());
@@ -704,6 +707,10 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
   for (int pass = 1; pass <= o.max_passes; ++pass) {
     Timer refine_timer;
     std::vector<Refinement> refine;
+    // The spare table array (and the headroom of a new one) saves page faults, not memory:
+    // given up once the hierarchy holds half the limit.
+    const bool tight = budget.limit > 0 && budget.held() > 0.5 * budget.limit;
+    if (tight) LinkArray().swap(table.spare);
     if (pass > 1) {  // recheck the accepted links against the new B
       // The verdicts, and at worst every link to refine.
       budget.check(static_cast<double>(table.links.size()) * (1.0 + sizeof(Refinement)), "recheck");
@@ -728,7 +735,8 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
     while (!pending.empty() || !refine.empty()) {
       std::size_t new_links = 0;
       {  // the wave's peak: new nodes (a reallocation holds old and new buffers), its links
-         // (pending, evaluated, actions, at worst all refined again), the table's growth
+         // (pending, evaluated, actions, at worst all refined again); the links accepted in
+         // earlier waves are held (Budget::held) until the pass's index
         std::size_t new_nodes = 0;
         std::tie(new_nodes, new_links) = wave_size(h, refine, to_split);
         const std::size_t nodes = h.nodes().size();
@@ -781,11 +789,13 @@ HierarchicalResult solve_hierarchical(const Scene& scene, const HierarchicalOpti
           refine.push_back({pending[k].first, pending[k].second, action[k]});
       }
       evaluated.resize(accepted);
+      // Kept until the pass's index: not at twice the size it needs.
+      if (accepted < evaluated.capacity() / 2) evaluated.shrink_to_fit();
       if (accepted > 0) table.fresh.push_back(std::move(evaluated));
       std::vector<std::pair<std::int32_t, std::int32_t>>().swap(pending);
     }
-    budget.check(table.index_bytes(), "link index");
-    table.index(threads);
+    budget.check(table.index_bytes(tight), "link index");
+    table.index(threads, tight);
     st.refine_seconds += refine_timer.seconds();
 
     Timer solve_timer;
