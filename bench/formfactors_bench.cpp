@@ -10,6 +10,9 @@
 //  2b. the same end-to-end fills on CAD slivers: the generated heat sink of data/heat_sink
 //     (3,852 facets up to 100 mm x 0.05 mm, issue 36), rays/s and the ratio to the Cornell
 //     box's per-ray rate of the same estimator in the same run, and raw Embree on its rays;
+//  2c. the same for "hemicube" (directions, i.e. pixels, per second against closest-hit
+//     rays) and for the specular pass of the extended form factors (segments per second on
+//     the specular Cornell box against raw closest-hit rays on its BVH);
 //  3. time and peak memory of the Cornell box fill at ~2,000, ~10,000 and ~30,000 patches,
 //     each in a forked child so that its peak RSS is its own.
 // Usage: formfactors_bench [--quick] [--repeats N] [--sizes 2000,10000,30000] [--samples K]
@@ -33,6 +36,7 @@
 #include "core/timer.hpp"
 #include "geometry/formfactors/formfactors.hpp"
 #include "geometry/formfactors/kernels.hpp"
+#include "geometry/formfactors/specular.hpp"
 #include "geometry/visibility/bvh.hpp"
 #include "io/obj_loader.hpp"
 #include "io/stl_loader.hpp"
@@ -111,13 +115,19 @@ double raw_packet_throughput(const Bvh& bvh, const std::vector<Ray>& rays,
   return static_cast<double>(rays.size()) / t.seconds();
 }
 
-// Rays per second of a whole fill of F by a pair estimator (stats.rays / stats.seconds).
-double fill_rate(const PatchMesh& mesh, const char* estimator, int samples, int threads) {
+// Options for one fill by `estimator` on `threads` threads, without progress output.
+FormFactorOptions bench_options(const char* estimator, int threads) {
   FormFactorOptions o;
   o.estimator = estimator;
-  o.pair.samples = samples;
   o.run.threads = threads;
   o.run.progress = false;
+  return o;
+}
+
+// Rays per second of a whole fill of F by a pair estimator (stats.rays / stats.seconds).
+double fill_rate(const PatchMesh& mesh, const char* estimator, int samples, int threads) {
+  FormFactorOptions o = bench_options(estimator, threads);
+  o.pair.samples = samples;
   const FormFactors ff = compute_form_factors(mesh, o);
   return ff.stats.rays / ff.stats.seconds;
 }
@@ -235,11 +245,8 @@ int main(int argc, char** argv) {
   for (int r = 0; r < repeats; ++r) {
     raw_closest.push_back(raw_closest_hit_rate(bvh, grays, threads));
     raw_closest_packet.push_back(raw_closest_hit_packet_rate(bvh, grays, threads));
-    FormFactorOptions o;
-    o.estimator = "gather";
+    FormFactorOptions o = bench_options("gather", threads);
     o.gather.rays = gather_k;
-    o.run.threads = threads;
-    o.run.progress = false;
     const FormFactors ff = compute_form_factors(mesh, o);
     e2e_gather.push_back(ff.stats.rays / ff.stats.seconds);
   }
@@ -248,6 +255,44 @@ int main(int argc, char** argv) {
   std::printf("%-34s %14.2f %8.2f\n", "raw Embree rtcIntersect16 per patch",
               median(raw_closest_packet) / 1e6, median(raw_closest_packet) / rc_m);
   std::printf("%-34s %14.2f %8.2f\n", "end-to-end gather (+ averaging)", ga_m / 1e6, ga_m / rc_m);
+
+  // Hemicube: each pixel of a patch's hemicube is one direction's closest hit, what one
+  // gather ray finds, so its directions per second (3 res² per row: the top face and four
+  // half faces) are compared with the same raw closest-hit rate.
+  std::vector<double> e2e_hemicube;
+  const int hemi_res = 128;
+  for (int r = 0; r < repeats; ++r) {
+    FormFactorOptions o = bench_options("hemicube", threads);
+    o.hemicube.resolution = hemi_res;
+    const FormFactors ff = compute_form_factors(mesh, o);
+    e2e_hemicube.push_back(3.0 * hemi_res * hemi_res * mesh.size() / ff.stats.seconds);
+  }
+  const double hc_m = median(e2e_hemicube);
+  std::printf("%-34s %14.2f %8.2f\n", "hemicube 128, directions (pixels)", hc_m / 1e6, hc_m / rc_m);
+
+  // The specular pass (extended form factors) on the specular Cornell box: its segments
+  // (closest-hit rays along the paths) per second against raw closest-hit rays on its BVH.
+  const std::filesystem::path spec_path =
+      std::filesystem::path(builtin_cornell_box_path()).parent_path().parent_path() /
+      "cornell_box_specular" / "cornell_box_specular.obj";
+  if (std::filesystem::exists(spec_path)) {
+    const PatchMesh spec = mesh_scene(load_obj(spec_path.string()), {0.0, 2000});
+    const Bvh spec_bvh(spec);
+    const std::vector<BenchRay> spec_rays = hemisphere_rays(spec, gather_k);
+    std::vector<double> spec_raw, spec_rate;
+    for (int r = 0; r < repeats; ++r) {
+      spec_raw.push_back(raw_closest_hit_rate(spec_bvh, spec_rays, threads));
+      FormFactorOptions o = bench_options("gather", threads);
+      o.specular.rays = gather_k;
+      Timer t;
+      const ff::SpecularTransport sp = ff::compute_specular_transport(spec, o, spec_bvh);
+      spec_rate.push_back(static_cast<double>(sp.rays) / t.seconds());
+    }
+    std::printf("%-34s %14.2f %8s\n", "specular box, raw rtcIntersect1", median(spec_raw) / 1e6,
+                "1.00");
+    std::printf("%-34s %14.2f %8.2f\n", "specular pass, segments", median(spec_rate) / 1e6,
+                median(spec_rate) / median(spec_raw));
+  }
 
   // 3: time and peak memory per size.
   std::printf("\n%-9s %-9s %8s %10s %12s %10s %12s %12s\n", "target", "patches", "est", "samples",

@@ -40,13 +40,20 @@ double max_cosine(const Eigen::Vector3d& n, const Eigen::Vector3d* w, int m) {
 }
 
 // A direction uniform in the solid angle of the spherical triangle (a, b, c) (Arvo 1995).
+// The angle α at a enters only through its cosine and sine: cos α from the edge planes'
+// normals, sin α from |(a x b) x (a x c)| = |a · (b x c)| (a is unit), and the sine and
+// cosine of u1 · area - α by the angle-difference formulas from those of u1 · area (at most
+// 2π: a fraction of a turn, cos_sin_turn), without acos, sin or cos (a third of the
+// sampler's time in libm before).
 Eigen::Vector3d arvo(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
                      double area, double u1, double u2) {
   const Eigen::Vector3d nab = a.cross(b), nac = a.cross(c);
-  const double cos_alpha =
-      std::clamp(nab.dot(nac) / std::max(nab.norm() * nac.norm(), 1e-300), -1.0, 1.0);
-  const double alpha = std::acos(cos_alpha), sin_alpha = std::sin(alpha);
-  const double s = std::sin(u1 * area - alpha), t = std::cos(u1 * area - alpha);
+  const double norms = std::max(nab.norm() * nac.norm(), 1e-300);
+  const double cos_alpha = std::clamp(nab.dot(nac) / norms, -1.0, 1.0);
+  const double sin_alpha = std::min(1.0, std::abs(a.dot(b.cross(c))) / norms);
+  double cu, su;  // cos and sin of u1 · area
+  cos_sin_turn(std::clamp(u1 * area / (2.0 * M_PI), 0.0, 1.0), cu, su);
+  const double s = su * cos_alpha - cu * sin_alpha, t = cu * cos_alpha + su * sin_alpha;
   const double u = t - cos_alpha, v = s + sin_alpha * a.dot(b);
   const double den = (v * s + u * t) * sin_alpha;
   const double q =
