@@ -91,11 +91,15 @@ void trace_row(const std::vector<PatchGeom>& geom, const std::vector<Eigen::Vect
   flush();
 }
 
+// A sort of t touched columns costs ~t log t comparisons, a scan of the accumulator one
+// (vectorisable) test per patch: scan when t >= n / kScanPerTouched.
+constexpr std::int64_t kScanPerTouched = 32;
+
 // Row i's entries from its hits: F_ij = Σ w / K (summed in hit order), and with `with_err`
 // the error from the replicate estimates (Σ_{hits in r} w) / k_r. Without errors the sums
 // go through a dense accumulator over the patches (`acc`, all zero on entry and on return;
-// O(hits + distinct log distinct)); with errors the hits are sorted by patch (stable, so
-// each sum is in the same order and F is bitwise the same either way).
+// O(hits + min(distinct log distinct, patches))); with errors the hits are sorted by patch (stable,
+// so each sum is in the same order and F is bitwise the same either way).
 void row_from_hits(std::vector<Hit>& hits, int K, bool with_err, std::vector<double>& acc,
                    std::vector<std::int32_t>& touched, std::vector<RowEntry>& row) {
   row.clear();
@@ -104,6 +108,17 @@ void row_from_hits(std::vector<Hit>& hits, int K, bool with_err, std::vector<dou
     for (const Hit& h : hits) {
       if (acc[h.j] == 0.0) touched.push_back(h.j);
       acc[h.j] += h.w;
+    }
+    const auto n = static_cast<std::int32_t>(acc.size());
+    if (static_cast<std::int64_t>(touched.size()) * kScanPerTouched >= n) {
+      // Many patches touched (a few thousand patches, K ~ 1024): one pass over the
+      // accumulator in column order costs less than sorting them (the same row).
+      for (std::int32_t j = 0; j < n; ++j)
+        if (acc[j] != 0.0) {
+          if (acc[j] > 0.0) row.push_back({j, acc[j] / K, 0.0});
+          acc[j] = 0.0;
+        }
+      return;
     }
     std::sort(touched.begin(), touched.end());
     touched.erase(std::unique(touched.begin(), touched.end()), touched.end());  // w = 0 hits

@@ -134,6 +134,33 @@ TEST(FormFactorGather, BitwiseIdenticalForAnyThreadCount) {
   }
 }
 
+// A row's sums go through a dense accumulator without standard errors (read back by a scan
+// in column order when many patches were touched, else by sorting the touched columns) and
+// through a stable sort by column with them: each entry summed in hit order either way, so F
+// is bitwise the same. 2,400 patches: K = 8 rays touch few (the sort), K = 128 many (the scan).
+TEST(FormFactorGather, RowsAreBitwiseTheSameWithOrWithoutErrors) {
+  const PatchMesh mesh = mesh_scene(unit_cube(), {0.05, 0});
+  ASSERT_EQ(mesh.size(), 2400);
+  for (const int rays : {8, 128}) {
+    FormFactorOptions o;
+    o.estimator = "gather";
+    o.gather.rays = rays;
+    o.reciprocity = "none";
+    o.run.progress = false;
+    o.run.with_stderr = true;
+    const FormFactors with = compute_form_factors(mesh, o);
+    o.run.with_stderr = false;
+    const FormFactors without = compute_form_factors(mesh, o);
+    ASSERT_EQ(with.F.nonZeros(), without.F.nonZeros()) << rays;
+    for (std::int64_t k = 0; k < with.F.nonZeros(); ++k) {
+      ASSERT_EQ(with.F.valuePtr()[k], without.F.valuePtr()[k]) << rays << " entry " << k;
+      ASSERT_EQ(with.F.innerIndexPtr()[k], without.F.innerIndexPtr()[k]) << rays;
+    }
+    for (Eigen::Index i = 0; i <= mesh.size(); ++i)
+      ASSERT_EQ(with.F.outerIndexPtr()[i], without.F.outerIndexPtr()[i]) << rays;
+  }
+}
+
 // Gather's direct light (gather.hpp): with few emitting patches each pair with an emitter is
 // the hybrid kernel's, the other rays' share scaled to the rest of the hemisphere. In a
 // closed cube with two of the lamp face's 25 patches emitting: the emitter entries are the
