@@ -53,10 +53,12 @@ class Kronecker4 {
     Rng rng(rng_bits);
     for (double& s : shift_) s = rng.uniform();
   }
-  /// Coordinate d (0..3) of point s.
+  /// Coordinate d (0..3) of point s (s >= 0).
   double get(std::int64_t s, int d) const {
     const double v = shift_[d] + static_cast<double>(s) * kAlpha[d];
-    return v - std::floor(v);
+    // v >= 0 (far below 2^63), so truncation is floor: two conversions instead of SSE2's
+    // masked floor sequence (a tenth of the hybrid kernel's own time), bitwise the same.
+    return v - static_cast<double>(static_cast<std::int64_t>(v));
   }
 
  private:

