@@ -98,8 +98,8 @@ constexpr std::int64_t kScanPerTouched = 32;
 // Row i's entries from its hits: F_ij = Σ w / K (summed in hit order), and with `with_err`
 // the error from the replicate estimates (Σ_{hits in r} w) / k_r. Without errors the sums
 // go through a dense accumulator over the patches (`acc`, all zero on entry and on return;
-// O(hits + min(distinct log distinct, patches))); with errors the hits are sorted by patch (stable,
-// so each sum is in the same order and F is bitwise the same either way).
+// O(hits + min(distinct log distinct, patches))); with errors the hits are sorted by patch
+// (stable, so each sum is in the same order and F is bitwise the same either way).
 void row_from_hits(std::vector<Hit>& hits, int K, bool with_err, std::vector<double>& acc,
                    std::vector<std::int32_t>& touched, std::vector<RowEntry>& row) {
   row.clear();
