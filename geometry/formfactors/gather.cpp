@@ -32,6 +32,7 @@
 #include "geometry/formfactors/assembly.hpp"
 #include "geometry/formfactors/constants.hpp"
 #include "geometry/formfactors/kernels.hpp"
+#include "geometry/formfactors/mirror.hpp"
 #include "geometry/formfactors/pairwise.hpp"
 #include "geometry/formfactors/replicates.hpp"
 
@@ -223,18 +224,22 @@ void direct_row(const std::vector<PatchGeom>& geom, const std::vector<Eigen::Vec
 }
 
 // Unordered pairs with an entry on at least one side: every upper entry, plus the lower
-// entries whose mirror is absent (binary search in the mirror's sorted row). O(nnz log).
+// entries whose mirror is absent (found by a MirrorCursor, as the averaging finds them).
 std::int64_t connected_pairs(const SparseF& F, int threads) {
+  using Index = SparseF::StorageIndex;
   const std::int32_t n = static_cast<std::int32_t>(F.rows());
-  const auto* outer = F.outerIndexPtr();
-  const auto* col = F.innerIndexPtr();
+  const Index* outer = F.outerIndexPtr();
+  const Index* col = F.innerIndexPtr();
   std::vector<std::int64_t> per_row(n, 0);
+  const std::uint64_t call = MirrorCursor::next_call();
   parallel_for(n, 1024, threads, [&](std::int64_t begin, std::int64_t end) {
+    thread_local MirrorCursor mirror;
+    mirror.rows(n);
     for (std::int64_t i = begin; i < end; ++i) {
       std::int64_t count = 0;
       for (auto k = outer[i]; k < outer[i + 1]; ++k) {
-        const auto j = col[k];
-        if (j > i || !std::binary_search(col + outer[j], col + outer[j + 1], i)) ++count;
+        const Index j = col[k];
+        if (j > i || mirror.find(col, outer, j, static_cast<Index>(i), call) < 0) ++count;
       }
       per_row[i] = count;
     }
